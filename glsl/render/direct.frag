@@ -1,0 +1,103 @@
+#version 450 core
+// Direct light at diffuse hits by shadow rays (stratified over each area light,
+// one ray per point light), and emitters seen along the path. Drawn with additive
+// blending: one call per batch of shadow samples adds its share. It also records
+// the first diffuse hit of each eye path, where the radiance estimate will add
+// indirect light and caustics: an eye path ends at its diffuse hit, so each
+// pixel's record is written once and the blend onto zero copies it.
+#include "common/scene.glsl"
+#include "common/random.glsl"
+
+uniform sampler2D u_hit_position;
+uniform sampler2D u_hit_normal;
+uniform sampler2D u_hit_throughput;
+uniform sampler2D u_hit_direction;
+uniform uint u_seed;
+uniform int u_depth;
+uniform int u_shadow_rays;   // N per area light
+uniform int u_strata_x;      // N = strata_x * strata_y
+uniform int u_sample_begin;  // this batch: samples [begin, end)
+uniform int u_sample_end;
+
+layout(location = 0) out vec4 o_radiance;
+layout(location = 1) out vec4 o_diffuse_position;   // xyz, w = 1 where recorded
+layout(location = 2) out vec4 o_diffuse_normal;     // facing the viewer, w = material + 1
+layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the hit
+
+const float PI = 3.14159265358979;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    o_radiance = vec4(0.0);
+    o_diffuse_position = vec4(0.0);
+    o_diffuse_normal = vec4(0.0);
+    o_diffuse_throughput = vec4(0.0);
+    vec4 hp = texelFetch(u_hit_position, px, 0);
+    vec4 ht = texelFetch(u_hit_throughput, px, 0);
+    if (hp.w < 0.0 || ht.w == 0.0) return;
+    int mat = int(hp.w);
+    int kind = material_kind(mat);
+    vec3 d = texelFetch(u_hit_direction, px, 0).xyz;
+    vec3 n = texelFetch(u_hit_normal, px, 0).xyz;
+    bool first_batch = u_sample_begin == 0;
+
+    if (kind == MAT_EMITTER) {
+        // One-sided: radiance leaves on the side of the light's normal only.
+        vec3 light_normal = material_texel(mat, 2).xyz;
+        if (first_batch && dot(d, light_normal) < 0.0)
+            o_radiance = vec4(ht.rgb * material_texel(mat, 1).rgb, 0.0);
+        return;
+    }
+    if (kind != MAT_DIFFUSE) return;
+
+    vec3 nf = dot(n, d) < 0.0 ? n : -n; // one BRDF on both sides: shade the side seen
+    vec3 p = hp.xyz;
+    vec3 origin = p + offset_scale(p) * nf;
+    vec3 albedo = material_texel(mat, 1).rgb;
+    vec3 sum = vec3(0.0);
+    int strata_y = u_shadow_rays / u_strata_x;
+
+    for (int l = 0; l < u_light_count; ++l) {
+        vec4 head = light_texel(l, 0);
+        vec3 a = light_texel(l, 1).xyz;
+        vec3 emitted = light_texel(l, 4).rgb;
+        if (int(head.x) == LIGHT_POINT) {
+            if (!first_batch) continue;
+            vec3 to_light = a - origin;
+            float dist = length(to_light);
+            vec3 wi = to_light / dist;
+            float cos_x = dot(nf, wi);
+            if (cos_x > 0.0 && !occluded(origin, wi, dist))
+                sum += emitted * cos_x / (dist * dist);
+            continue;
+        }
+        vec3 e1 = light_texel(l, 2).xyz;
+        vec3 e2 = light_texel(l, 3).xyz;
+        vec3 light_normal = head.yzw;
+        float area = length(cross(e1, e2));
+        vec3 light_sum = vec3(0.0);
+        for (int s = u_sample_begin; s < u_sample_end; ++s) {
+            uint rng = rng_init(u_seed, uvec2(px),
+                                0x40000000u | (uint(u_depth) << 24) | (uint(l) << 12) | uint(s));
+            float su = (float(s % u_strata_x) + rng_next(rng)) / float(u_strata_x);
+            float sv = (float(s / u_strata_x) + rng_next(rng)) / float(strata_y);
+            vec3 q = a + su * e1 + sv * e2;
+            vec3 to_light = q - origin;
+            float dist = length(to_light);
+            vec3 wi = to_light / dist;
+            float cos_x = dot(nf, wi);
+            float cos_l = -dot(light_normal, wi);
+            if (cos_x <= 0.0 || cos_l <= 0.0) continue;
+            // Stop short of the light's own surface by its offset scale.
+            if (occluded(origin, wi, dist - 2.0 * offset_scale(q))) continue;
+            light_sum += emitted * (cos_x * cos_l / (dist * dist));
+        }
+        sum += light_sum * (area / float(u_shadow_rays));
+    }
+    o_radiance = vec4(ht.rgb * (albedo / PI) * sum, 0.0);
+    if (first_batch) {
+        o_diffuse_position = vec4(p, 1.0);
+        o_diffuse_normal = vec4(nf, float(mat + 1));
+        o_diffuse_throughput = vec4(ht.rgb, 0.0);
+    }
+}

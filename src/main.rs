@@ -1,0 +1,201 @@
+//! The command line: `photonmap render`, `photonmap info`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Result};
+use clap::{Parser, Subcommand};
+
+use photonmap::gpu::{EglPlatform, Gpu};
+use photonmap::render::{self, RenderOptions};
+use photonmap::scene::load_scene;
+
+#[derive(Parser)]
+#[command(
+    name = "photonmap",
+    version,
+    about = "Headless GPU photon mapping after Purcell et al. 2003, on OpenGL fragment passes"
+)]
+struct Cli {
+    /// EGL platform: auto (a GPU's device platform when present, else Mesa surfaceless), surfaceless, device.
+    #[arg(long, value_enum, default_value_t = EglPlatform::Auto, global = true)]
+    egl: EglPlatform,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene file to a PNG (sRGB) and optionally an EXR (linear float RGB).
+    Render {
+        /// Scene file (TOML; see README.md).
+        scene: PathBuf,
+        /// Output PNG path.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also write linear float RGB to this OpenEXR path.
+        #[arg(long)]
+        exr: Option<PathBuf>,
+        /// Random seed: the same seed on the same driver gives the same image.
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// Image width in pixels (default: the scene's).
+        #[arg(long)]
+        width: Option<u32>,
+        /// Image height in pixels (default: the scene's).
+        #[arg(long)]
+        height: Option<u32>,
+        /// No progress bar and no timing table on stderr.
+        #[arg(long)]
+        quiet: bool,
+        /// Print the per-stage timings as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the EGL and GL implementation and the limits this program relies on.
+    Info {
+        /// As JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn check_output(path: &Path, extension: &str, flag: &str) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !ext.eq_ignore_ascii_case(extension) {
+        bail!(
+            "{flag} {}: the file name must end in .{extension}",
+            path.display()
+        );
+    }
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        bail!(
+            "{flag} {}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Info { json } => {
+            let gpu = Gpu::new(cli.egl)?;
+            let caps = gpu.capabilities();
+            if json {
+                println!("{}", serde_json::to_string_pretty(&caps)?);
+            } else {
+                println!("EGL platform      {}", caps.egl_platform);
+                println!(
+                    "EGL vendor        {} (EGL {})",
+                    caps.egl_vendor, caps.egl_version
+                );
+                println!("GL vendor         {}", caps.gl_vendor);
+                println!("GL renderer       {}", caps.gl_renderer);
+                println!(
+                    "GL version        {} (context {})",
+                    caps.gl_version, caps.context_version
+                );
+                println!("GLSL version      {}", caps.glsl_version);
+                println!("max texture size  {}", caps.max_texture_size);
+                println!("max draw buffers  {}", caps.max_draw_buffers);
+                println!(
+                    "point size range  {} .. {}",
+                    caps.point_size_range[0], caps.point_size_range[1]
+                );
+                println!("stencil bits      {}", caps.stencil_bits);
+                println!("timer query bits  {}", caps.timer_query_bits);
+                println!("occlusion query bits {}", caps.occlusion_query_bits);
+            }
+            Ok(())
+        }
+        Command::Render {
+            scene,
+            output,
+            exr,
+            seed,
+            width,
+            height,
+            quiet,
+            json,
+        } => {
+            check_output(&output, "png", "-o")?;
+            if let Some(e) = &exr {
+                check_output(e, "exr", "--exr")?;
+            }
+            let scene = load_scene(&scene)?;
+            let mut options = RenderOptions::for_scene(&scene);
+            options.seed = seed;
+            for (name, v) in [("--width", width), ("--height", height)] {
+                if let Some(v) = v {
+                    if !(1..=16384).contains(&v) {
+                        bail!("{name} {v}: the allowed range is 1..=16384");
+                    }
+                }
+            }
+            options.width = width.unwrap_or(options.width);
+            options.height = height.unwrap_or(options.height);
+            let gpu = Gpu::new(cli.egl)?;
+            let bar = if quiet {
+                indicatif::ProgressBar::hidden()
+            } else {
+                let b = indicatif::ProgressBar::new(1);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{msg} [{bar:40}] {pos}/{len} passes {elapsed}",
+                    )
+                    .expect("valid template")
+                    .progress_chars("=> "),
+                );
+                b.set_message(format!(
+                    "{} {}x{}",
+                    scene.name, options.width, options.height
+                ));
+                b
+            };
+            let progress = |done: usize, total: usize| {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            };
+            let out = render::render(&gpu, &scene, &options, &progress)?;
+            bar.finish_and_clear();
+            if out.image.has_non_finite() {
+                bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
+            }
+            let png = out.image.png_bytes().map_err(anyhow::Error::msg)?;
+            let exr_bytes = exr
+                .as_ref()
+                .map(|_| out.image.exr_bytes())
+                .transpose()
+                .map_err(anyhow::Error::msg)?;
+            render::image::write_atomically(&output, &png).map_err(anyhow::Error::msg)?;
+            if let (Some(path), Some(bytes)) = (&exr, exr_bytes) {
+                render::image::write_atomically(path, &bytes).map_err(anyhow::Error::msg)?;
+            }
+            if json {
+                println!("{}", serde_json::to_string_pretty(&out.timings)?);
+            }
+            if !quiet {
+                eprint!("{}", out.timings.table());
+                eprintln!("wrote {}", output.display());
+            }
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

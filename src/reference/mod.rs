@@ -1,0 +1,5 @@
+//! Plain-Rust twins of the GPU kernels, for tests and the paper's software column.
+
+pub mod intersect;
+pub mod random;
+pub mod ray_trace;

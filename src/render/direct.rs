@@ -1,0 +1,109 @@
+//! Direct illumination by shadow rays, emitters seen along eye paths, and the
+//! record of each eye path's first diffuse hit (what the radiance estimate reads).
+
+use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::scene::pack::SceneTextures;
+
+use super::{HitBuffers, Image};
+
+pub struct DirectLight {
+    gpu: Gpu,
+    /// Accumulated radiance per pixel (linear RGB).
+    pub radiance: Texture,
+    /// First diffuse hit: position (w = 1 where one exists).
+    pub diffuse_position: Texture,
+    /// Normal facing the viewer, w = material index + 1.
+    pub diffuse_normal: Texture,
+    /// Path throughput up to that hit.
+    pub diffuse_throughput: Texture,
+    target: Target,
+    program: Program,
+}
+
+/// Splits N samples into an nx x ny grid of strata, nx the largest divisor <= sqrt(N).
+pub fn strata(n: u32) -> (u32, u32) {
+    let mut nx = (n as f64).sqrt().floor() as u32;
+    while nx > 1 && n % nx != 0 {
+        nx -= 1;
+    }
+    let nx = nx.max(1);
+    (nx, n / nx)
+}
+
+impl DirectLight {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, GpuError> {
+        let t = || Texture::new(gpu, width, height, TexFormat::Rgba32F);
+        let (radiance, diffuse_position, diffuse_normal, diffuse_throughput) =
+            (t()?, t()?, t()?, t()?);
+        let target = Target::new(
+            gpu,
+            &[
+                &radiance,
+                &diffuse_position,
+                &diffuse_normal,
+                &diffuse_throughput,
+            ],
+        )?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            radiance,
+            diffuse_position,
+            diffuse_normal,
+            diffuse_throughput,
+            target,
+            program: Program::fullscreen(gpu, "render/direct.frag")?,
+        })
+    }
+
+    pub fn clear(&self) {
+        self.target.clear([0.0; 4]);
+    }
+
+    /// Adds shadow samples `samples` (of `shadow_rays` per area light) for the hits of `depth`.
+    pub fn shade(
+        &self,
+        scene: &SceneTextures,
+        hits: &HitBuffers,
+        shadow_rays: u32,
+        samples: std::ops::Range<u32>,
+        depth: u32,
+        seed: u32,
+    ) {
+        let (nx, _) = strata(shadow_rays);
+        let mut b = self.program.bind();
+        scene.bind(&mut b);
+        hits.bind(&mut b);
+        b.uint("u_seed", seed)
+            .int("u_depth", depth as i32)
+            .int("u_shadow_rays", shadow_rays as i32)
+            .int("u_strata_x", nx as i32)
+            .int("u_sample_begin", samples.start as i32)
+            .int("u_sample_end", samples.end as i32);
+        self.gpu.set_additive_blend(true);
+        self.gpu.draw_fullscreen(&self.target);
+        self.gpu.set_additive_blend(false);
+    }
+
+    pub fn read_radiance(&self) -> Image {
+        Image::from_gl_rgba(
+            self.radiance.width,
+            self.radiance.height,
+            &self.radiance.read_f32(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn strata_cover_every_sample_count() {
+        assert_eq!(super::strata(32), (4, 8));
+        assert_eq!(super::strata(4), (2, 2));
+        assert_eq!(super::strata(1), (1, 1));
+        assert_eq!(super::strata(7), (1, 7));
+        for n in 1..=1024 {
+            let (a, b) = super::strata(n);
+            assert_eq!(a * b, n);
+        }
+    }
+}

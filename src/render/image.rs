@@ -1,0 +1,146 @@
+//! Linear float RGB images, top row first; PNG (sRGB, clamped) and EXR (linear) output.
+
+use std::path::Path;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB, row 0 = top of the picture.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
+pub fn linear_to_srgb(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.0031308 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; (width * height) as usize],
+        }
+    }
+
+    /// From a GL read-back (RGBA, row 0 = bottom) to top-row-first RGB.
+    pub fn from_gl_rgba(width: u32, height: u32, rgba: &[f32]) -> Self {
+        let mut pixels = Vec::with_capacity((width * height) as usize);
+        for row in (0..height).rev() {
+            for x in 0..width {
+                let i = ((row * width + x) * 4) as usize;
+                pixels.push([rgba[i], rgba[i + 1], rgba[i + 2]]);
+            }
+        }
+        Self {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
+        self.pixels[(y * self.width + x) as usize]
+    }
+
+    pub fn mean(&self) -> [f64; 3] {
+        let mut s = [0f64; 3];
+        for p in &self.pixels {
+            for c in 0..3 {
+                s[c] += p[c] as f64;
+            }
+        }
+        s.map(|v| v / self.pixels.len().max(1) as f64)
+    }
+
+    pub fn has_non_finite(&self) -> bool {
+        self.pixels.iter().flatten().any(|v| !v.is_finite())
+    }
+
+    /// 8-bit sRGB PNG (values clamped to [0, 1] before the transfer function).
+    pub fn png_bytes(&self) -> Result<Vec<u8>, String> {
+        let mut buf = Vec::with_capacity(self.pixels.len() * 3);
+        for p in &self.pixels {
+            for c in p {
+                buf.push((linear_to_srgb(*c) * 255.0 + 0.5) as u8);
+            }
+        }
+        let img = image::RgbImage::from_raw(self.width, self.height, buf)
+            .ok_or("image buffer size mismatch")?;
+        let mut out = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut out, image::ImageFormat::Png)
+            .map_err(|e| e.to_string())?;
+        Ok(out.into_inner())
+    }
+
+    /// Linear float RGB OpenEXR, the same orientation as the PNG.
+    pub fn exr_bytes(&self) -> Result<Vec<u8>, String> {
+        use exr::prelude::*;
+        let w = self.width as usize;
+        let layer = Layer::new(
+            (w, self.height as usize),
+            LayerAttributes::named("rgb"),
+            Encoding::SMALL_LOSSLESS,
+            SpecificChannels::rgb(|pos: Vec2<usize>| {
+                let p = self.pixels[pos.y() * w + pos.x()];
+                (p[0], p[1], p[2])
+            }),
+        );
+        let mut out = std::io::Cursor::new(Vec::new());
+        exr::image::Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut out)
+            .map_err(|e| e.to_string())?;
+        Ok(out.into_inner())
+    }
+
+    pub fn read_exr(path: &Path) -> Result<Self, String> {
+        use exr::prelude::*;
+        let img = read_first_rgba_layer_from_file(
+            path,
+            |res, _| {
+                (
+                    res.width(),
+                    res.height(),
+                    vec![[0f32; 3]; res.width() * res.height()],
+                )
+            },
+            |(w, _, px): &mut (usize, usize, Vec<[f32; 3]>),
+             pos,
+             (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = [r, g, b];
+            },
+        )
+        .map_err(|e| format!("cannot read EXR {}: {e}", path.display()))?;
+        let (w, h, pixels) = img.layer_data.channel_data.pixels;
+        Ok(Self {
+            width: w as u32,
+            height: h as u32,
+            pixels,
+        })
+    }
+}
+
+/// Writes `bytes` to `path` all or nothing: a temporary file beside it, then a
+/// rename, so a failure never leaves a partial image behind.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+    let tmp = dir.join(format!(".{}.partial", name.to_string_lossy()));
+    std::fs::write(&tmp, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("cannot write {}: {e}", path.display())
+    })
+}

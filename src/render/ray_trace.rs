@@ -1,0 +1,128 @@
+//! Eye rays, closest hits and specular continuation as fragment passes over
+//! per-pixel ray and hit textures (breadth-first: one depth at a time).
+
+use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::scene::pack::SceneTextures;
+use crate::scene::Camera;
+
+use super::RenderOptions;
+
+/// Per-pixel rays: origin (w = active), unit direction, throughput.
+pub struct RayBuffers {
+    pub origin: Texture,
+    pub direction: Texture,
+    pub throughput: Texture,
+    target: Target,
+}
+
+/// Per-pixel hit records of one specular depth, as the paper's ray tracer writes them.
+pub struct HitBuffers {
+    /// xyz, w = material index (-1: no hit)
+    pub position: Texture,
+    /// geometric normal, w = primitive index
+    pub normal: Texture,
+    /// path throughput, w = 1 while the path is alive
+    pub throughput: Texture,
+    /// incoming unit direction, w = distance along the ray
+    pub direction: Texture,
+    target: Target,
+}
+
+impl HitBuffers {
+    pub fn bind(&self, b: &mut crate::gpu::Bindings<'_>) {
+        b.texture("u_hit_position", &self.position)
+            .texture("u_hit_normal", &self.normal)
+            .texture("u_hit_throughput", &self.throughput)
+            .texture("u_hit_direction", &self.direction);
+    }
+}
+
+pub struct RayTracer {
+    gpu: Gpu,
+    pub rays: RayBuffers,
+    pub hits: HitBuffers,
+    eye_program: Program,
+    intersect_program: Program,
+    specular_program: Program,
+}
+
+fn rgba(gpu: &Gpu, w: u32, h: u32) -> Result<Texture, GpuError> {
+    Texture::new(gpu, w, h, TexFormat::Rgba32F)
+}
+
+impl RayTracer {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, GpuError> {
+        let (origin, direction, throughput) = (
+            rgba(gpu, width, height)?,
+            rgba(gpu, width, height)?,
+            rgba(gpu, width, height)?,
+        );
+        let target = Target::new(gpu, &[&origin, &direction, &throughput])?;
+        let rays = RayBuffers {
+            origin,
+            direction,
+            throughput,
+            target,
+        };
+        let (position, normal, hthroughput, hdirection) = (
+            rgba(gpu, width, height)?,
+            rgba(gpu, width, height)?,
+            rgba(gpu, width, height)?,
+            rgba(gpu, width, height)?,
+        );
+        let target = Target::new(gpu, &[&position, &normal, &hthroughput, &hdirection])?;
+        let hits = HitBuffers {
+            position,
+            normal,
+            throughput: hthroughput,
+            direction: hdirection,
+            target,
+        };
+        Ok(Self {
+            gpu: gpu.clone(),
+            rays,
+            hits,
+            eye_program: Program::fullscreen(gpu, "render/eye_rays.frag")?,
+            intersect_program: Program::fullscreen(gpu, "render/intersect.frag")?,
+            specular_program: Program::fullscreen(gpu, "render/specular.frag")?,
+        })
+    }
+
+    /// One ray per pixel through its centre.
+    pub fn eye_rays(&self, camera: &Camera, options: &RenderOptions) {
+        let (u, v, w) = camera.basis();
+        let tan_v = (camera.vfov_degrees.to_radians() * 0.5).tan();
+        let aspect = options.width as f32 / options.height as f32;
+        let mut b = self.eye_program.bind();
+        b.vec3("u_camera_position", camera.position.to_array())
+            .vec3("u_camera_right", u.to_array())
+            .vec3("u_camera_up", v.to_array())
+            .vec3("u_camera_backward", w.to_array())
+            .vec2("u_tan_half_fov", [tan_v * aspect, tan_v])
+            .vec2(
+                "u_image_size",
+                [options.width as f32, options.height as f32],
+            )
+            .vec2("u_subpixel", [0.5, 0.5]);
+        self.gpu.draw_fullscreen(&self.rays.target);
+    }
+
+    /// Closest hit of every active ray into the hit textures.
+    pub fn intersect(&self, scene: &SceneTextures) {
+        let mut b = self.intersect_program.bind();
+        scene.bind(&mut b);
+        b.texture("u_ray_origin", &self.rays.origin)
+            .texture("u_ray_direction", &self.rays.direction)
+            .texture("u_ray_throughput", &self.rays.throughput);
+        self.gpu.draw_fullscreen(&self.hits.target);
+    }
+
+    /// Reflected or refracted rays from the specular hits of this depth.
+    pub fn specular(&self, scene: &SceneTextures, depth: u32, seed: u32) {
+        let mut b = self.specular_program.bind();
+        scene.bind(&mut b);
+        self.hits.bind(&mut b);
+        b.uint("u_seed", seed).int("u_depth", depth as i32);
+        self.gpu.draw_fullscreen(&self.rays.target);
+    }
+}

@@ -1,0 +1,214 @@
+//! The scene: a plain-Rust model of camera, shapes, materials, lights and the
+//! paper's per-scene parameters, loaded from TOML (+ OBJ) and validated.
+
+pub mod load;
+pub mod pack;
+
+use glam::Vec3;
+
+pub use load::{load_scene, load_scene_str, SceneError};
+
+#[derive(Clone, Debug)]
+pub struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub vfov_degrees: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Camera {
+    /// Orthonormal basis (right, up, backward) with the camera looking down -w.
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
+        let w = (self.position - self.look_at).normalize();
+        let u = self.up.cross(w).normalize();
+        let v = w.cross(u);
+        (u, v, w)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Lambertian, BRDF = albedo / pi, the same on both sides.
+    Diffuse { albedo: Vec3 },
+    /// Perfect specular reflection scaled by `reflectance`, both sides.
+    Mirror { reflectance: Vec3 },
+    /// Smooth dielectric in air, exact unpolarised Fresnel, no absorption.
+    Glass { ior: f32 },
+    /// An area light's surface: emits `radiance` on the side of `normal`, reflects nothing.
+    Emitter { radiance: Vec3, normal: Vec3 },
+}
+
+impl Material {
+    pub fn is_specular(&self) -> bool {
+        matches!(self, Material::Mirror { .. } | Material::Glass { .. })
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Geometry {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// Open cylinder: no caps, zero thickness; `axis` is a unit vector from the
+    /// centre of the base circle, `height` along it.
+    Cylinder {
+        base: Vec3,
+        axis: Vec3,
+        radius: f32,
+        height: f32,
+    },
+    /// Points corner + a*edge1 + b*edge2 for a, b in [0, 1].
+    Parallelogram {
+        corner: Vec3,
+        edge1: Vec3,
+        edge2: Vec3,
+    },
+    Triangle {
+        v0: Vec3,
+        v1: Vec3,
+        v2: Vec3,
+    },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shape {
+    pub geometry: Geometry,
+    pub material: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// One-sided parallelogram emitter of constant radiance; power = pi * area * Le.
+    Area {
+        corner: Vec3,
+        edge1: Vec3,
+        edge2: Vec3,
+        normal: Vec3,
+        radiance: Vec3,
+    },
+    /// Isotropic point light of radiant intensity I (W/sr); power = 4 pi I.
+    Point { position: Vec3, intensity: Vec3 },
+}
+
+impl Light {
+    pub fn power(&self) -> Vec3 {
+        match *self {
+            Light::Area {
+                edge1,
+                edge2,
+                radiance,
+                ..
+            } => std::f32::consts::PI * edge1.cross(edge2).length() * radiance,
+            Light::Point { intensity, .. } => 4.0 * std::f32::consts::PI * intensity,
+        }
+    }
+}
+
+/// Ray-tracing parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderParams {
+    /// Shadow rays per pixel to each area light (point lights always take one).
+    pub shadow_rays: u32,
+    /// Specular bounces an eye path may take before it is dropped.
+    pub max_specular_depth: u32,
+}
+
+/// The paper's photon-map parameters (used by the photon and estimate stages).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhotonMapParams {
+    /// Photons in the map (not emitted): 5,000 / 16,000 / 65,000 in the paper.
+    pub photons_stored: u32,
+    pub grid_resolution: [u32; 3],
+    /// Grid bounds; None = fitted automatically.
+    pub grid_bounds: Option<(Vec3, Vec3)>,
+    /// Photons sought per radiance estimate.
+    pub k: u32,
+    pub max_radius: f32,
+    pub max_bounces: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub camera: Camera,
+    pub materials: Vec<Material>,
+    pub shapes: Vec<Shape>,
+    pub lights: Vec<Light>,
+    pub render: RenderParams,
+    pub photon_map: PhotonMapParams,
+}
+
+impl Scene {
+    /// Axis-aligned bounds of every shape (area lights included).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut add = |p: Vec3| {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        };
+        for s in &self.shapes {
+            match s.geometry {
+                Geometry::Sphere { center, radius } => {
+                    add(center - Vec3::splat(radius));
+                    add(center + Vec3::splat(radius));
+                }
+                Geometry::Cylinder {
+                    base,
+                    axis,
+                    radius,
+                    height,
+                } => {
+                    for end in [base, base + axis * height] {
+                        add(end - Vec3::splat(radius));
+                        add(end + Vec3::splat(radius));
+                    }
+                }
+                Geometry::Parallelogram {
+                    corner,
+                    edge1,
+                    edge2,
+                } => {
+                    for p in [
+                        corner,
+                        corner + edge1,
+                        corner + edge2,
+                        corner + edge1 + edge2,
+                    ] {
+                        add(p);
+                    }
+                }
+                Geometry::Triangle { v0, v1, v2 } => {
+                    add(v0);
+                    add(v1);
+                    add(v2);
+                }
+            }
+        }
+        for l in &self.lights {
+            if let Light::Point { position, .. } = l {
+                add(*position);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The largest coordinate magnitude: what float error in hit points scales with.
+    pub fn extent(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        lo.abs()
+            .max(hi.abs())
+            .max_element()
+            .max((hi - lo).max_element())
+    }
+
+    pub fn has_specular(&self) -> bool {
+        self.shapes
+            .iter()
+            .any(|s| self.materials[s.material].is_specular())
+    }
+}

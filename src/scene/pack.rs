@@ -1,0 +1,152 @@
+//! The scene packed into float textures once, in the layout glsl/common/scene.glsl reads.
+
+use crate::gpu::{Gpu, GpuError, TexFormat, Texture};
+
+use super::{Geometry, Light, Material, Scene};
+
+pub const PRIMITIVE_TEXELS: u32 = 4;
+pub const MATERIAL_TEXELS: u32 = 3;
+pub const LIGHT_TEXELS: u32 = 5;
+
+/// Rows of RGBA floats, one row per primitive / material / light.
+pub struct PackedScene {
+    pub primitives: Vec<[f32; 4]>,
+    pub materials: Vec<[f32; 4]>,
+    pub lights: Vec<[f32; 4]>,
+    pub primitive_count: usize,
+    pub light_count: usize,
+    /// Absolute floor of ray-origin offsets: a millionth of the scene's size.
+    pub offset_floor: f32,
+}
+
+pub fn pack_geometry(g: &Geometry) -> [[f32; 4]; 3] {
+    let v = |a: glam::Vec3, w: f32| [a.x, a.y, a.z, w];
+    match *g {
+        Geometry::Sphere { center, radius } => [v(center, radius), [0.0; 4], [0.0; 4]],
+        Geometry::Cylinder {
+            base,
+            axis,
+            radius,
+            height,
+        } => [v(base, radius), v(axis, height), [0.0; 4]],
+        Geometry::Parallelogram {
+            corner,
+            edge1,
+            edge2,
+        } => [v(corner, 0.0), v(edge1, 0.0), v(edge2, 0.0)],
+        Geometry::Triangle { v0, v1, v2 } => [v(v0, 0.0), v(v1 - v0, 0.0), v(v2 - v0, 0.0)],
+    }
+}
+
+pub fn geometry_kind(g: &Geometry) -> f32 {
+    match g {
+        Geometry::Sphere { .. } => 0.0,
+        Geometry::Cylinder { .. } => 1.0,
+        Geometry::Parallelogram { .. } => 2.0,
+        Geometry::Triangle { .. } => 3.0,
+    }
+}
+
+impl PackedScene {
+    pub fn new(scene: &Scene) -> Self {
+        let mut primitives = Vec::new();
+        for s in &scene.shapes {
+            primitives.push([geometry_kind(&s.geometry), s.material as f32, 0.0, 0.0]);
+            primitives.extend(pack_geometry(&s.geometry));
+        }
+        let mut materials = Vec::new();
+        for m in &scene.materials {
+            let (kind, ior, color, normal) = match *m {
+                Material::Diffuse { albedo } => (0.0, 1.0, albedo, glam::Vec3::ZERO),
+                Material::Mirror { reflectance } => (1.0, 1.0, reflectance, glam::Vec3::ZERO),
+                Material::Glass { ior } => (2.0, ior, glam::Vec3::ONE, glam::Vec3::ZERO),
+                Material::Emitter { radiance, normal } => (3.0, 1.0, radiance, normal),
+            };
+            materials.push([kind, ior, 0.0, 0.0]);
+            materials.push([color.x, color.y, color.z, 0.0]);
+            materials.push([normal.x, normal.y, normal.z, 0.0]);
+        }
+        let mut lights = Vec::new();
+        for l in &scene.lights {
+            let v = |a: glam::Vec3| [a.x, a.y, a.z, 0.0];
+            match *l {
+                Light::Area {
+                    corner,
+                    edge1,
+                    edge2,
+                    normal,
+                    radiance,
+                } => {
+                    lights.extend([
+                        [0.0, normal.x, normal.y, normal.z],
+                        v(corner),
+                        v(edge1),
+                        v(edge2),
+                        v(radiance),
+                    ]);
+                }
+                Light::Point {
+                    position,
+                    intensity,
+                } => {
+                    lights.extend([
+                        [1.0, 0.0, 0.0, 0.0],
+                        v(position),
+                        [0.0; 4],
+                        [0.0; 4],
+                        v(intensity),
+                    ]);
+                }
+            }
+        }
+        Self {
+            primitives,
+            materials,
+            lights,
+            primitive_count: scene.shapes.len(),
+            light_count: scene.lights.len(),
+            offset_floor: 1e-6 * scene.extent(),
+        }
+    }
+}
+
+/// The packed scene on the GPU.
+pub struct SceneTextures {
+    pub primitives: Texture,
+    pub materials: Texture,
+    pub lights: Texture,
+    pub primitive_count: usize,
+    pub light_count: usize,
+    pub offset_floor: f32,
+}
+
+fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture, GpuError> {
+    let height = (rows.len() as u32 / width).max(1);
+    let mut data: Vec<f32> = rows.iter().flatten().copied().collect();
+    data.resize((width * height * 4) as usize, 0.0);
+    Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, &data)
+}
+
+impl SceneTextures {
+    pub fn new(gpu: &Gpu, scene: &Scene) -> Result<Self, GpuError> {
+        let p = PackedScene::new(scene);
+        Ok(Self {
+            primitives: upload(gpu, &p.primitives, PRIMITIVE_TEXELS)?,
+            materials: upload(gpu, &p.materials, MATERIAL_TEXELS)?,
+            lights: upload(gpu, &p.lights, LIGHT_TEXELS)?,
+            primitive_count: p.primitive_count,
+            light_count: p.light_count,
+            offset_floor: p.offset_floor,
+        })
+    }
+
+    /// Binds the textures and counts that glsl/common/scene.glsl declares.
+    pub fn bind(&self, b: &mut crate::gpu::Bindings<'_>) {
+        b.texture("u_primitives", &self.primitives)
+            .texture("u_materials", &self.materials)
+            .texture("u_lights", &self.lights)
+            .int("u_primitive_count", self.primitive_count as i32)
+            .int("u_light_count", self.light_count as i32)
+            .float("u_offset_floor", self.offset_floor);
+    }
+}
