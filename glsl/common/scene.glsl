@@ -65,7 +65,7 @@ int primitive_material(int prim) { return int(primitive_texel(prim, 0).y); }
 // Distance to move a ray origin off a surface at p: relative to p's magnitude
 // (float error in p scales with it) plus a floor relative to the scene's size.
 uniform float u_offset_floor;
-const float OFFSET_RELATIVE = 3.0517578125e-5; // 2^-15: 256 ulp of |p|
+const float OFFSET_RELATIVE = 3.814697265625e-6; // 2^-18: 32 ulp of |p|
 
 float offset_scale(vec3 p) {
     vec3 ap = abs(p);

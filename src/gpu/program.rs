@@ -31,8 +31,12 @@ pub struct ShaderError {
     pub log: String,
 }
 
-/// Source after `#include` resolution, with a table from GLSL source-string
-/// numbers (`#line L N`) back to file names.
+/// Source after `#include` resolution. Each file's lines are numbered
+/// `id * LINE_STRIDE + line` with `#line`: drivers report line numbers faithfully
+/// but not always the source-string number (Mesa 22 gives 0 for some errors),
+/// so the file is encoded in the line itself.
+const LINE_STRIDE: u32 = 1_000_000;
+
 struct Preprocessed {
     text: String,
     files: Vec<String>,
@@ -81,17 +85,17 @@ fn expand(
         if let Some(rest) = trimmed.strip_prefix("#include") {
             let path = rest.trim().trim_matches('"');
             expand(lookup, path, Some((name, line_no)), &[], out, included)?;
-            out.text += &format!("#line {} {}\n", line_no + 1, id);
+            out.text += &format!("#line {}\n", id as u32 * LINE_STRIDE + line_no + 1);
         } else if trimmed.starts_with("#version") {
             out.text += line;
             out.text.push('\n');
             for (k, v) in defines {
                 out.text += &format!("#define {k} {v}\n");
             }
-            out.text += &format!("#line {} {}\n", line_no + 1, id);
+            out.text += &format!("#line {}\n", id as u32 * LINE_STRIDE + line_no + 1);
         } else {
             if line_no == 1 {
-                out.text += &format!("#line 1 {id}\n");
+                out.text += &format!("#line {}\n", id as u32 * LINE_STRIDE + 1);
             }
             out.text += line;
             out.text.push('\n');
@@ -237,12 +241,12 @@ fn compile(
         let log = gl.get_shader_info_log(sh);
         gl.delete_shader(sh);
         let (file, line, message) = match parse_log(&log) {
-            Some((src, line, msg)) => (
+            Some((_, line, msg)) => (
                 pre.files
-                    .get(src)
+                    .get((line / LINE_STRIDE) as usize)
                     .cloned()
                     .unwrap_or_else(|| name.to_string()),
-                line,
+                line % LINE_STRIDE,
                 msg,
             ),
             None => (name.to_string(), 0, "compile error".to_string()),
@@ -292,8 +296,8 @@ mod tests {
         assert_eq!(p.files, vec!["a.frag", "b.glsl"]);
         assert!(p
             .text
-            .starts_with("#version 450 core\n#define K 3\n#line 2 0\n"));
-        assert!(p.text.contains("#line 1 1\nfloat b()"));
-        assert!(p.text.contains("#line 3 0\nvoid main"));
+            .starts_with("#version 450 core\n#define K 3\n#line 2\n"));
+        assert!(p.text.contains("#line 1000001\nfloat b()"));
+        assert!(p.text.contains("#line 3\nvoid main"));
     }
 }

@@ -54,7 +54,8 @@ pub fn surface_point(g: &Geometry, o: Vec3, d: Vec3, t: f32, u: f32, v: f32) -> 
     }
 }
 
-pub const OFFSET_RELATIVE: f32 = 3.0517578125e-5;
+/// 2^-18, as glsl/common/scene.glsl.
+pub const OFFSET_RELATIVE: f32 = 3.814697265625e-6;
 
 pub fn offset_scale(p: Vec3, offset_floor: f32) -> f32 {
     OFFSET_RELATIVE * p.abs().max_element() + offset_floor
@@ -82,7 +83,7 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> (f32, f32) {
 /// Expected radiance along a ray: direct light (area lights by a `grid` x `grid`
 /// midpoint rule), emitters, and every specular branch, to `depth_left` bounces.
 pub fn expected_radiance(scene: &Scene, o: Vec3, d: Vec3, depth_left: u32, grid: u32) -> Vec3 {
-    let floor = 1e-6 * scene.extent();
+    let floor = 1e-6 * scene.size();
     let Some((i, _t, p, n)) = closest_hit(scene, o, d) else {
         return Vec3::ZERO;
     };

@@ -613,13 +613,7 @@ fn scene_size(shapes: &[Shape]) -> f32 {
             max_bounces: 1,
         },
     };
-    let (lo, hi) = scene.bounds();
-    let d = (hi - lo).max_element();
-    if d.is_finite() && d > 0.0 {
-        d
-    } else {
-        1.0
-    }
+    scene.size()
 }
 
 /// Splits a planar convex polygon into a triangle fan.

@@ -197,13 +197,15 @@ impl Scene {
         (lo, hi)
     }
 
-    /// The largest coordinate magnitude: what float error in hit points scales with.
-    pub fn extent(&self) -> f32 {
+    /// The longest side of the scene's bounds: its size, wherever it stands.
+    pub fn size(&self) -> f32 {
         let (lo, hi) = self.bounds();
-        lo.abs()
-            .max(hi.abs())
-            .max_element()
-            .max((hi - lo).max_element())
+        let s = (hi - lo).max_element();
+        if s.is_finite() && s > 0.0 {
+            s
+        } else {
+            1.0
+        }
     }
 
     pub fn has_specular(&self) -> bool {

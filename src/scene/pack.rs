@@ -15,7 +15,8 @@ pub struct PackedScene {
     pub lights: Vec<[f32; 4]>,
     pub primitive_count: usize,
     pub light_count: usize,
-    /// Absolute floor of ray-origin offsets: a millionth of the scene's size.
+    /// Absolute floor of ray-origin offsets: a millionth of the scene's size (its
+    /// position is covered by the offset's term relative to |p|).
     pub offset_floor: f32,
 }
 
@@ -105,7 +106,7 @@ impl PackedScene {
             lights,
             primitive_count: scene.shapes.len(),
             light_count: scene.lights.len(),
-            offset_floor: 1e-6 * scene.extent(),
+            offset_floor: 1e-6 * scene.size(),
         }
     }
 }

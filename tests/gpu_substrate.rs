@@ -1,0 +1,231 @@
+//! The substrate on the real pipeline: exact read-back, ping-pong, integer
+//! addressing, shader errors located in glsl/, and every GLSL file compiling.
+
+mod common;
+
+use photonmap::gpu::program::glsl_files;
+use photonmap::gpu::{GpuError, PingPong, Program, Target, TexFormat, Texture};
+
+#[test]
+fn a_pass_writes_values_that_read_back_exactly() {
+    let gpu = common::gpu();
+    let (w, h) = (37, 19);
+    let tex = Texture::new(&gpu, w, h, TexFormat::Rgba32F).unwrap();
+    let target = Target::new(&gpu, &[&tex]).unwrap();
+    let program = Program::fullscreen(&gpu, "test/write_values.frag").unwrap();
+    let value = 0.1f32; // not a short binary fraction: must still come back bit for bit
+    program.bind().float("u_value", value);
+    gpu.draw_fullscreen(&target);
+    let data = tex.read_f32();
+    for y in 0..h {
+        for x in 0..w {
+            let i = ((y * w + x) * 4) as usize;
+            assert_eq!(
+                &data[i..i + 4],
+                &[x as f32, y as f32, value, 16777215.0 - x as f32],
+                "texel ({x}, {y})"
+            );
+        }
+    }
+}
+
+#[test]
+fn ping_pong_swaps_what_is_read_and_written() {
+    let gpu = common::gpu();
+    let mut pp = PingPong::new(&gpu, 8, 4, &[TexFormat::Rgba32F]).unwrap();
+    pp.current_target().clear([0.0; 4]);
+    let program = Program::fullscreen(&gpu, "test/add_one.frag").unwrap();
+    let first = pp.current_index();
+    for n in 1..=5 {
+        program.bind().texture("u_current", &pp.current()[0]);
+        gpu.draw_fullscreen(pp.next_target());
+        pp.swap();
+        assert_eq!(pp.current_index(), (first + n) % 2);
+        assert!(
+            pp.current()[0].read_f32().iter().all(|&v| v == n as f32),
+            "after {n} passes"
+        );
+    }
+}
+
+#[test]
+fn texel_addressing_is_exact_up_to_2_pow_28() {
+    let gpu = common::gpu();
+    let mut queries = Vec::new();
+    let widths = [
+        1, 2, 3, 7, 255, 256, 1000, 1024, 4095, 4096, 8191, 8192, 16383, 16384,
+    ];
+    let limit: i64 = 1 << 28;
+    for &w in &widths {
+        let w = w as i64;
+        // Boundaries of rows, powers of two, 2^24 (where float addressing breaks), the top.
+        let mut idx = vec![
+            0,
+            1,
+            w - 1,
+            w,
+            w + 1,
+            limit - 1,
+            limit - w,
+            (1 << 24) - 1,
+            1 << 24,
+            (1 << 24) + 1,
+        ];
+        for k in 0..28 {
+            idx.push(1 << k);
+            idx.push((1 << k) - 1);
+        }
+        let mut x: u64 = 0x9e3779b97f4a7c15 ^ w as u64;
+        for _ in 0..2000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            idx.push((x % limit as u64) as i64);
+        }
+        for i in idx.into_iter().filter(|&i| (0..limit).contains(&i)) {
+            queries.extend([i as i32, w as i32, 0, 0]);
+        }
+    }
+    let n = queries.len() / 4;
+    let tex_w = 256u32;
+    let tex_h = n.div_ceil(tex_w as usize) as u32;
+    queries.resize((tex_w * tex_h * 4) as usize, 0);
+    for q in queries.chunks_mut(4).skip(n) {
+        q[1] = 1;
+    }
+    let input = Texture::from_i32(&gpu, tex_w, tex_h, &queries).unwrap();
+    let output = Texture::new(&gpu, tex_w, tex_h, TexFormat::Rgba32I).unwrap();
+    let target = Target::new(&gpu, &[&output]).unwrap();
+    let program = Program::fullscreen(&gpu, "test/addressing.frag").unwrap();
+    program.bind().texture("u_queries", &input);
+    gpu.draw_fullscreen(&target);
+    let out = output.read_i32();
+    let mut mismatches = 0;
+    for k in 0..n {
+        let (i, w) = (queries[4 * k] as i64, queries[4 * k + 1] as i64);
+        let expect = [(i % w) as i32, (i / w) as i32, i as i32];
+        if out[4 * k..4 * k + 3] != expect {
+            mismatches += 1;
+            eprintln!(
+                "index {i} width {w}: got {:?}, expected {expect:?}",
+                &out[4 * k..4 * k + 3]
+            );
+        }
+    }
+    assert!(n > 20_000, "tested {n} indices");
+    assert_eq!(mismatches, 0);
+}
+
+#[test]
+fn a_broken_shader_names_its_glsl_file_and_line() {
+    let gpu = common::gpu();
+    // The real tree, with one include replaced by a file broken on its line 3.
+    let lookup = |name: &str| -> Option<String> {
+        match name {
+            "test/broken.frag" => Some(
+                "#version 450 core\n#include \"common/random.glsl\"\n#include \"test/broken_helper.glsl\"\nout vec4 c;\nvoid main() { c = vec4(helper()); }\n".into(),
+            ),
+            "test/broken_helper.glsl" => {
+                Some("// a helper\nfloat helper() {\n    return undefined_name * 2.0;\n}\n".into())
+            }
+            other => glsl_files().find(|(n, _)| *n == other).map(|(_, s)| s.to_string()),
+        }
+    };
+    let err = Program::from_lookup(
+        &gpu,
+        &lookup,
+        "common/fullscreen.vert",
+        "test/broken.frag",
+        &[],
+    )
+    .err()
+    .expect("the broken shader must not compile");
+    let GpuError::Shader(e) = err else {
+        panic!("expected a shader error, got {err}")
+    };
+    assert_eq!(
+        (e.file.as_str(), e.line),
+        ("test/broken_helper.glsl", 3),
+        "{e}"
+    );
+    assert!(
+        e.to_string().starts_with("glsl/test/broken_helper.glsl:3:"),
+        "{e}"
+    );
+
+    // An error in the root file after an include is located there too.
+    let lookup2 = |name: &str| -> Option<String> {
+        match name {
+            "test/broken.frag" => Some("#version 450 core\n#include \"common/random.glsl\"\nout vec4 c;\nvoid main() { c = vec4(nope); }\n".into()),
+            other => glsl_files().find(|(n, _)| *n == other).map(|(_, s)| s.to_string()),
+        }
+    };
+    let GpuError::Shader(e) = Program::from_lookup(
+        &gpu,
+        &lookup2,
+        "common/fullscreen.vert",
+        "test/broken.frag",
+        &[],
+    )
+    .err()
+    .unwrap() else {
+        panic!()
+    };
+    assert_eq!((e.file.as_str(), e.line), ("test/broken.frag", 4), "{e}");
+}
+
+#[test]
+fn every_glsl_file_compiles() {
+    let gpu = common::gpu();
+    let on_disk: Vec<String> = walk(&common::root().join("glsl"));
+    let embedded: Vec<&str> = glsl_files().map(|(n, _)| n).collect();
+    for f in &on_disk {
+        assert!(embedded.contains(&f.as_str()), "glsl/{f} is not embedded");
+    }
+    let mut compiled = 0;
+    for (name, _) in glsl_files() {
+        if name.ends_with(".frag") {
+            Program::fullscreen(&gpu, name).unwrap_or_else(|e| panic!("{e}"));
+            compiled += 1;
+        }
+    }
+    // Helpers (.glsl) compile as part of the passes that include them; make sure each is used.
+    for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".glsl")) {
+        let used = glsl_files().any(|(_, src)| src.contains(&format!("#include \"{name}\"")));
+        assert!(
+            used,
+            "glsl/{name} is included by no pass, so nothing compiles it"
+        );
+    }
+    assert!(compiled >= 6);
+}
+
+fn walk(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            for f in walk(&p) {
+                out.push(format!("{}/{f}", p.file_name().unwrap().to_string_lossy()));
+            }
+        } else {
+            out.push(p.file_name().unwrap().to_string_lossy().into_owned());
+        }
+    }
+    out
+}
+
+#[test]
+fn capabilities_report_what_later_stages_rely_on() {
+    let gpu = common::gpu();
+    let caps = gpu.capabilities();
+    assert!(!caps.gl_renderer.is_empty());
+    assert!(caps.max_texture_size >= 4096, "{caps:?}");
+    assert!(caps.max_draw_buffers >= 4, "{caps:?}");
+    assert_eq!(caps.stencil_bits, 8, "{caps:?}");
+    assert!(
+        caps.timer_query_bits > 0 && caps.occlusion_query_bits > 0,
+        "{caps:?}"
+    );
+    assert!(caps.point_size_range[1] >= 16.0, "{caps:?}");
+}
