@@ -727,14 +727,29 @@ impl Cx<'_> {
             + 1
     }
 
-    /// The line of `key =` inside the span of a table, else the table's first line.
+    /// The line of `key =` in a table: from the table's span (for `[header]`
+    /// tables the span holds only the header) up to the next header.
     fn field_line(&self, span: std::ops::Range<usize>, field: &str) -> usize {
         let key = field.rsplit('.').next().unwrap_or(field);
         let key = key.split('[').next().unwrap_or(key);
-        let body = &self.text[span.start.min(self.text.len())..span.end.min(self.text.len())];
-        let mut offset = span.start;
-        for line in body.split_inclusive('\n') {
-            let mut rest = line.trim_start();
+        let start = span.start.min(self.text.len());
+        let inline = self.text[start..].starts_with('{');
+        let end = if inline {
+            span.end.min(self.text.len())
+        } else {
+            self.text.len()
+        };
+        let mut offset = start;
+        for (n, line) in self.text[start..end].split_inclusive('\n').enumerate() {
+            let trimmed = line.trim_start();
+            let is_header = trimmed.starts_with('[')
+                && trimmed
+                    .trim_start_matches('[')
+                    .starts_with(|c: char| c.is_alphabetic() || c == '"');
+            if n > 0 && is_header && !inline {
+                break;
+            }
+            let mut rest = trimmed;
             // Also inside an inline table: `{ a = 1, key = 2 }`.
             loop {
                 if let Some(after) = rest.strip_prefix(key) {
@@ -762,22 +777,90 @@ impl Cx<'_> {
     }
 
     fn toml_error(&self, e: &toml::de::Error) -> SceneError {
-        let line = e.span().map_or(0, |s| self.line_of(s.start));
+        let span = e.span().unwrap_or(0..0);
         let message = e.message().trim().to_string();
+        let named = |what: &str| {
+            message
+                .contains(what)
+                .then(|| message.split('`').nth(1).map(str::to_string))
+                .flatten()
+        };
         // serde names the field in backticks: "unknown field `radiu`", "missing field `radius`".
-        let field = message
-            .split('`')
-            .nth(1)
-            .filter(|_| message.contains("field"))
-            .map(str::to_string)
-            .or_else(|| e.span().and_then(|s| self.key_before(s.start)))
+        if let Some(field) = named("unknown field") {
+            let line = self.field_line(span, &field);
+            return SceneError {
+                file: self.file.clone(),
+                line,
+                field,
+                message,
+            };
+        }
+        if let Some(field) = named("missing field") {
+            return SceneError {
+                file: self.file.clone(),
+                line: self.line_of(span.start),
+                field,
+                message,
+            };
+        }
+        if message.starts_with("unknown variant") {
+            let line = self.field_line(span, "type");
+            return SceneError {
+                file: self.file.clone(),
+                line,
+                field: "type".into(),
+                message,
+            };
+        }
+        // A type error inside a tagged table is reported at the table: find the
+        // line whose value is the one the message quotes.
+        if let Some((line, key)) = self.line_with_value(span.clone(), &message) {
+            return SceneError {
+                file: self.file.clone(),
+                line,
+                field: key,
+                message,
+            };
+        }
+        let field = self
+            .key_before(span.start)
             .unwrap_or_else(|| "(syntax)".into());
         SceneError {
             file: self.file.clone(),
-            line,
+            line: self.line_of(span.start),
             field,
             message,
         }
+    }
+
+    /// For "invalid type: string \"big\", expected f32", the `key = "big"` line.
+    fn line_with_value(
+        &self,
+        span: std::ops::Range<usize>,
+        message: &str,
+    ) -> Option<(usize, String)> {
+        let rest = message
+            .strip_prefix("invalid type: ")
+            .or_else(|| message.strip_prefix("invalid value: "))?;
+        let value = rest
+            .split(", expected")
+            .next()?
+            .split_once(' ')?
+            .1
+            .trim()
+            .trim_matches('`');
+        let start = span.start.min(self.text.len());
+        let mut offset = start;
+        for line in self.text[start..].split_inclusive('\n') {
+            if let Some((key, v)) = line.split_once('=') {
+                if v.trim().starts_with(value) && !value.is_empty() {
+                    let key = key.rsplit([',', '{']).next().unwrap_or(key).trim();
+                    return Some((self.line_of(offset), key.to_string()));
+                }
+            }
+            offset += line.len();
+        }
+        None
     }
 
     /// For a type error at a value, the key on the same line (`radius = "x"` -> radius).

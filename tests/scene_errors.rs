@@ -1,0 +1,345 @@
+//! Each kind of malformed scene gives its own error, naming file, line and field.
+
+mod common;
+
+use std::path::Path;
+
+use photonmap::scene::{load_scene, load_scene_str, SceneError};
+
+const GOOD: &str = r#"name = "t"
+[camera]
+position = [0.0, 1.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+vfov = 40.0
+width = 64
+height = 48
+
+[materials]
+white = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
+
+[[shape]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "white"
+
+[[light]]
+type = "point"
+position = [0.0, 3.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+
+fn load(text: &str) -> Result<photonmap::scene::Scene, SceneError> {
+    load_scene_str(text, Path::new("scenes/broken.toml"))
+}
+
+/// Replaces `from` in the good scene and expects an error at `line` on `field`
+/// whose message contains `says`.
+fn expect(from: &str, to: &str, line: usize, field: &str, says: &str) {
+    assert!(GOOD.contains(from), "{from:?} not in the good scene");
+    let text = GOOD.replacen(from, to, 1);
+    let e = load(&text).expect_err(&format!("{from:?} -> {to:?} should fail"));
+    assert_eq!(e.file, Path::new("scenes/broken.toml"));
+    assert_eq!((e.line, e.field.as_str()), (line, field), "{e}");
+    assert!(e.message.contains(says), "{e}");
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with(&format!("scenes/broken.toml:{line}: {field}: ")),
+        "{shown}"
+    );
+}
+
+#[test]
+fn the_good_scene_loads() {
+    let s = load(GOOD).unwrap();
+    assert_eq!((s.shapes.len(), s.lights.len(), s.camera.width), (1, 1, 64));
+}
+
+#[test]
+fn syntax_error() {
+    expect("vfov = 40.0", "vfov = = 40.0", 5, "vfov", "");
+}
+
+#[test]
+fn unknown_field() {
+    expect("radius = 1.0", "radiu = 1.0", 15, "radiu", "unknown field");
+}
+
+#[test]
+fn missing_field() {
+    expect("radius = 1.0\n", "", 12, "radius", "missing field");
+}
+
+#[test]
+fn wrong_type() {
+    expect(
+        "radius = 1.0",
+        "radius = \"big\"",
+        15,
+        "radius",
+        "expected f32",
+    );
+}
+
+#[test]
+fn unknown_shape_type() {
+    expect(
+        "type = \"sphere\"",
+        "type = \"cone\"",
+        13,
+        "type",
+        "unknown variant `cone`",
+    );
+}
+
+#[test]
+fn nan_value() {
+    expect(
+        "radius = 1.0",
+        "radius = nan",
+        15,
+        "shape[0].radius",
+        "not a finite number",
+    );
+}
+
+#[test]
+fn negative_radius() {
+    expect(
+        "radius = 1.0",
+        "radius = -1.0",
+        15,
+        "shape[0].radius",
+        "greater than 0",
+    );
+}
+
+#[test]
+fn albedo_above_one() {
+    expect(
+        "albedo = [0.5, 0.5, 0.5]",
+        "albedo = [0.5, 1.5, 0.5]",
+        10,
+        "materials.white.albedo",
+        "[0, 1]",
+    );
+}
+
+#[test]
+fn unknown_material() {
+    expect(
+        "material = \"white\"",
+        "material = \"black\"",
+        16,
+        "shape[0].material",
+        "no material named \"black\"",
+    );
+}
+
+#[test]
+fn absurd_resolution() {
+    expect(
+        "width = 64",
+        "width = 100000",
+        6,
+        "camera.width",
+        "1..=16384",
+    );
+}
+
+#[test]
+fn camera_looking_at_itself() {
+    expect(
+        "look_at = [0.0, 0.0, 0.0]",
+        "look_at = [0.0, 1.0, 3.0]",
+        4,
+        "camera.look_at",
+        "equals camera.position",
+    );
+}
+
+#[test]
+fn negative_light() {
+    expect(
+        "intensity = [1.0, 1.0, 1.0]",
+        "intensity = [1.0, -1.0, 1.0]",
+        21,
+        "light[0].intensity",
+        ">= 0",
+    );
+}
+
+#[test]
+fn no_light() {
+    let text = GOOD.split("[[light]]").next().unwrap();
+    let e = load(text).unwrap_err();
+    assert_eq!(e.field, "light");
+    assert!(e.message.contains("no [[light]]"), "{e}");
+}
+
+#[test]
+fn area_light_normal_off_its_plane() {
+    let text = GOOD.replace(
+        "type = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]",
+        "type = \"area\"\ncorner = [0.0, 3.0, 0.0]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [0.0, 0.0, 1.0]\nnormal = [1.0, 0.0, 0.0]\nradiance = [1.0, 1.0, 1.0]",
+    );
+    let e = load(&text).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (23, "light[0].normal"), "{e}");
+}
+
+#[test]
+fn zero_area_light() {
+    let text = GOOD.replace(
+        "type = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]",
+        "type = \"area\"\ncorner = [0.0, 3.0, 0.0]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [2.0, 0.0, 0.0]\nradiance = [1.0, 1.0, 1.0]",
+    );
+    let e = load(&text).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (22, "light[0].edge2"), "{e}");
+    assert!(e.message.contains("no area"), "{e}");
+}
+
+#[test]
+fn non_planar_polygon() {
+    let text = GOOD.replace(
+        "type = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+        "type = \"polygon\"\nvertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.5]]",
+    );
+    let e = load(&text).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (14, "shape[0].vertices"), "{e}");
+    assert!(e.message.contains("planar"), "{e}");
+}
+
+fn with_mesh(dir: &Path, obj_name: &str) -> std::path::PathBuf {
+    let text = GOOD.replace(
+        "type = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+        &format!("type = \"mesh\"\nfile = \"{obj_name}\""),
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn missing_obj_names_the_path() {
+    let dir = tempdir("missing_obj");
+    let e = load_scene(&with_mesh(&dir, "nowhere.obj")).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (14, "shape[0].file"), "{e}");
+    assert!(
+        e.message
+            .contains(&dir.join("nowhere.obj").display().to_string()),
+        "{e}"
+    );
+}
+
+#[test]
+fn obj_with_nan_vertex_is_refused() {
+    let dir = tempdir("nan_obj");
+    std::fs::write(
+        dir.join("bad.obj"),
+        "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let e = load_scene(&with_mesh(&dir, "bad.obj")).unwrap_err();
+    assert!(e.message.contains("finite"), "{e}");
+}
+
+#[test]
+fn good_obj_loads_as_triangles() {
+    let dir = tempdir("good_obj");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let s = load_scene(&with_mesh(&dir, "quad.obj")).unwrap();
+    assert_eq!(s.shapes.len(), 2);
+}
+
+#[test]
+fn missing_scene_file() {
+    let e = load_scene(Path::new("/nonexistent/scene.toml")).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/scene.toml:0: (file): cannot read"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_paper_scenes_match_the_pinned_numbers() {
+    use glam::Vec3;
+    use photonmap::scene::{Geometry, Light, Material};
+    let g = common::paper_scene("glass_ball");
+    assert_eq!(
+        (g.camera.width, g.camera.height, g.camera.vfov_degrees),
+        (512, 384, 38.0)
+    );
+    assert_eq!(
+        (
+            g.photon_map.photons_stored,
+            g.photon_map.k,
+            g.render.shadow_rays
+        ),
+        (5000, 32, 4)
+    );
+    assert_eq!(g.photon_map.grid_resolution, [250, 1, 250]);
+    assert!(g.shapes.iter().any(|s| s.geometry
+        == Geometry::Sphere {
+            center: Vec3::new(0.0, 0.8, 0.0),
+            radius: 0.8
+        }
+        && g.materials[s.material] == Material::Glass { ior: 1.5 }));
+    assert!(matches!(g.lights[0], Light::Area { radiance, .. } if radiance == Vec3::splat(60.0)));
+
+    let r = common::paper_scene("ring");
+    assert_eq!(
+        (
+            r.photon_map.photons_stored,
+            r.photon_map.k,
+            r.render.shadow_rays
+        ),
+        (16000, 64, 1)
+    );
+    assert_eq!(
+        r.lights[0],
+        Light::Point {
+            position: Vec3::new(0.0, 1.4, -3.2),
+            intensity: Vec3::splat(40.0)
+        }
+    );
+    assert!(r.shapes.iter().any(|s| s.geometry
+        == Geometry::Cylinder {
+            base: Vec3::ZERO,
+            axis: Vec3::Y,
+            radius: 1.0,
+            height: 0.6
+        }
+        && r.materials[s.material]
+            == Material::Mirror {
+                reflectance: Vec3::new(0.95, 0.80, 0.45)
+            }));
+
+    let c = common::paper_scene("cornell_box");
+    assert_eq!((c.camera.width, c.camera.height), (512, 512));
+    assert_eq!(
+        (
+            c.photon_map.photons_stored,
+            c.photon_map.k,
+            c.render.shadow_rays
+        ),
+        (65000, 500, 32)
+    );
+    assert_eq!(c.photon_map.grid_resolution, [25, 25, 50]);
+    let power = c.lights[0].power();
+    assert!(
+        (power.x - std::f32::consts::PI * 0.25 * 25.0).abs() < 1e-4,
+        "{power}"
+    );
+    assert_eq!(c.shapes.len(), 5 + 2 + 1, "5 walls, 2 spheres, the light");
+}
+
+fn tempdir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("photonmap-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
