@@ -83,19 +83,31 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> (f32, f32) {
 /// Expected radiance along a ray: direct light (area lights by a `grid` x `grid`
 /// midpoint rule), emitters, and every specular branch, to `depth_left` bounces.
 pub fn expected_radiance(scene: &Scene, o: Vec3, d: Vec3, depth_left: u32, grid: u32) -> Vec3 {
+    expected_moments(scene, o, d, depth_left, grid).0
+}
+
+/// First and second moments of the GPU's one-path estimate along a ray: glass
+/// picks reflection with probability F, so both moments mix the branches with
+/// weights F and 1 - F; variance = second - first^2, exactly.
+pub fn expected_moments(
+    scene: &Scene,
+    o: Vec3,
+    d: Vec3,
+    depth_left: u32,
+    grid: u32,
+) -> (Vec3, Vec3) {
     let floor = 1e-6 * scene.size();
     let Some((i, _t, p, n)) = closest_hit(scene, o, d) else {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, Vec3::ZERO);
     };
+    let deterministic = |l: Vec3| (l, l * l);
     let nf = if n.dot(d) < 0.0 { n } else { -n };
     match scene.materials[scene.shapes[i].material] {
-        Material::Emitter { radiance, normal } => {
-            if d.dot(normal) < 0.0 {
-                radiance
-            } else {
-                Vec3::ZERO
-            }
-        }
+        Material::Emitter { radiance, normal } => deterministic(if d.dot(normal) < 0.0 {
+            radiance
+        } else {
+            Vec3::ZERO
+        }),
         Material::Diffuse { albedo } => {
             let origin = p + offset_scale(p, floor) * nf;
             let mut sum = Vec3::ZERO;
@@ -148,19 +160,20 @@ pub fn expected_radiance(scene: &Scene, o: Vec3, d: Vec3, depth_left: u32, grid:
                     }
                 }
             }
-            albedo / std::f32::consts::PI * sum
+            deterministic(albedo / std::f32::consts::PI * sum)
         }
         Material::Mirror { reflectance } => {
             if depth_left == 0 {
-                return Vec3::ZERO;
+                return (Vec3::ZERO, Vec3::ZERO);
             }
             let r = (d - 2.0 * d.dot(nf) * nf).normalize();
             let origin = p + offset_scale(p, floor) * nf;
-            reflectance * expected_radiance(scene, origin, r, depth_left - 1, grid)
+            let (m1, m2) = expected_moments(scene, origin, r, depth_left - 1, grid);
+            (reflectance * m1, reflectance * reflectance * m2)
         }
         Material::Glass { ior } => {
             if depth_left == 0 {
-                return Vec3::ZERO;
+                return (Vec3::ZERO, Vec3::ZERO);
             }
             let entering = n.dot(d) < 0.0;
             let eta = if entering { 1.0 / ior } else { ior };
@@ -168,25 +181,32 @@ pub fn expected_radiance(scene: &Scene, o: Vec3, d: Vec3, depth_left: u32, grid:
             let (f, cos_t) = fresnel_dielectric(cos_i, eta);
             let r = (d - 2.0 * d.dot(nf) * nf).normalize();
             let s = offset_scale(p, floor);
-            let mut l = f * expected_radiance(scene, p + s * nf, r, depth_left - 1, grid);
+            let (r1, r2) = expected_moments(scene, p + s * nf, r, depth_left - 1, grid);
+            let (mut m1, mut m2) = (f * r1, f * r2);
             if f < 1.0 {
                 let t = (eta * d + (eta * cos_i - cos_t) * nf).normalize();
-                l += (1.0 - f) * expected_radiance(scene, p - s * nf, t, depth_left - 1, grid);
+                let (t1, t2) = expected_moments(scene, p - s * nf, t, depth_left - 1, grid);
+                m1 += (1.0 - f) * t1;
+                m2 += (1.0 - f) * t2;
             }
-            l
+            (m1, m2)
         }
     }
 }
 
 /// The eye ray through pixel (x, y), y counted from the top row.
 pub fn eye_ray(scene: &Scene, width: u32, height: u32, x: u32, y: u32) -> (Vec3, Vec3) {
+    eye_ray_at(scene, width, height, x as f32 + 0.5, y as f32 + 0.5)
+}
+
+/// The eye ray through image point (fx, fy) in pixels from the top-left corner.
+pub fn eye_ray_at(scene: &Scene, width: u32, height: u32, fx: f32, fy: f32) -> (Vec3, Vec3) {
     let cam = &scene.camera;
     let (u, v, w) = cam.basis();
     let tan_v = (cam.vfov_degrees.to_radians() * 0.5).tan();
     let aspect = width as f32 / height as f32;
-    let gl_y = height - 1 - y;
-    let nx = (x as f32 + 0.5) / width as f32 * 2.0 - 1.0;
-    let ny = (gl_y as f32 + 0.5) / height as f32 * 2.0 - 1.0;
+    let nx = fx / width as f32 * 2.0 - 1.0;
+    let ny = (height as f32 - fy) / height as f32 * 2.0 - 1.0;
     let d = -w + nx * tan_v * aspect * u + ny * tan_v * v;
     (cam.position, d.normalize())
 }
