@@ -1,0 +1,120 @@
+//! The `photonmap` command as a user runs it.
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use photonmap::render::Image;
+
+fn photonmap() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_photonmap"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("photonmap-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn scene(name: &str) -> PathBuf {
+    common::root().join("scenes").join(format!("{name}.toml"))
+}
+
+#[test]
+fn render_writes_png_and_exr_the_same_way_up() {
+    let d = tmp("render");
+    let (png, exr) = (d.join("c.png"), d.join("c.exr"));
+    let out = photonmap()
+        .args(["render", "--quiet", "--width", "48", "--height", "40"])
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .arg("--exr")
+        .arg(&exr)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let linear = Image::read_exr(&exr).unwrap();
+    assert_eq!((linear.width, linear.height), (48, 40));
+    let srgb = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(srgb.dimensions(), (48, 40));
+    // The ceiling light is at the top: the brightest row is in the top quarter, in both files.
+    let brightest_exr = (0..40).max_by(|&a, &b| {
+        let row = |y| (0..48).map(|x| linear.get(x, y)[0]).sum::<f32>();
+        row(a).total_cmp(&row(b))
+    });
+    assert!(brightest_exr.unwrap() < 10, "brightest EXR row {brightest_exr:?}");
+    for (x, y, p) in srgb.enumerate_pixels() {
+        let v = linear.get(x, y);
+        let expect = (photonmap::render::image::linear_to_srgb(v[0]) * 255.0 + 0.5) as u8;
+        assert_eq!(p[0], expect, "pixel ({x}, {y})");
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_image_and_another_seed_another() {
+    let d = tmp("seed");
+    let run = |seed: &str, name: &str| {
+        let exr = d.join(name);
+        let st = photonmap()
+            .args(["render", "--quiet", "--width", "40", "--height", "30", "--seed", seed])
+            .arg(scene("glass_ball"))
+            .arg("-o")
+            .arg(d.join("x.png"))
+            .arg("--exr")
+            .arg(&exr)
+            .status()
+            .unwrap();
+        assert!(st.success());
+        Image::read_exr(&exr).unwrap()
+    };
+    let (a, b, c) = (run("7", "a.exr"), run("7", "b.exr"), run("8", "c.exr"));
+    assert_eq!(a, b, "same seed, same driver: identical images");
+    assert_ne!(a, c, "another seed: other shadow samples");
+}
+
+#[test]
+fn a_malformed_scene_fails_cleanly_and_writes_nothing() {
+    let d = tmp("bad");
+    let bad = d.join("bad.toml");
+    std::fs::write(&bad, std::fs::read_to_string(scene("ring")).unwrap().replace("radius = 1.0", "radius = -1.0")).unwrap();
+    let png = d.join("out.png");
+    let out = photonmap().args(["render", "--quiet"]).arg(&bad).arg("-o").arg(&png).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&format!("{}:", bad.display())) && err.contains("shape[1].radius"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1, "only the scene file is there");
+}
+
+#[test]
+fn impossible_parameters_say_the_allowed_range() {
+    let d = tmp("range");
+    let out = photonmap()
+        .args(["render", "--quiet", "--width", "0"])
+        .arg(scene("ring"))
+        .arg("-o")
+        .arg(d.join("x.png"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1..=16384"));
+    let out = photonmap().args(["render", "--quiet"]).arg(scene("ring")).arg("-o").arg(d.join("missing/x.png")).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+    let out = photonmap().args(["render", "--quiet"]).arg(scene("ring")).arg("-o").arg(d.join("x.jpg")).output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".png"));
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 0, "nothing written");
+}
+
+#[test]
+fn info_names_the_renderer_and_limits() {
+    let out = photonmap().args(["info", "--json"]).output().unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["gl_renderer"].as_str().is_some_and(|s| !s.is_empty()));
+    assert!(v["max_texture_size"].as_i64().unwrap() >= 4096);
+    assert_eq!(v["stencil_bits"], 8);
+}
