@@ -35,7 +35,11 @@ fn render_writes_png_and_exr_the_same_way_up() {
         .arg(&exr)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let linear = Image::read_exr(&exr).unwrap();
     assert_eq!((linear.width, linear.height), (48, 40));
     let srgb = image::open(&png).unwrap().to_rgb8();
@@ -45,7 +49,10 @@ fn render_writes_png_and_exr_the_same_way_up() {
         let row = |y| (0..48).map(|x| linear.get(x, y)[0]).sum::<f32>();
         row(a).total_cmp(&row(b))
     });
-    assert!(brightest_exr.unwrap() < 10, "brightest EXR row {brightest_exr:?}");
+    assert!(
+        brightest_exr.unwrap() < 10,
+        "brightest EXR row {brightest_exr:?}"
+    );
     for (x, y, p) in srgb.enumerate_pixels() {
         let v = linear.get(x, y);
         let expect = (photonmap::render::image::linear_to_srgb(v[0]) * 255.0 + 0.5) as u8;
@@ -59,7 +66,9 @@ fn the_same_seed_gives_the_same_image_and_another_seed_another() {
     let run = |seed: &str, name: &str| {
         let exr = d.join(name);
         let st = photonmap()
-            .args(["render", "--quiet", "--width", "40", "--height", "30", "--seed", seed])
+            .args([
+                "render", "--quiet", "--width", "40", "--height", "30", "--seed", seed,
+            ])
             .arg(scene("glass_ball"))
             .arg("-o")
             .arg(d.join("x.png"))
@@ -79,14 +88,33 @@ fn the_same_seed_gives_the_same_image_and_another_seed_another() {
 fn a_malformed_scene_fails_cleanly_and_writes_nothing() {
     let d = tmp("bad");
     let bad = d.join("bad.toml");
-    std::fs::write(&bad, std::fs::read_to_string(scene("ring")).unwrap().replace("radius = 1.0", "radius = -1.0")).unwrap();
+    std::fs::write(
+        &bad,
+        std::fs::read_to_string(scene("ring"))
+            .unwrap()
+            .replace("radius = 1.0", "radius = -1.0"),
+    )
+    .unwrap();
     let png = d.join("out.png");
-    let out = photonmap().args(["render", "--quiet"]).arg(&bad).arg("-o").arg(&png).output().unwrap();
+    let out = photonmap()
+        .args(["render", "--quiet"])
+        .arg(&bad)
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains(&format!("{}:", bad.display())) && err.contains("shape[1].radius"), "{err}");
+    assert!(
+        err.contains(&format!("{}:", bad.display())) && err.contains("shape[1].radius"),
+        "{err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
-    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1, "only the scene file is there");
+    assert_eq!(
+        std::fs::read_dir(&d).unwrap().count(),
+        1,
+        "only the scene file is there"
+    );
 }
 
 #[test]
@@ -101,10 +129,22 @@ fn impossible_parameters_say_the_allowed_range() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("1..=16384"));
-    let out = photonmap().args(["render", "--quiet"]).arg(scene("ring")).arg("-o").arg(d.join("missing/x.png")).output().unwrap();
+    let out = photonmap()
+        .args(["render", "--quiet"])
+        .arg(scene("ring"))
+        .arg("-o")
+        .arg(d.join("missing/x.png"))
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
-    let out = photonmap().args(["render", "--quiet"]).arg(scene("ring")).arg("-o").arg(d.join("x.jpg")).output().unwrap();
+    let out = photonmap()
+        .args(["render", "--quiet"])
+        .arg(scene("ring"))
+        .arg("-o")
+        .arg(d.join("x.jpg"))
+        .output()
+        .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains(".png"));
     assert_eq!(std::fs::read_dir(&d).unwrap().count(), 0, "nothing written");
 }

@@ -7,9 +7,7 @@ use glam::{DVec3, Vec3};
 use photonmap::gpu::{Gpu, Program, Target, TexFormat, Texture};
 use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
 use photonmap::scene::pack::SceneTextures;
-use photonmap::scene::{
-    Camera, Geometry, Light, Material, PhotonMapParams, RenderParams, Scene, Shape,
-};
+use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
 
 struct Rng(u64);
 impl Rng {
@@ -41,40 +39,19 @@ fn one_shape_scene(g: Geometry) -> Scene {
         Geometry::Parallelogram { corner, .. } => corner,
         Geometry::Triangle { v0, .. } => v0,
     };
-    Scene {
-        name: "twin".into(),
-        camera: Camera {
-            position: Vec3::Z,
-            look_at: Vec3::ZERO,
-            up: Vec3::Y,
-            vfov_degrees: 40.0,
-            width: 1,
-            height: 1,
-        },
-        materials: vec![Material::Diffuse {
-            albedo: Vec3::splat(0.5),
-        }],
-        shapes: vec![Shape {
+    Scene::with_shapes(
+        vec![Shape {
             geometry: g,
             material: 0,
         }],
-        lights: vec![Light::Point {
+        vec![Material::Diffuse {
+            albedo: Vec3::splat(0.5),
+        }],
+        vec![Light::Point {
             position: light_at,
             intensity: Vec3::ONE,
         }],
-        render: RenderParams {
-            shadow_rays: 1,
-            max_specular_depth: 1,
-        },
-        photon_map: PhotonMapParams {
-            photons_stored: 1,
-            grid_resolution: [1; 3],
-            grid_bounds: None,
-            k: 1,
-            max_radius: 1.0,
-            max_bounces: 1,
-        },
-    }
+    )
 }
 
 /// Runs glsl/test/intersect_twin.frag over rays; returns (t, u, v, hit) per ray.

@@ -42,8 +42,9 @@ unsafe impl Send for SharedDisplay {}
 #[allow(unsafe_code)]
 unsafe impl Sync for SharedDisplay {}
 
-static DISPLAYS: OnceLock<std::sync::Mutex<Vec<(EglPlatform, Arc<SharedDisplay>)>>> =
-    OnceLock::new();
+type DisplayTable = std::sync::Mutex<Vec<(EglPlatform, Arc<SharedDisplay>)>>;
+
+static DISPLAYS: OnceLock<DisplayTable> = OnceLock::new();
 
 const PACKAGE_HINT: &str =
     "install Mesa's EGL: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri";

@@ -218,7 +218,8 @@ impl Program {
             .borrow_mut()
             .entry(name.to_string())
             .or_insert_with(|| unsafe { self.gpu.gl().get_uniform_location(self.raw, name) })
-            .clone()
+            .as_ref()
+            .copied()
     }
 }
 

@@ -55,7 +55,7 @@ pub fn surface_point(g: &Geometry, o: Vec3, d: Vec3, t: f32, u: f32, v: f32) -> 
 }
 
 /// 2^-18, as glsl/common/scene.glsl.
-pub const OFFSET_RELATIVE: f32 = 3.814697265625e-6;
+pub const OFFSET_RELATIVE: f32 = 3.814_697e-6;
 
 pub fn offset_scale(p: Vec3, offset_floor: f32) -> f32 {
     OFFSET_RELATIVE * p.abs().max_element() + offset_floor

@@ -23,7 +23,7 @@ pub struct DirectLight {
 /// Splits N samples into an nx x ny grid of strata, nx the largest divisor <= sqrt(N).
 pub fn strata(n: u32) -> (u32, u32) {
     let mut nx = (n as f64).sqrt().floor() as u32;
-    while nx > 1 && n % nx != 0 {
+    while nx > 1 && !n.is_multiple_of(nx) {
         nx -= 1;
     }
     let nx = nx.max(1);

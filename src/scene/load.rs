@@ -587,33 +587,7 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
 }
 
 fn scene_size(shapes: &[Shape]) -> f32 {
-    let scene = Scene {
-        name: String::new(),
-        camera: Camera {
-            position: Vec3::ZERO,
-            look_at: Vec3::Z,
-            up: Vec3::Y,
-            vfov_degrees: 1.0,
-            width: 1,
-            height: 1,
-        },
-        materials: vec![],
-        shapes: shapes.to_vec(),
-        lights: vec![],
-        render: RenderParams {
-            shadow_rays: 1,
-            max_specular_depth: 0,
-        },
-        photon_map: PhotonMapParams {
-            photons_stored: 1,
-            grid_resolution: [1; 3],
-            grid_bounds: None,
-            k: 1,
-            max_radius: 1.0,
-            max_bounces: 1,
-        },
-    };
-    scene.size()
+    Scene::with_shapes(shapes.to_vec(), vec![], vec![]).size()
 }
 
 /// Splits a planar convex polygon into a triangle fan.

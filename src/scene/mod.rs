@@ -143,6 +143,37 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// A scene of these shapes and lights with neutral camera and parameters
+    /// (for measuring geometry, and for tests).
+    pub fn with_shapes(shapes: Vec<Shape>, materials: Vec<Material>, lights: Vec<Light>) -> Self {
+        Scene {
+            name: String::new(),
+            camera: Camera {
+                position: Vec3::Z,
+                look_at: Vec3::ZERO,
+                up: Vec3::Y,
+                vfov_degrees: 40.0,
+                width: 1,
+                height: 1,
+            },
+            materials,
+            shapes,
+            lights,
+            render: RenderParams {
+                shadow_rays: 1,
+                max_specular_depth: 1,
+            },
+            photon_map: PhotonMapParams {
+                photons_stored: 1,
+                grid_resolution: [1; 3],
+                grid_bounds: None,
+                k: 1,
+                max_radius: 1.0,
+                max_bounces: 1,
+            },
+        }
+    }
+
     /// Axis-aligned bounds of every shape (area lights included).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::INFINITY);
