@@ -182,12 +182,30 @@ fn every_glsl_file_compiles() {
     for f in &on_disk {
         assert!(embedded.contains(&f.as_str()), "glsl/{f} is not embedded");
     }
+    // Fragment programs drawn from points pair with their vertex program; the
+    // rest with the full-screen triangle. Vertex programs with #ifdef variants
+    // are built both ways.
+    let vertex_of = |frag: &str| match frag {
+        "photon/route.frag" | "photon/count.frag" => "photon/route.vert",
+        _ => "common/fullscreen.vert",
+    };
     let mut compiled = 0;
     for (name, _) in glsl_files() {
         if name.ends_with(".frag") {
-            Program::fullscreen(&gpu, name).unwrap_or_else(|e| panic!("{e}"));
+            Program::new(&gpu, vertex_of(name), name, &[]).unwrap_or_else(|e| panic!("{e}"));
+            if vertex_of(name) == "photon/route.vert" {
+                Program::new(&gpu, vertex_of(name), name, &[("READBACK", "1".into())])
+                    .unwrap_or_else(|e| panic!("{e}"));
+            }
             compiled += 1;
         }
+    }
+    for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".vert")) {
+        let used = glsl_files().any(|(f, _)| f.ends_with(".frag") && vertex_of(f) == name);
+        assert!(
+            used,
+            "glsl/{name} is paired with no fragment program, so nothing compiles it"
+        );
     }
     // Helpers (.glsl) compile as part of the passes that include them; make sure each is used.
     for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".glsl")) {

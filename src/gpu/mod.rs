@@ -8,6 +8,7 @@ pub mod pass;
 pub mod program;
 pub mod query;
 pub mod texture;
+pub mod vertex;
 
 use std::rc::Rc;
 
@@ -18,6 +19,7 @@ pub use pass::Bindings;
 pub use program::{Program, ShaderError};
 pub use query::{OcclusionQuery, TimerQuery};
 pub use texture::{PingPong, Target, TexFormat, Texture};
+pub use vertex::VertexBuffer;
 
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
@@ -92,6 +94,68 @@ impl Gpu {
         unsafe {
             self.gl().bind_vertex_array(Some(self.empty_vao));
             self.gl().draw_arrays(glow::TRIANGLES, 0, 3);
+        }
+    }
+
+    /// Draws a full-screen triangle clipped to the rectangle (x, y, w, h) of
+    /// `target`: a pass over one band of a texture (a photon frame).
+    pub fn draw_region(&self, target: &Target, x: i32, y: i32, w: i32, h: i32) {
+        target.bind();
+        unsafe {
+            let gl = self.gl();
+            gl.viewport(x, y, w, h);
+            gl.bind_vertex_array(Some(self.empty_vao));
+            gl.draw_arrays(glow::TRIANGLES, 0, 3);
+        }
+    }
+
+    /// Makes what earlier draws wrote to a texture visible to later draws that
+    /// read other texels of it while it is attached (GL 4.5 glTextureBarrier).
+    pub fn texture_barrier(&self) {
+        type TextureBarrier = extern "system" fn();
+        match self.ctx.proc_address("glTextureBarrier") {
+            // SAFETY: the GL 4.5 signature, on the current context.
+            Some(f) => unsafe { std::mem::transmute::<extern "system" fn(), TextureBarrier>(f)() },
+            // Without it, finishing the queue is the conservative equivalent.
+            None => self.finish(),
+        }
+    }
+
+    /// Sets up stencil and depth state for one draw, or turns both tests off.
+    pub fn set_stencil_routing(&self, on: bool) {
+        unsafe {
+            let gl = self.gl();
+            if on {
+                gl.enable(glow::STENCIL_TEST);
+                gl.enable(glow::DEPTH_TEST);
+                gl.depth_func(glow::LESS);
+                gl.depth_mask(true);
+                gl.stencil_mask(0xff);
+            } else {
+                gl.disable(glow::STENCIL_TEST);
+                gl.disable(glow::DEPTH_TEST);
+            }
+        }
+    }
+
+    /// Colour writes on every draw buffer on or off.
+    pub fn set_color_writes(&self, on: bool) {
+        unsafe { self.gl().color_mask(on, on, on, on) }
+    }
+
+    /// Depth test that always passes and writes nothing (stencil-only passes).
+    pub fn set_depth_test_always_no_write(&self) {
+        unsafe {
+            self.gl().depth_func(glow::ALWAYS);
+            self.gl().depth_mask(false);
+        }
+    }
+
+    /// glStencilFunc(func, reference, 0xff) and glStencilOp(sfail, dpfail, dppass).
+    pub fn stencil(&self, func: u32, reference: i32, ops: [u32; 3]) {
+        unsafe {
+            self.gl().stencil_func(func, reference, 0xff);
+            self.gl().stencil_op(ops[0], ops[1], ops[2]);
         }
     }
 

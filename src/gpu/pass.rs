@@ -77,6 +77,13 @@ impl Bindings<'_> {
         };
         self
     }
+    pub fn ivec3(&mut self, name: &str, v: [i32; 3]) -> &mut Self {
+        unsafe {
+            self.gl
+                .uniform_3_i32(self.program.uniform(name).as_ref(), v[0], v[1], v[2])
+        };
+        self
+    }
     pub fn ivec2(&mut self, name: &str, v: [i32; 2]) -> &mut Self {
         unsafe {
             self.gl

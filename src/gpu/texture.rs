@@ -307,6 +307,38 @@ impl Target {
         }
     }
 
+    /// Clears depth to `depth` and stencil to `stencil` (a target with_stencil).
+    pub fn clear_depth_stencil(&self, depth: f32, stencil: i32) {
+        self.bind();
+        unsafe {
+            self.gpu.gl().depth_mask(true);
+            self.gpu.gl().stencil_mask(0xff);
+            self.gpu
+                .gl()
+                .clear_buffer_depth_stencil(glow::DEPTH_STENCIL, 0, depth, stencil);
+        }
+    }
+
+    /// Reads the stencil buffer back (row 0 first), for tests.
+    pub fn read_stencil(&self) -> Vec<u8> {
+        self.bind();
+        let mut out = vec![0u8; (self.width * self.height) as usize];
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            gl.read_pixels(
+                0,
+                0,
+                self.width as i32,
+                self.height as i32,
+                glow::STENCIL_INDEX,
+                glow::UNSIGNED_BYTE,
+                glow::PixelPackData::Slice(Some(&mut out)),
+            );
+        }
+        out
+    }
+
     pub fn stencil_bits(&self) -> i32 {
         self.bind();
         if self.depth_stencil.is_none() {

@@ -1,5 +1,6 @@
 //! Plain-Rust twins of the GPU kernels, for tests and the paper's software column.
 
 pub mod intersect;
+pub mod photon;
 pub mod random;
 pub mod ray_trace;

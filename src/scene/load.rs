@@ -66,6 +66,7 @@ struct PhotonMapDef {
     k: Option<i64>,
     max_radius: Option<f32>,
     max_bounces: Option<i64>,
+    store_direct: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -567,6 +568,7 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 1,
                 64,
             )? as u32,
+            store_direct: p.and_then(|p| p.store_direct).unwrap_or(false),
         }
     };
 

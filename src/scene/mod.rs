@@ -129,6 +129,9 @@ pub struct PhotonMapParams {
     pub k: u32,
     pub max_radius: f32,
     pub max_bounces: u32,
+    /// Store photons at their first diffuse hit too (off in the paper's split,
+    /// where shadow rays count direct light; on for tests of the photon flux).
+    pub store_direct: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -170,6 +173,7 @@ impl Scene {
                 k: 1,
                 max_radius: 1.0,
                 max_bounces: 1,
+                store_direct: false,
             },
         }
     }

@@ -6,7 +6,7 @@ use super::{Geometry, Light, Material, Scene};
 
 pub const PRIMITIVE_TEXELS: u32 = 4;
 pub const MATERIAL_TEXELS: u32 = 3;
-pub const LIGHT_TEXELS: u32 = 5;
+pub const LIGHT_TEXELS: u32 = 6;
 
 /// Rows of RGBA floats, one row per primitive / material / light.
 pub struct PackedScene {
@@ -67,10 +67,31 @@ impl PackedScene {
             materials.push([color.x, color.y, color.z, 0.0]);
             materials.push([normal.x, normal.y, normal.z, 0.0]);
         }
+        // Photon emission picks a light in proportion to its power (sum of channels).
+        let weights: Vec<f32> = scene
+            .lights
+            .iter()
+            .map(|l| l.power().element_sum())
+            .collect();
+        let total: f32 = weights.iter().sum();
+        let mut cdf = 0.0;
+        // Area light k is the k-th emitter shape (the loader appends them in order).
+        let mut emitter_shapes = scene
+            .shapes
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| matches!(scene.materials[s.material], Material::Emitter { .. }))
+            .map(|(i, _)| i as f32);
         let mut lights = Vec::new();
-        for l in &scene.lights {
+        for (l, w) in scene.lights.iter().zip(&weights) {
             let v = |a: glam::Vec3| [a.x, a.y, a.z, 0.0];
-            match *l {
+            let probability = if total > 0.0 {
+                w / total
+            } else {
+                1.0 / scene.lights.len() as f32
+            };
+            cdf += probability;
+            let primitive = match *l {
                 Light::Area {
                     corner,
                     edge1,
@@ -85,6 +106,7 @@ impl PackedScene {
                         v(edge2),
                         v(radiance),
                     ]);
+                    emitter_shapes.next().unwrap_or(-1.0)
                 }
                 Light::Point {
                     position,
@@ -97,8 +119,10 @@ impl PackedScene {
                         [0.0; 4],
                         v(intensity),
                     ]);
+                    -1.0
                 }
-            }
+            };
+            lights.push([cdf, probability, primitive, 0.0]);
         }
         Self {
             primitives,

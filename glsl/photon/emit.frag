@@ -1,0 +1,52 @@
+#version 450 core
+// Frame 0 of the photon textures: each photon leaves a light chosen in
+// proportion to its power, carrying power = light power / (photons emitted x
+// probability of that light). Area lights: a uniform point and a
+// cosine-distributed direction; point lights: an isotropic direction.
+#include "common/scene.glsl"
+#include "common/random.glsl"
+#include "common/sampling.glsl"
+
+uniform uint u_seed;
+uniform int u_emitted;   // photons emitted N
+uniform int u_width;     // frame width
+
+layout(location = 0) out vec4 o_position; // xyz, w = material of the hit (-1: on a light)
+layout(location = 1) out vec4 o_power;    // rgb arriving, w = 1 if stored here
+layout(location = 2) out vec4 o_incoming; // direction of arrival, w = 1 if it goes on
+layout(location = 3) out vec4 o_outgoing; // direction it leaves by, w = primitive (-1 none)
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    int index = px.y * u_width + px.x;
+    o_position = vec4(0.0, 0.0, 0.0, -1.0);
+    o_power = vec4(0.0);
+    o_incoming = vec4(0.0);
+    o_outgoing = vec4(0.0, 0.0, 0.0, -1.0);
+    if (index >= u_emitted) return;
+    uint rng = rng_init(u_seed, uvec2(px), 0x10000000u);
+    float pick = rng_next(rng);
+    int l = 0;
+    while (l < u_light_count - 1 && pick >= light_texel(l, 5).x) ++l;
+    vec4 choice = light_texel(l, 5); // (cdf, probability, primitive, 0)
+    vec4 head = light_texel(l, 0);
+    vec3 a = light_texel(l, 1).xyz;
+    vec3 emitted = light_texel(l, 4).rgb;
+    float u1 = rng_next(rng), u2 = rng_next(rng), u3 = rng_next(rng), u4 = rng_next(rng);
+    vec3 p, d, power;
+    if (int(head.x) == LIGHT_POINT) {
+        p = a;
+        d = sample_sphere(u1, u2);
+        power = 4.0 * SAMPLING_PI * emitted;
+    } else {
+        vec3 e1 = light_texel(l, 2).xyz;
+        vec3 e2 = light_texel(l, 3).xyz;
+        p = a + u1 * e1 + u2 * e2;
+        d = sample_cosine(head.yzw, u3, u4);
+        power = SAMPLING_PI * length(cross(e1, e2)) * emitted;
+    }
+    o_position = vec4(p, -1.0);
+    o_power = vec4(power / (float(u_emitted) * choice.y), 0.0);
+    o_incoming = vec4(0.0, 0.0, 0.0, 1.0);
+    o_outgoing = vec4(d, choice.z);
+}

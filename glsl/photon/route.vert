@@ -1,0 +1,57 @@
+#version 450 core
+// One photon record per vertex, drawn as a point: over its cell's m x m block
+// (routing), or as one texel of the per-cell count texture (COUNT). Records
+// that are not stored photons, are past the emitted count in use, or fall
+// outside the grid are moved off screen.
+// READBACK: the paper's way, records read back to the CPU and drawn from a
+// vertex buffer; otherwise the vertex stage fetches them from the photon textures.
+#include "common/addressing.glsl"
+#include "common/grid.glsl"
+
+uniform int u_record_width;
+uniform int u_frame_height;
+uniform int u_photons_used;
+uniform int u_blocks_per_row;   // cells per row of the routing buffer or count texture
+uniform ivec2 u_target_size;
+uniform int u_block;            // m (1 when counting)
+
+#ifdef READBACK
+layout(location = 0) in vec4 a_position;
+layout(location = 1) in vec4 a_power;
+layout(location = 2) in vec4 a_incoming;
+#else
+uniform sampler2D u_position;
+uniform sampler2D u_power;
+uniform sampler2D u_incoming;
+#endif
+
+flat out vec4 v_position;
+flat out vec4 v_power;
+flat out vec4 v_incoming;
+
+void main() {
+    int record = gl_VertexID;
+    ivec2 t = texel_of_index(record, u_record_width);
+#ifdef READBACK
+    vec4 position = a_position, power = a_power, incoming = a_incoming;
+#else
+    vec4 position = texelFetch(u_position, t, 0);
+    vec4 power = texelFetch(u_power, t, 0);
+    vec4 incoming = texelFetch(u_incoming, t, 0);
+#endif
+    int photon = (t.y % u_frame_height) * u_record_width + t.x;
+    int cell = grid_cell(position.xyz);
+    gl_PointSize = float(u_block);
+    v_position = vec4(position.xyz, 1.0);
+    v_power = power;
+    v_incoming = incoming;
+    if (power.w == 0.0 || photon >= u_photons_used || cell < 0) {
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // clipped: not drawn
+        return;
+    }
+    ivec2 block = texel_of_index(cell, u_blocks_per_row);
+    // The centre of the block: a point of even size m centred on a pixel corner
+    // covers exactly the m x m pixels around it.
+    vec2 centre = vec2(block * u_block) + 0.5 * float(u_block);
+    gl_Position = vec4(centre / vec2(u_target_size) * 2.0 - 1.0, 0.0, 1.0);
+}

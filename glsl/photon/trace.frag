@@ -1,0 +1,103 @@
+#version 450 core
+// One bounce of every photon (breadth-first): reads frame b-1 of the photon
+// textures and writes frame b, a non-overlapping band of the same textures
+// (a texture barrier between passes makes the previous frame visible).
+// Diffuse hits store the photon, except its first hit (direct light is the
+// shadow rays' job), and continue by Russian roulette; mirrors reflect; glass
+// reflects or refracts by exact Fresnel. Lost or absorbed photons are marked
+// dead, never compacted.
+#include "common/scene.glsl"
+#include "common/random.glsl"
+#include "common/sampling.glsl"
+#include "common/fresnel.glsl"
+
+uniform sampler2D u_position;
+uniform sampler2D u_power;
+uniform sampler2D u_incoming;
+uniform sampler2D u_outgoing;
+uniform uint u_seed;
+uniform int u_bounce;        // this frame, 1..
+uniform int u_frame_height;
+uniform int u_store_direct;  // 1: store first hits too (tests of the flux)
+
+layout(location = 0) out vec4 o_position;
+layout(location = 1) out vec4 o_power;
+layout(location = 2) out vec4 o_incoming;
+layout(location = 3) out vec4 o_outgoing;
+
+// The normal of primitive `prim` at p (for the origin offset).
+vec3 primitive_normal(int prim, vec3 p) {
+    int kind = int(primitive_texel(prim, 0).x);
+    vec4 a = primitive_texel(prim, 1);
+    vec4 b = primitive_texel(prim, 2);
+    if (kind == PRIM_SPHERE) return normalize(p - a.xyz);
+    if (kind == PRIM_CYLINDER) {
+        vec3 r = p - a.xyz;
+        return normalize(r - dot(r, b.xyz) * b.xyz);
+    }
+    return normalize(cross(b.xyz, primitive_texel(prim, 3).xyz));
+}
+
+// What the previous interaction multiplies the power by on the way out.
+vec3 leaving_factor(int mat) {
+    if (mat < 0) return vec3(1.0); // emission
+    int kind = material_kind(mat);
+    vec3 color = material_texel(mat, 1).rgb;
+    if (kind == MAT_DIFFUSE) return color / max(color.r, max(color.g, color.b)); // roulette kept it
+    if (kind == MAT_MIRROR) return color;
+    return vec3(1.0);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    ivec2 prev = px - ivec2(0, u_frame_height);
+    o_position = vec4(0.0, 0.0, 0.0, -1.0);
+    o_power = vec4(0.0);
+    o_incoming = vec4(0.0);
+    o_outgoing = vec4(0.0, 0.0, 0.0, -1.0);
+    vec4 last_incoming = texelFetch(u_incoming, prev, 0);
+    if (last_incoming.w == 0.0) return; // dead since an earlier bounce
+    vec4 last_position = texelFetch(u_position, prev, 0);
+    vec4 last_outgoing = texelFetch(u_outgoing, prev, 0);
+    vec3 power = texelFetch(u_power, prev, 0).rgb * leaving_factor(int(last_position.w));
+    vec3 d = last_outgoing.xyz;
+    int last_prim = int(last_outgoing.w);
+    vec3 origin = last_position.xyz;
+    if (last_prim >= 0) origin = offset_origin(origin, primitive_normal(last_prim, origin), d);
+
+    vec4 hit;
+    int prim = closest_hit(origin, d, hit);
+    if (prim < 0) return; // left the scene
+    int mat = primitive_material(prim);
+    int kind = material_kind(mat);
+    if (kind == MAT_EMITTER) return; // lights reflect nothing
+    vec3 n;
+    vec3 p = surface_point(prim, origin, d, hit, n);
+    vec3 nf = dot(n, d) < 0.0 ? n : -n;
+    ivec2 local = ivec2(px.x, px.y - u_bounce * u_frame_height);
+    uint rng = rng_init(u_seed, uvec2(local), 0x10000000u + uint(u_bounce));
+    float u0 = rng_next(rng), u1 = rng_next(rng), u2 = rng_next(rng);
+    bool stored = false;
+    bool alive = true;
+    vec3 next;
+    if (kind == MAT_DIFFUSE) {
+        stored = u_bounce >= 2 || u_store_direct != 0;
+        vec3 albedo = material_texel(mat, 1).rgb;
+        alive = u0 < max(albedo.r, max(albedo.g, albedo.b));
+        next = sample_cosine(nf, u1, u2);
+    } else if (kind == MAT_MIRROR) {
+        next = reflect(d, nf);
+    } else {
+        bool entering = dot(n, d) < 0.0;
+        float ior = material_texel(mat, 0).y;
+        float eta = entering ? 1.0 / ior : ior;
+        float cos_i = -dot(d, nf);
+        float cos_t;
+        float f = fresnel_dielectric(cos_i, eta, cos_t);
+        next = u0 < f ? reflect(d, nf) : eta * d + (eta * cos_i - cos_t) * nf;
+    }
+    o_position = vec4(p, float(mat));
+    o_power = vec4(power, stored ? 1.0 : 0.0);
+    o_incoming = vec4(d, alive ? 1.0 : 0.0);
+    o_outgoing = vec4(normalize(next), float(prim));
+}

@@ -1,0 +1,178 @@
+//! Build A (section 2.2.1): a (cell, record) key per photon record, bitonic
+//! merge sort as log2(n)(log2(n)+1)/2 fragment passes over a 2D texture, one
+//! binary-search pass that writes each grid cell's first photon, and a gather
+//! of the photon records into sorted order.
+
+use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture, TimerQuery};
+use crate::render::Timings;
+
+use super::{Grid, PhotonFrames};
+
+/// The key of records that are not in the map: they sort last.
+pub const INVALID_KEY: i32 = i32::MAX;
+
+/// The photon map of build A.
+pub struct SortedPhotonMap {
+    /// Sorted (cell, record) pairs.
+    pub pairs: Texture,
+    /// Sorted photon records: position (w = 1 valid), power, incoming direction.
+    pub position: Texture,
+    pub power: Texture,
+    pub incoming: Texture,
+    /// First sorted index of each cell, and one entry past the last cell.
+    pub grid_first: Texture,
+    pub grid_width: u32,
+    pub grid: Grid,
+}
+
+/// A 2D texture of n = 2^k texels: width 2^ceil(k/2), height 2^floor(k/2).
+pub fn sort_texture_size(n: u64) -> (u32, u32) {
+    let k = n.max(2).next_power_of_two().trailing_zeros();
+    (1 << k.div_ceil(2), 1 << (k / 2))
+}
+
+/// Passes of a bitonic sort of n = 2^k elements: k (k + 1) / 2.
+pub fn pass_count(n: u64) -> u32 {
+    let k = n.max(2).next_power_of_two().trailing_zeros();
+    k * (k + 1) / 2
+}
+
+pub struct BitonicBuild {
+    gpu: Gpu,
+    keys: Program,
+    bitonic: Program,
+    search: Program,
+    gather: Program,
+}
+
+impl BitonicBuild {
+    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
+        Ok(Self {
+            gpu: gpu.clone(),
+            keys: Program::fullscreen(gpu, "photon/keys.frag")?,
+            bitonic: Program::fullscreen(gpu, "photon/bitonic.frag")?,
+            search: Program::fullscreen(gpu, "photon/binary_search.frag")?,
+            gather: Program::fullscreen(gpu, "photon/gather.frag")?,
+        })
+    }
+
+    /// Sorts the (key, payload) pairs in `pairs` (RGBA32I, width x height a power
+    /// of two) by key, then payload. Returns the sorted texture and the passes run.
+    pub fn sort(&self, pairs: Texture) -> Result<(Texture, u32), GpuError> {
+        let (w, h) = (pairs.width, pairs.height);
+        let n = w as u64 * h as u64;
+        assert!(
+            n.is_power_of_two(),
+            "bitonic sort needs a power-of-two texel count"
+        );
+        // Ping-pong between the input and one more texture: read one, draw the other.
+        let other = Texture::new(&self.gpu, w, h, TexFormat::Rgba32I)?;
+        let textures = [pairs, other];
+        let targets = [
+            Target::new(&self.gpu, &[&textures[0]])?,
+            Target::new(&self.gpu, &[&textures[1]])?,
+        ];
+        let mut current = 0;
+        let mut passes = 0;
+        let mut stage = 2u64;
+        while stage <= n {
+            let mut distance = stage / 2;
+            while distance >= 1 {
+                let mut b = self.bitonic.bind();
+                b.texture("u_pairs", &textures[current])
+                    .int("u_width", w as i32)
+                    .int("u_stage", stage as i32)
+                    .int("u_distance", distance as i32);
+                self.gpu.draw_fullscreen(&targets[1 - current]);
+                current = 1 - current;
+                passes += 1;
+                distance /= 2;
+            }
+            stage *= 2;
+        }
+        self.gpu.check("bitonic sort")?;
+        drop(targets);
+        let [a, b] = textures;
+        Ok((if current == 0 { a } else { b }, passes))
+    }
+
+    /// For each cell 0..=cells, the lower bound of the cell in the sorted pairs.
+    pub fn binary_search(&self, sorted: &Texture, cells: u32) -> Result<(Texture, u32), GpuError> {
+        let entries = cells as u64 + 1;
+        let grid_width = (entries as f64).sqrt().ceil() as u32;
+        let grid_height = (entries.div_ceil(grid_width as u64)) as u32;
+        let first = Texture::new(&self.gpu, grid_width, grid_height, TexFormat::Rgba32I)?;
+        let target = Target::new(&self.gpu, &[&first])?;
+        let mut b = self.search.bind();
+        b.texture("u_sorted", sorted)
+            .int("u_sorted_width", sorted.width as i32)
+            .int("u_sorted_count", (sorted.width * sorted.height) as i32)
+            .int("u_grid_width", grid_width as i32)
+            .int("u_cell_count", cells as i32);
+        self.gpu.draw_fullscreen(&target);
+        self.gpu.check("binary search")?;
+        Ok((first, grid_width))
+    }
+
+    /// The whole build from traced photon frames, with its stages timed.
+    pub fn build(
+        &self,
+        frames: &PhotonFrames,
+        grid: &Grid,
+        timings: &mut Timings,
+    ) -> Result<SortedPhotonMap, GpuError> {
+        let query = TimerQuery::new(&self.gpu)?;
+        let (w, h) = sort_texture_size(frames.record_count() as u64);
+        let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rgba32I)?;
+        {
+            let target = Target::new(&self.gpu, &[&pairs])?;
+            query.begin();
+            let mut b = self.keys.bind();
+            grid.bind(&mut b);
+            b.texture("u_position", &frames.position)
+                .texture("u_power", &frames.power)
+                .int("u_sort_width", w as i32)
+                .int("u_record_width", frames.width as i32)
+                .int("u_record_count", frames.record_count() as i32)
+                .int("u_frame_height", frames.frame_height as i32)
+                .int("u_photons_used", frames.photons_used as i32);
+            self.gpu.draw_fullscreen(&target);
+            query.end();
+            timings.add("keys", query.seconds(), 1);
+        }
+        query.begin();
+        let (sorted, passes) = self.sort(pairs)?;
+        query.end();
+        timings.add("bitonic sort", query.seconds(), passes as usize);
+        query.begin();
+        let (grid_first, grid_width) = self.binary_search(&sorted, grid.cell_count())?;
+        query.end();
+        timings.add("binary search", query.seconds(), 1);
+
+        let t = || Texture::new(&self.gpu, w, h, TexFormat::Rgba32F);
+        let (position, power, incoming) = (t()?, t()?, t()?);
+        let target = Target::new(&self.gpu, &[&position, &power, &incoming])?;
+        query.begin();
+        let mut b = self.gather.bind();
+        b.texture("u_sorted", &sorted)
+            .texture("u_position", &frames.position)
+            .texture("u_power", &frames.power)
+            .texture("u_incoming", &frames.incoming)
+            .int("u_sorted_width", w as i32)
+            .int("u_record_width", frames.width as i32)
+            .float("u_power_scale", frames.power_scale);
+        self.gpu.draw_fullscreen(&target);
+        query.end();
+        timings.add("gather", query.seconds(), 1);
+        self.gpu.check("gathering sorted photons")?;
+        Ok(SortedPhotonMap {
+            pairs: sorted,
+            position,
+            power,
+            incoming,
+            grid_first,
+            grid_width,
+            grid: *grid,
+        })
+    }
+}

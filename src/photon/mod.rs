@@ -1,0 +1,88 @@
+//! Figure 1's "trace photons" and "build photon map" boxes: breadth-first photon
+//! tracing into frames of photon textures (section 2.1), and the two photon-map
+//! builds, bitonic merge sort + binary search (2.2.1) and stencil routing (2.2.2).
+
+pub mod bitonic;
+pub mod stencil_routing;
+pub mod trace;
+
+use glam::Vec3;
+
+use crate::gpu::Bindings;
+use crate::scene::Scene;
+
+pub use bitonic::{BitonicBuild, SortedPhotonMap};
+pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
+pub use trace::{PhotonFrames, PhotonTracer, TraceReport};
+
+/// The uniform grid photons are sorted or routed into.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    pub min: Vec3,
+    pub max: Vec3,
+    pub resolution: [u32; 3],
+}
+
+impl Grid {
+    /// The scene's grid: its bounds if it fixes them, else the scene's bounds
+    /// padded by a thousandth of its size so surfaces on the boundary fall inside.
+    pub fn for_scene(scene: &Scene) -> Self {
+        let (min, max) = scene.photon_map.grid_bounds.unwrap_or_else(|| {
+            let (lo, hi) = scene.bounds();
+            let pad = Vec3::splat(1e-3 * scene.size());
+            (lo - pad, hi + pad)
+        });
+        Self {
+            min,
+            max,
+            resolution: scene.photon_map.grid_resolution,
+        }
+    }
+
+    pub fn cell_count(&self) -> u32 {
+        self.resolution.iter().product()
+    }
+
+    /// The cell of p, or None outside: the arithmetic of glsl/common/grid.glsl.
+    pub fn cell_of(&self, p: Vec3) -> Option<u32> {
+        let res = Vec3::new(
+            self.resolution[0] as f32,
+            self.resolution[1] as f32,
+            self.resolution[2] as f32,
+        );
+        let f = (p - self.min) / (self.max - self.min) * res;
+        let c = f.floor();
+        if c.cmplt(Vec3::ZERO).any() || c.cmpge(res).any() || !f.is_finite() {
+            return None;
+        }
+        let [x, y, z] = [c.x as u32, c.y as u32, c.z as u32];
+        Some(x + self.resolution[0] * (y + self.resolution[1] * z))
+    }
+
+    pub fn bind(&self, b: &mut Bindings<'_>) {
+        let r = self.resolution.map(|v| v as i32);
+        b.vec3("u_grid_min", self.min.to_array())
+            .vec3("u_grid_max", self.max.to_array())
+            .ivec3("u_grid_resolution", r);
+    }
+}
+
+/// Which photon-map build to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum BuildMethod {
+    /// Bitonic merge sort + binary search (section 2.2.1): exact, O(log^2 n) passes.
+    Bitonic,
+    /// Stencil routing (section 2.2.2): one pass, at most m^2 photons a cell.
+    Stencil,
+}
+
+/// A photon map from either build.
+pub enum PhotonMap {
+    Sorted(SortedPhotonMap),
+    Routed(RoutedPhotonMap),
+}
+
+/// The smallest power of two >= n.
+pub fn next_power_of_two(n: u64) -> u64 {
+    n.max(1).next_power_of_two()
+}

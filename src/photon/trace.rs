@@ -1,0 +1,258 @@
+//! Breadth-first photon tracing (section 2.1): emission into frame 0, then one
+//! pass per bounce, each writing its own frame (a band of rows) of four RGBA32F
+//! textures. Photon i sits at texel (i % width, i / width) of every frame.
+
+use crate::gpu::{max_texture_size, Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+
+/// The photon textures after tracing.
+pub struct PhotonFrames {
+    /// xyz, w = material of the hit (-1: on the light)
+    pub position: Texture,
+    /// rgb arriving, w = 1 where the photon is stored
+    pub power: Texture,
+    /// direction of arrival, w = 1 if the photon goes on
+    pub incoming: Texture,
+    /// direction it leaves by, w = primitive hit (-1: none)
+    pub outgoing: Texture,
+    target: Target,
+    pub width: u32,
+    pub frame_height: u32,
+    pub frames: u32,
+    /// Photons traced.
+    pub emitted: u32,
+    /// Photons whose records count: indices below this (see `PhotonTracer::trace_to_stored`).
+    pub photons_used: u32,
+    /// emitted / photons_used: the power each used photon must carry.
+    pub power_scale: f32,
+}
+
+impl PhotonFrames {
+    /// Texels in all frames: the records a photon-map build reads.
+    pub fn record_count(&self) -> u32 {
+        self.width * self.frame_height * self.frames
+    }
+
+    /// Stored records per photon index (read back; used to choose how many
+    /// emitted photons to keep, never to move photons).
+    pub fn stored_per_photon(&self) -> Vec<u32> {
+        let power = self.power.read_f32();
+        let per_frame = (self.width * self.frame_height) as usize;
+        let mut counts = vec![0u32; self.emitted as usize];
+        for (texel, p) in power.chunks(4).enumerate() {
+            let photon = texel % per_frame;
+            if p[3] != 0.0 && photon < counts.len() {
+                counts[photon] += 1;
+            }
+        }
+        counts
+    }
+
+    /// Stored records among the photons in use.
+    pub fn stored(&self) -> u32 {
+        self.stored_per_photon()[..self.photons_used as usize]
+            .iter()
+            .sum()
+    }
+}
+
+/// Frame width and height for `emitted` photons and `frames` frames: square-ish
+/// frames (width a power of two) stacked within the driver's texture size.
+pub fn frame_layout(emitted: u32, frames: u32, max_size: u32) -> Result<(u32, u32), GpuError> {
+    let width = ((emitted as f64).sqrt().ceil() as u32)
+        .next_power_of_two()
+        .clamp(1, max_size);
+    let frame_height = emitted.div_ceil(width).max(1);
+    if frame_height as u64 * frames as u64 > max_size as u64 {
+        return Err(GpuError::Gl(format!(
+            "{emitted} photons x {frames} frames need {} x {} texels; this driver allows {max_size} a side: emit fewer photons or allow fewer bounces",
+            width,
+            frame_height as u64 * frames as u64
+        )));
+    }
+    Ok((width, frame_height))
+}
+
+/// What `trace_to_stored` did to reach the stored count.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TraceReport {
+    /// Photons traced in each attempt.
+    pub attempts: Vec<u32>,
+    pub emitted: u32,
+    pub photons_used: u32,
+    pub stored: u32,
+    pub target: u32,
+}
+
+pub struct PhotonTracer {
+    gpu: Gpu,
+    emit: Program,
+    bounce: Program,
+}
+
+impl PhotonTracer {
+    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
+        Ok(Self {
+            gpu: gpu.clone(),
+            emit: Program::fullscreen(gpu, "photon/emit.frag")?,
+            bounce: Program::fullscreen(gpu, "photon/trace.frag")?,
+        })
+    }
+
+    /// Traces `emitted` photons through `max_bounces` bounces; all of them count.
+    pub fn trace(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        seed: u32,
+        emitted: u32,
+    ) -> Result<PhotonFrames, GpuError> {
+        let frames = scene.photon_map.max_bounces + 1;
+        let (width, frame_height) = frame_layout(emitted, frames, max_texture_size(&self.gpu))?;
+        let height = frame_height * frames;
+        let t = || Texture::new(&self.gpu, width, height, TexFormat::Rgba32F);
+        let (position, power, incoming, outgoing) = (t()?, t()?, t()?, t()?);
+        let target = Target::new(&self.gpu, &[&position, &power, &incoming, &outgoing])?;
+        target.clear([0.0; 4]);
+        let (w, fh) = (width as i32, frame_height as i32);
+        {
+            let mut b = self.emit.bind();
+            textures.bind(&mut b);
+            b.uint("u_seed", seed)
+                .int("u_emitted", emitted as i32)
+                .int("u_width", w);
+            self.gpu.draw_region(&target, 0, 0, w, fh);
+        }
+        for bounce in 1..frames as i32 {
+            // The previous frame was drawn into these very textures.
+            self.gpu.texture_barrier();
+            let mut b = self.bounce.bind();
+            textures.bind(&mut b);
+            b.texture("u_position", &position)
+                .texture("u_power", &power)
+                .texture("u_incoming", &incoming)
+                .texture("u_outgoing", &outgoing)
+                .uint("u_seed", seed)
+                .int("u_bounce", bounce)
+                .int("u_frame_height", fh)
+                .int("u_store_direct", scene.photon_map.store_direct as i32);
+            self.gpu.draw_region(&target, 0, bounce * fh, w, fh);
+        }
+        self.gpu.check("photon tracing")?;
+        Ok(PhotonFrames {
+            position,
+            power,
+            incoming,
+            outgoing,
+            target,
+            width,
+            frame_height,
+            frames,
+            emitted,
+            photons_used: emitted,
+            power_scale: 1.0,
+        })
+    }
+
+    /// Traces until the map can hold exactly `photons_stored` photons: trace N,
+    /// count the stored records of each photon (in index order), and if they
+    /// fall short, trace again with N scaled by target / stored (x 1.1 + 64).
+    /// Then keep the first M photons whose records reach the target, and give
+    /// each the power of 1/M of the light (power_scale = N / M). Only the last
+    /// kept photon may add records past the target, so stored is the target or
+    /// a few above it (its further bounces).
+    pub fn trace_to_stored(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        seed: u32,
+    ) -> Result<(PhotonFrames, TraceReport), GpuError> {
+        let target = scene.photon_map.photons_stored;
+        let max_emitted = {
+            let frames = scene.photon_map.max_bounces + 1;
+            let max = max_texture_size(&self.gpu) as u64;
+            // Texels available per frame, rounded down to whole rows of the widest frame.
+            ((max * max / frames as u64).min(u32::MAX as u64 / 2)) as u32
+        };
+        let mut emitted = target.max(64);
+        let mut attempts = Vec::new();
+        loop {
+            let mut frames = self.trace(scene, textures, seed, emitted)?;
+            attempts.push(emitted);
+            let counts = frames.stored_per_photon();
+            let total: u64 = counts.iter().map(|&c| c as u64).sum();
+            if total >= target as u64 {
+                let mut sum = 0u32;
+                let mut used = counts.len() as u32;
+                for (i, &c) in counts.iter().enumerate() {
+                    sum += c;
+                    if sum >= target {
+                        used = i as u32 + 1;
+                        break;
+                    }
+                }
+                frames.photons_used = used;
+                frames.power_scale = emitted as f32 / used as f32;
+                let report = TraceReport {
+                    attempts,
+                    emitted,
+                    photons_used: used,
+                    stored: sum,
+                    target,
+                };
+                return Ok((frames, report));
+            }
+            if emitted >= max_emitted || attempts.len() >= 8 {
+                return Err(GpuError::Gl(format!(
+                    "{emitted} photons emitted stored only {total} of the {target} asked for: the scene's lights reach too few diffuse surfaces after a bounce (lower photons_stored, or set store_direct)"
+                )));
+            }
+            let grow = if total == 0 {
+                16.0
+            } else {
+                (target as f64 / total as f64) * 1.1
+            };
+            emitted = ((emitted as f64 * grow) as u64 + 64).min(max_emitted as u64) as u32;
+        }
+    }
+}
+
+impl PhotonFrames {
+    pub fn target(&self) -> &Target {
+        &self.target
+    }
+
+    /// Photon frames made from given records (RGBA per texel, row 0 first, all
+    /// frames stacked): for tests and benchmarks of the builds on chosen inputs.
+    #[allow(clippy::too_many_arguments)]
+    pub fn from_records(
+        gpu: &Gpu,
+        width: u32,
+        frame_height: u32,
+        frames: u32,
+        position: &[f32],
+        power: &[f32],
+        incoming: &[f32],
+        photons_used: u32,
+    ) -> Result<Self, GpuError> {
+        let height = frame_height * frames;
+        let t = |d: &[f32]| Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, d);
+        let (position, power, incoming) = (t(position)?, t(power)?, t(incoming)?);
+        let outgoing = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let target = Target::new(gpu, &[&position, &power, &incoming, &outgoing])?;
+        Ok(Self {
+            position,
+            power,
+            incoming,
+            outgoing,
+            target,
+            width,
+            frame_height,
+            frames,
+            emitted: width * frame_height,
+            photons_used,
+            power_scale: 1.0,
+        })
+    }
+}

@@ -1,0 +1,246 @@
+//! Plain-Rust twins of glsl/photon/: the photon tracer fed the same random
+//! numbers (the same hash of the same streams), and stencil routing simulated
+//! in draw order.
+
+use glam::{Vec3, Vec4};
+
+use crate::scene::pack::PackedScene;
+use crate::scene::{Material, Scene};
+
+use super::intersect::intersect_geometry;
+use super::random::{rng_init, rng_next};
+use super::ray_trace::{closest_hit, fresnel_dielectric, offset_scale};
+
+const PI: f32 = std::f32::consts::PI;
+
+/// One texel of each photon texture.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotonRecord {
+    pub position: Vec4,
+    pub power: Vec4,
+    pub incoming: Vec4,
+    pub outgoing: Vec4,
+}
+
+pub fn basis_around(n: Vec3) -> (Vec3, Vec3) {
+    let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (s + n.z);
+    let c = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + s * n.x * n.x * a, s * c, -s * n.x),
+        Vec3::new(c, s + n.y * n.y * a, -n.y),
+    )
+}
+
+pub fn sample_cosine(n: Vec3, u1: f32, u2: f32) -> Vec3 {
+    let r = u1.sqrt();
+    let phi = 2.0 * PI * u2;
+    let (t, b) = basis_around(n);
+    (r * phi.cos() * t + r * phi.sin() * b + (1.0 - u1).max(0.0).sqrt() * n).normalize()
+}
+
+pub fn sample_sphere(u1: f32, u2: f32) -> Vec3 {
+    let z = 1.0 - 2.0 * u1;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u2;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - 2.0 * n.dot(d) * n
+}
+
+fn primitive_normal(scene: &Scene, prim: usize, p: Vec3) -> Vec3 {
+    use crate::scene::Geometry::*;
+    match scene.shapes[prim].geometry {
+        Sphere { center, .. } => (p - center).normalize(),
+        Cylinder { base, axis, .. } => {
+            let r = p - base;
+            (r - r.dot(axis) * axis).normalize()
+        }
+        Parallelogram { edge1, edge2, .. } => edge1.cross(edge2).normalize(),
+        Triangle { v0, v1, v2 } => (v1 - v0).cross(v2 - v0).normalize(),
+    }
+}
+
+fn leaving_factor(scene: &Scene, material: i32) -> Vec3 {
+    if material < 0 {
+        return Vec3::ONE;
+    }
+    match scene.materials[material as usize] {
+        Material::Diffuse { albedo } => albedo / albedo.max_element(),
+        Material::Mirror { reflectance } => reflectance,
+        _ => Vec3::ONE,
+    }
+}
+
+const DEAD: PhotonRecord = PhotonRecord {
+    position: Vec4::new(0.0, 0.0, 0.0, -1.0),
+    power: Vec4::ZERO,
+    incoming: Vec4::ZERO,
+    outgoing: Vec4::new(0.0, 0.0, 0.0, -1.0),
+};
+
+/// glsl/photon/emit.frag for the photon at frame texel (x, y).
+pub fn emit(
+    packed: &PackedScene,
+    seed: u32,
+    emitted: u32,
+    width: u32,
+    x: u32,
+    y: u32,
+) -> PhotonRecord {
+    if y * width + x >= emitted {
+        return DEAD;
+    }
+    let mut rng = rng_init(seed, [x, y], 0x10000000);
+    let pick = rng_next(&mut rng);
+    let light_row = |l: usize, i: usize| Vec4::from(packed.lights[l * 6 + i]);
+    let mut l = 0;
+    while l + 1 < packed.light_count && pick >= light_row(l, 5).x {
+        l += 1;
+    }
+    let choice = light_row(l, 5);
+    let head = light_row(l, 0);
+    let a = light_row(l, 1).truncate();
+    let emitted_radiance = light_row(l, 4).truncate();
+    let (u1, u2, u3, u4) = (
+        rng_next(&mut rng),
+        rng_next(&mut rng),
+        rng_next(&mut rng),
+        rng_next(&mut rng),
+    );
+    let (p, d, power) = if head.x as i32 == 1 {
+        (a, sample_sphere(u1, u2), 4.0 * PI * emitted_radiance)
+    } else {
+        let (e1, e2) = (light_row(l, 2).truncate(), light_row(l, 3).truncate());
+        (
+            a + u1 * e1 + u2 * e2,
+            sample_cosine(Vec3::new(head.y, head.z, head.w), u3, u4),
+            PI * e1.cross(e2).length() * emitted_radiance,
+        )
+    };
+    PhotonRecord {
+        position: p.extend(-1.0),
+        power: (power / (emitted as f32 * choice.y)).extend(0.0),
+        incoming: Vec4::new(0.0, 0.0, 0.0, 1.0),
+        outgoing: d.extend(choice.z),
+    }
+}
+
+/// glsl/photon/trace.frag: bounce `bounce` of a photon whose last record is `last`.
+pub fn bounce(
+    scene: &Scene,
+    seed: u32,
+    bounce: u32,
+    x: u32,
+    local_y: u32,
+    last: &PhotonRecord,
+) -> PhotonRecord {
+    if last.incoming.w == 0.0 {
+        return DEAD;
+    }
+    let floor = 1e-6 * scene.size();
+    let power = last.power.truncate() * leaving_factor(scene, last.position.w as i32);
+    let d = last.outgoing.truncate();
+    let last_prim = last.outgoing.w as i32;
+    let mut origin = last.position.truncate();
+    if last_prim >= 0 {
+        let n = primitive_normal(scene, last_prim as usize, origin);
+        let s = offset_scale(origin, floor);
+        origin += if d.dot(n) >= 0.0 { s } else { -s } * n;
+    }
+    let Some((prim, _t, p, n)) = closest_hit(scene, origin, d) else {
+        return DEAD;
+    };
+    let mat = scene.shapes[prim].material;
+    let material = scene.materials[mat];
+    if matches!(material, Material::Emitter { .. }) {
+        return DEAD;
+    }
+    let nf = if n.dot(d) < 0.0 { n } else { -n };
+    let mut rng = rng_init(seed, [x, local_y], 0x10000000 + bounce);
+    let (u0, u1, u2) = (rng_next(&mut rng), rng_next(&mut rng), rng_next(&mut rng));
+    let (mut stored, mut alive) = (false, true);
+    let next = match material {
+        Material::Diffuse { albedo } => {
+            stored = bounce >= 2 || scene.photon_map.store_direct;
+            alive = u0 < albedo.max_element();
+            sample_cosine(nf, u1, u2)
+        }
+        Material::Mirror { .. } => reflect(d, nf),
+        Material::Glass { ior } => {
+            let entering = n.dot(d) < 0.0;
+            let eta = if entering { 1.0 / ior } else { ior };
+            let cos_i = -d.dot(nf);
+            let (f, cos_t) = fresnel_dielectric(cos_i, eta);
+            if u0 < f {
+                reflect(d, nf)
+            } else {
+                eta * d + (eta * cos_i - cos_t) * nf
+            }
+        }
+        Material::Emitter { .. } => unreachable!(),
+    };
+    PhotonRecord {
+        position: p.extend(mat as f32),
+        power: power.extend(if stored { 1.0 } else { 0.0 }),
+        incoming: d.extend(if alive { 1.0 } else { 0.0 }),
+        outgoing: next.normalize().extend(prim as f32),
+    }
+}
+
+/// Every record of every frame, row 0 of frame 0 first (the GPU texture layout).
+pub fn trace_photons(
+    scene: &Scene,
+    seed: u32,
+    emitted: u32,
+    width: u32,
+    frame_height: u32,
+) -> Vec<PhotonRecord> {
+    let packed = PackedScene::new(scene);
+    let frames = scene.photon_map.max_bounces + 1;
+    let per_frame = (width * frame_height) as usize;
+    let mut out = vec![DEAD; per_frame * frames as usize];
+    for y in 0..frame_height {
+        for x in 0..width {
+            let i = (y * width + x) as usize;
+            out[i] = emit(&packed, seed, emitted, width, x, y);
+            for b in 1..frames {
+                let last = out[(b as usize - 1) * per_frame + i];
+                out[b as usize * per_frame + i] = bounce(scene, seed, b, x, y, &last);
+            }
+        }
+    }
+    out
+}
+
+/// Whether any primitive other than the closest lies within `eps` of its
+/// distance (a near-tie that f32 rounding may decide either way).
+pub fn near_tie(scene: &Scene, o: Vec3, d: Vec3, eps: f32) -> bool {
+    let mut ts: Vec<f32> = scene
+        .shapes
+        .iter()
+        .filter_map(|s| intersect_geometry(&s.geometry, o, d).map(|h| h.0))
+        .collect();
+    ts.sort_by(f32::total_cmp);
+    ts.windows(2).any(|w| w[1] - w[0] < eps * w[0].max(1.0))
+}
+
+/// Stencil routing in draw order: `cells[i]` is record i's cell (None: not
+/// drawn). Returns, per cell, the records in slot order (slot m^2-1 first) and
+/// how many were destined.
+pub fn route(cells: &[Option<u32>], cell_count: u32, block: u32) -> (Vec<Vec<usize>>, Vec<u32>) {
+    let slots = (block * block) as usize;
+    let mut stored = vec![Vec::new(); cell_count as usize];
+    let mut destined = vec![0u32; cell_count as usize];
+    for (record, cell) in cells.iter().enumerate() {
+        if let Some(c) = *cell {
+            destined[c as usize] += 1;
+            if stored[c as usize].len() < slots {
+                stored[c as usize].push(record);
+            }
+        }
+    }
+    (stored, destined)
+}
