@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{Vec3, Vec4};
-use photonmap::photon::PhotonTracer;
+use photonmap::photon::{PhotonTracer, RandomSource};
 use photonmap::reference::photon::{trace_photons, PhotonRecord};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{load_scene_str, Scene};
@@ -182,4 +182,21 @@ fn stored_flux_on_a_plane_matches_the_solid_angle() {
         "flux {flux} vs {expected} after choosing the emitted count ({report:?})"
     );
     let _ = Vec3::ZERO;
+}
+
+#[test]
+fn the_random_texture_traces_the_same_photons_as_the_hash() {
+    let gpu = common::gpu();
+    let scene = common::paper_scene("cornell_box");
+    let textures = SceneTextures::new(&gpu, &scene).unwrap();
+    let hash = PhotonTracer::with_random(&gpu, RandomSource::Hash).unwrap();
+    let texture = PhotonTracer::with_random(&gpu, RandomSource::Texture).unwrap();
+    let a = records(&hash.trace(&scene, &textures, 3, 5000).unwrap());
+    let b = records(&texture.trace(&scene, &textures, 3, 5000).unwrap());
+    assert_eq!(
+        a, b,
+        "--faithful's random texture must reproduce the hash's photons"
+    );
+    let c = records(&texture.trace(&scene, &textures, 4, 5000).unwrap());
+    assert_ne!(a, c, "another seed, other photons");
 }

@@ -4,7 +4,7 @@
 // probability of that light). Area lights: a uniform point and a
 // cosine-distributed direction; point lights: an isotropic direction.
 #include "common/scene.glsl"
-#include "common/random.glsl"
+#include "common/photon_random.glsl"
 #include "common/sampling.glsl"
 
 uniform uint u_seed;
@@ -24,15 +24,16 @@ void main() {
     o_incoming = vec4(0.0);
     o_outgoing = vec4(0.0, 0.0, 0.0, -1.0);
     if (index >= u_emitted) return;
-    uint rng = rng_init(u_seed, uvec2(px), 0x10000000u);
-    float pick = rng_next(rng);
+    PhotonRandom rng = photon_random_init(u_seed, px, uvec2(px), 0x10000000u);
+    float pick = photon_random_next(rng);
     int l = 0;
     while (l < u_light_count - 1 && pick >= light_texel(l, 5).x) ++l;
     vec4 choice = light_texel(l, 5); // (cdf, probability, primitive, 0)
     vec4 head = light_texel(l, 0);
     vec3 a = light_texel(l, 1).xyz;
     vec3 emitted = light_texel(l, 4).rgb;
-    float u1 = rng_next(rng), u2 = rng_next(rng), u3 = rng_next(rng), u4 = rng_next(rng);
+    float u1 = photon_random_next(rng), u2 = photon_random_next(rng);
+    float u3 = photon_random_next(rng), u4 = photon_random_next(rng);
     vec3 p, d, power;
     if (int(head.x) == LIGHT_POINT) {
         p = a;

@@ -7,7 +7,7 @@
 // reflects or refracts by exact Fresnel. Lost or absorbed photons are marked
 // dead, never compacted.
 #include "common/scene.glsl"
-#include "common/random.glsl"
+#include "common/photon_random.glsl"
 #include "common/sampling.glsl"
 #include "common/fresnel.glsl"
 
@@ -75,8 +75,8 @@ void main() {
     vec3 p = surface_point(prim, origin, d, hit, n);
     vec3 nf = dot(n, d) < 0.0 ? n : -n;
     ivec2 local = ivec2(px.x, px.y - u_bounce * u_frame_height);
-    uint rng = rng_init(u_seed, uvec2(local), 0x10000000u + uint(u_bounce));
-    float u0 = rng_next(rng), u1 = rng_next(rng), u2 = rng_next(rng);
+    PhotonRandom rng = photon_random_init(u_seed, px, uvec2(local), 0x10000000u + uint(u_bounce));
+    float u0 = photon_random_next(rng), u1 = photon_random_next(rng), u2 = photon_random_next(rng);
     bool stored = false;
     bool alive = true;
     vec3 next;

@@ -13,7 +13,7 @@ use crate::scene::Scene;
 
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
 pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
-pub use trace::{PhotonFrames, PhotonTracer, TraceReport};
+pub use trace::{PhotonFrames, PhotonTracer, RandomSource, TraceReport};
 
 /// The uniform grid photons are sorted or routed into.
 #[derive(Clone, Copy, Debug, PartialEq)]

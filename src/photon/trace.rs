@@ -85,19 +85,75 @@ pub struct TraceReport {
     pub target: u32,
 }
 
+/// Where photon tracing takes its random numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum RandomSource {
+    /// A PCG hash of (seed, photon, bounce) in the shader.
+    Hash,
+    /// The paper's way: a texture of random numbers, 8 per photon per frame,
+    /// filled on the CPU from the seed (with the hash's own sequence, so both
+    /// sources trace the same photons).
+    Texture,
+}
+
 pub struct PhotonTracer {
     gpu: Gpu,
     emit: Program,
     bounce: Program,
+    random: RandomSource,
 }
+
+/// Random numbers per photon per frame in the texture source.
+const RANDOM_PER_TEXEL_PAIR: usize = 8;
 
 impl PhotonTracer {
     pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
+        Self::with_random(gpu, RandomSource::Hash)
+    }
+
+    pub fn with_random(gpu: &Gpu, random: RandomSource) -> Result<Self, GpuError> {
+        let defines: Vec<(&str, String)> = match random {
+            RandomSource::Hash => vec![],
+            RandomSource::Texture => vec![("RANDOM_TEXTURE", "1".into())],
+        };
         Ok(Self {
             gpu: gpu.clone(),
-            emit: Program::fullscreen(gpu, "photon/emit.frag")?,
-            bounce: Program::fullscreen(gpu, "photon/trace.frag")?,
+            emit: Program::fullscreen_with(gpu, "photon/emit.frag", &defines)?,
+            bounce: Program::fullscreen_with(gpu, "photon/trace.frag", &defines)?,
+            random,
         })
+    }
+
+    /// The random-number texture: for frame f and photon texel (x, y), the
+    /// first 8 numbers of the hash stream that frame would use.
+    fn random_texture(
+        &self,
+        seed: u32,
+        width: u32,
+        frame_height: u32,
+        frames: u32,
+    ) -> Result<Texture, GpuError> {
+        use crate::reference::random::{rng_init, rng_next};
+        let mut data = vec![0f32; (width * 2 * frame_height * frames * 4) as usize];
+        for f in 0..frames {
+            for y in 0..frame_height {
+                for x in 0..width {
+                    let mut state = rng_init(seed, [x, y], 0x10000000 + f);
+                    let row = (f * frame_height + y) as usize;
+                    let base = (row * (width as usize * 2) + x as usize * 2) * 4;
+                    for k in 0..RANDOM_PER_TEXEL_PAIR {
+                        data[base + k] = rng_next(&mut state);
+                    }
+                }
+            }
+        }
+        Texture::from_f32(
+            &self.gpu,
+            width * 2,
+            frame_height * frames,
+            TexFormat::Rgba32F,
+            &data,
+        )
     }
 
     /// Traces `emitted` photons through `max_bounces` bounces; all of them count.
@@ -116,9 +172,18 @@ impl PhotonTracer {
         let target = Target::new(&self.gpu, &[&position, &power, &incoming, &outgoing])?;
         target.clear([0.0; 4]);
         let (w, fh) = (width as i32, frame_height as i32);
+        let random = match self.random {
+            RandomSource::Hash => None,
+            RandomSource::Texture => {
+                Some(self.random_texture(seed, width, frame_height, frames)?)
+            }
+        };
         {
             let mut b = self.emit.bind();
             textures.bind(&mut b);
+            if let Some(r) = &random {
+                b.texture("u_random_numbers", r);
+            }
             b.uint("u_seed", seed)
                 .int("u_emitted", emitted as i32)
                 .int("u_width", w);
@@ -129,6 +194,9 @@ impl PhotonTracer {
             self.gpu.texture_barrier();
             let mut b = self.bounce.bind();
             textures.bind(&mut b);
+            if let Some(r) = &random {
+                b.texture("u_random_numbers", r);
+            }
             b.texture("u_position", &position)
                 .texture("u_power", &power)
                 .texture("u_incoming", &incoming)
