@@ -1,5 +1,7 @@
 //! The command line: `photonmap render`, `photonmap info`.
 
+mod cli;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -7,6 +9,7 @@ use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
 
 use photonmap::gpu::{EglPlatform, Gpu};
+use photonmap::photon::{BuildMethod, VertexFeed};
 use photonmap::render::{self, RenderOptions};
 use photonmap::scene::load_scene;
 
@@ -52,11 +55,57 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Trace a scene's photons and build its photon map; report counts, passes and times.
+    Photons {
+        scene: PathBuf,
+        /// Photon-map build: bitonic sort + binary search, or stencil routing.
+        #[arg(long, value_enum, default_value_t = BuildMethod::Bitonic)]
+        build: BuildMethod,
+        /// Stencil routing: each cell holds m x m photons (1..=16).
+        #[arg(long, default_value_t = 4)]
+        stencil_m: u32,
+        /// Stencil routing: how photons reach the vertex stage.
+        #[arg(long, value_enum, default_value_t = VertexFeed::VertexFetch)]
+        feed: VertexFeed,
+        /// The paper's 2003 constraints: a texture of random numbers, read-back before routing.
+        #[arg(long)]
+        faithful: bool,
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// As JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Benchmarks (commands, not tests): `bench build`.
+    Bench {
+        #[command(subcommand)]
+        which: BenchCommand,
+    },
     /// Print the EGL and GL implementation and the limits this program relies on.
     Info {
         /// As JSON on stdout.
         #[arg(long)]
         json: bool,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Photon-map builds for n = 2^min .. 2^max synthetic photons: bitonic passes,
+    /// time per pass against a copy pass, binary search, stencil routing with and
+    /// without read-back.
+    Build {
+        #[arg(long, default_value_t = 10)]
+        min_log2: u32,
+        #[arg(long, default_value_t = 20)]
+        max_log2: u32,
+        /// Stencil routing m (the paper: a 1024 x 1024 buffer of about 40^3 cells).
+        #[arg(long, default_value_t = 4)]
+        stencil_m: u32,
+        #[arg(long)]
+        json: bool,
+        #[arg(long)]
+        quiet: bool,
     },
 }
 
@@ -84,6 +133,51 @@ fn check_output(path: &Path, extension: &str, flag: &str) -> Result<()> {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Photons {
+            scene,
+            build,
+            stencil_m,
+            feed,
+            faithful,
+            seed,
+            json,
+        } => {
+            let scene = load_scene(&scene)?;
+            let gpu = Gpu::new(cli.egl)?;
+            let options = cli::photons::PhotonOptions {
+                seed,
+                build,
+                faithful,
+                feed,
+                stencil_block: stencil_m,
+            };
+            let report = cli::photons::trace_and_build(&gpu, &scene, &options)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                cli::photons::print_report(&report);
+            }
+            Ok(())
+        }
+        Command::Bench {
+            which:
+                BenchCommand::Build {
+                    min_log2,
+                    max_log2,
+                    stencil_m,
+                    json,
+                    quiet,
+                },
+        } => {
+            let gpu = Gpu::new(cli.egl)?;
+            let bench = cli::bench::run_build_bench(&gpu, min_log2, max_log2, stencil_m, !quiet)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&bench)?);
+            } else {
+                cli::bench::print_build_bench(&bench);
+            }
+            Ok(())
+        }
         Command::Info { json } => {
             let gpu = Gpu::new(cli.egl)?;
             let caps = gpu.capabilities();

@@ -3,22 +3,24 @@
 // with i ^ j and keeps the smaller or larger by its place in the stage k.
 // Ties on the key are broken by the record index, so the decision is
 // antisymmetric: if i takes its partner's pair, the partner takes i's.
-#include "common/addressing.glsl"
-
+// The texture is 2^a x 2^b texels with i = y * width + x, so a distance or stage
+// below the width is a bit of x and one at or above it a bit of y: partner and
+// direction come from XOR and AND on the coordinate, with no division
+// (the host passes j and k split into their x and y parts, one of them zero).
 uniform isampler2D u_pairs;
-uniform int u_width;
-uniform int u_stage;     // k: the size of the bitonic sequences being merged
-uniform int u_distance;  // j: the partner distance of this pass
+uniform ivec2 u_distance_xy;  // j as (j, 0) or (0, j / width)
+uniform ivec2 u_stage_xy;     // k likewise (k = n gives (0, height): always ascending)
 
 layout(location = 0) out ivec4 o_pair;
 
 void main() {
-    int i = index_of_texel(ivec2(gl_FragCoord.xy), u_width);
-    int partner = i ^ u_distance;
-    ivec4 mine = texelFetch(u_pairs, ivec2(gl_FragCoord.xy), 0);
-    ivec4 theirs = texelFetch(u_pairs, texel_of_index(partner, u_width), 0);
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    ivec2 partner_px = px ^ u_distance_xy;
+    ivec4 mine = texelFetch(u_pairs, px, 0);
+    ivec4 theirs = texelFetch(u_pairs, partner_px, 0);
     bool mine_less = mine.x < theirs.x || (mine.x == theirs.x && mine.y < theirs.y);
-    bool ascending = (i & u_stage) == 0;
-    bool keep_smaller = (i < partner) == ascending;
+    bool ascending = all(equal(px & u_stage_xy, ivec2(0)));
+    bool lower = all(equal(px & u_distance_xy, ivec2(0))); // i < partner
+    bool keep_smaller = lower == ascending;
     o_pair = (keep_smaller == mine_less) ? mine : theirs;
 }

@@ -112,10 +112,10 @@ impl Gpu {
     /// Makes what earlier draws wrote to a texture visible to later draws that
     /// read other texels of it while it is attached (GL 4.5 glTextureBarrier).
     pub fn texture_barrier(&self) {
-        type TextureBarrier = extern "system" fn();
+        // glTextureBarrier takes no arguments and returns nothing: the pointer's
+        // own type is its signature.
         match self.ctx.proc_address("glTextureBarrier") {
-            // SAFETY: the GL 4.5 signature, on the current context.
-            Some(f) => unsafe { std::mem::transmute::<extern "system" fn(), TextureBarrier>(f)() },
+            Some(f) => f(),
             // Without it, finishing the queue is the conservative equivalent.
             None => self.finish(),
         }

@@ -10,13 +10,14 @@ pub enum TexFormat {
     Rg32F,
     R32F,
     Rgba32I,
+    Rg32I,
 }
 
 impl TexFormat {
     pub fn channels(self) -> usize {
         match self {
             TexFormat::Rgba32F | TexFormat::Rgba32I => 4,
-            TexFormat::Rg32F => 2,
+            TexFormat::Rg32F | TexFormat::Rg32I => 2,
             TexFormat::R32F => 1,
         }
     }
@@ -26,6 +27,7 @@ impl TexFormat {
             TexFormat::Rg32F => (glow::RG32F, glow::RG, glow::FLOAT),
             TexFormat::R32F => (glow::R32F, glow::RED, glow::FLOAT),
             TexFormat::Rgba32I => (glow::RGBA32I, glow::RGBA_INTEGER, glow::INT),
+            TexFormat::Rg32I => (glow::RG32I, glow::RG_INTEGER, glow::INT),
         }
     }
 }
@@ -85,9 +87,25 @@ impl Texture {
         Ok(t)
     }
 
+    /// An RGBA32I texture filled from `data` (4 ints a texel).
     pub fn from_i32(gpu: &Gpu, width: u32, height: u32, data: &[i32]) -> Result<Self, GpuError> {
-        let t = Self::new(gpu, width, height, TexFormat::Rgba32I)?;
-        assert_eq!(data.len(), t.texel_count() * 4, "texture data size");
+        Self::from_i32_format(gpu, width, height, TexFormat::Rgba32I, data)
+    }
+
+    pub fn from_i32_format(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        format: TexFormat,
+        data: &[i32],
+    ) -> Result<Self, GpuError> {
+        let t = Self::new(gpu, width, height, format)?;
+        assert!(t.is_integer(), "from_i32 with a float format");
+        assert_eq!(
+            data.len(),
+            t.texel_count() * format.channels(),
+            "texture data size"
+        );
         let (_, fmt, ty) = t.format.gl();
         unsafe {
             let gl = gpu.gl();
@@ -109,15 +127,16 @@ impl Texture {
         Ok(t)
     }
 
+    pub fn is_integer(&self) -> bool {
+        matches!(self.format, TexFormat::Rgba32I | TexFormat::Rg32I)
+    }
+
     pub fn texel_count(&self) -> usize {
         self.width as usize * self.height as usize
     }
 
     pub fn upload_f32(&self, data: &[f32]) -> Result<(), GpuError> {
-        assert!(
-            self.format != TexFormat::Rgba32I,
-            "upload_f32 on an integer texture"
-        );
+        assert!(!self.is_integer(), "upload_f32 on an integer texture");
         assert_eq!(
             data.len(),
             self.texel_count() * self.format.channels(),
@@ -145,10 +164,7 @@ impl Texture {
 
     /// Reads the whole texture back (row 0 first) as floats.
     pub fn read_f32(&self) -> Vec<f32> {
-        assert!(
-            self.format != TexFormat::Rgba32I,
-            "read_f32 on an integer texture"
-        );
+        assert!(!self.is_integer(), "read_f32 on an integer texture");
         let mut out = vec![0f32; self.texel_count() * self.format.channels()];
         let (_, fmt, ty) = self.format.gl();
         unsafe {
@@ -167,12 +183,8 @@ impl Texture {
     }
 
     pub fn read_i32(&self) -> Vec<i32> {
-        assert_eq!(
-            self.format,
-            TexFormat::Rgba32I,
-            "read_i32 on a float texture"
-        );
-        let mut out = vec![0i32; self.texel_count() * 4];
+        assert!(self.is_integer(), "read_i32 on a float texture");
+        let mut out = vec![0i32; self.texel_count() * self.format.channels()];
         let (_, fmt, ty) = self.format.gl();
         unsafe {
             let gl = self.gpu.gl();

@@ -56,8 +56,8 @@ impl BitonicBuild {
         })
     }
 
-    /// Sorts the (key, payload) pairs in `pairs` (RGBA32I, width x height a power
-    /// of two) by key, then payload. Returns the sorted texture and the passes run.
+    /// Sorts the (key, payload) pairs in `pairs` (RG32I or RGBA32I, width x
+    /// height a power of two) by key, then payload. Returns the sorted texture and the passes run.
     pub fn sort(&self, pairs: Texture) -> Result<(Texture, u32), GpuError> {
         let (w, h) = (pairs.width, pairs.height);
         let n = w as u64 * h as u64;
@@ -66,7 +66,7 @@ impl BitonicBuild {
             "bitonic sort needs a power-of-two texel count"
         );
         // Ping-pong between the input and one more texture: read one, draw the other.
-        let other = Texture::new(&self.gpu, w, h, TexFormat::Rgba32I)?;
+        let other = Texture::new(&self.gpu, w, h, pairs.format)?;
         let textures = [pairs, other];
         let targets = [
             Target::new(&self.gpu, &[&textures[0]])?,
@@ -78,11 +78,17 @@ impl BitonicBuild {
         while stage <= n {
             let mut distance = stage / 2;
             while distance >= 1 {
+                let split = |v: u64| {
+                    if v < w as u64 {
+                        [v as i32, 0]
+                    } else {
+                        [0, (v / w as u64) as i32]
+                    }
+                };
                 let mut b = self.bitonic.bind();
                 b.texture("u_pairs", &textures[current])
-                    .int("u_width", w as i32)
-                    .int("u_stage", stage as i32)
-                    .int("u_distance", distance as i32);
+                    .ivec2("u_stage_xy", split(stage))
+                    .ivec2("u_distance_xy", split(distance));
                 self.gpu.draw_fullscreen(&targets[1 - current]);
                 current = 1 - current;
                 passes += 1;
@@ -123,7 +129,8 @@ impl BitonicBuild {
     ) -> Result<SortedPhotonMap, GpuError> {
         let query = TimerQuery::new(&self.gpu)?;
         let (w, h) = sort_texture_size(frames.record_count() as u64);
-        let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rgba32I)?;
+        // (key, record) in RG32I: 8 bytes a pair, all a pass moves.
+        let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
         {
             let target = Target::new(&self.gpu, &[&pairs])?;
             query.begin();

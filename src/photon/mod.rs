@@ -2,6 +2,7 @@
 //! tracing into frames of photon textures (section 2.1), and the two photon-map
 //! builds, bitonic merge sort + binary search (2.2.1) and stencil routing (2.2.2).
 
+pub mod bench;
 pub mod bitonic;
 pub mod stencil_routing;
 pub mod trace;
@@ -43,7 +44,8 @@ impl Grid {
         self.resolution.iter().product()
     }
 
-    /// The cell of p, or None outside: the arithmetic of glsl/common/grid.glsl.
+    /// The cell of p, or None outside the closed bounds: the arithmetic of
+    /// glsl/common/grid.glsl.
     pub fn cell_of(&self, p: Vec3) -> Option<u32> {
         let res = Vec3::new(
             self.resolution[0] as f32,
@@ -51,10 +53,10 @@ impl Grid {
             self.resolution[2] as f32,
         );
         let f = (p - self.min) / (self.max - self.min) * res;
-        let c = f.floor();
-        if c.cmplt(Vec3::ZERO).any() || c.cmpge(res).any() || !f.is_finite() {
+        if f.cmplt(Vec3::ZERO).any() || f.cmpgt(res).any() || !f.is_finite() {
             return None;
         }
+        let c = f.floor().min(res - Vec3::ONE);
         let [x, y, z] = [c.x as u32, c.y as u32, c.z as u32];
         Some(x + self.resolution[0] * (y + self.resolution[1] * z))
     }

@@ -26,6 +26,8 @@ pub struct PhotonFrames {
     pub photons_used: u32,
     /// emitted / photons_used: the power each used photon must carry.
     pub power_scale: f32,
+    /// GPU time of the emission and bounce passes (timer query).
+    pub gpu_seconds: f64,
 }
 
 impl PhotonFrames {
@@ -83,6 +85,9 @@ pub struct TraceReport {
     pub photons_used: u32,
     pub stored: u32,
     pub target: u32,
+    /// GPU time of the last (kept) trace, and of all attempts together.
+    pub gpu_seconds: f64,
+    pub gpu_seconds_all_attempts: f64,
 }
 
 /// Where photon tracing takes its random numbers.
@@ -172,12 +177,14 @@ impl PhotonTracer {
         let target = Target::new(&self.gpu, &[&position, &power, &incoming, &outgoing])?;
         target.clear([0.0; 4]);
         let (w, fh) = (width as i32, frame_height as i32);
+        let query = crate::gpu::TimerQuery::new(&self.gpu)?;
         let random = match self.random {
             RandomSource::Hash => None,
             RandomSource::Texture => {
                 Some(self.random_texture(seed, width, frame_height, frames)?)
             }
         };
+        query.begin();
         {
             let mut b = self.emit.bind();
             textures.bind(&mut b);
@@ -207,6 +214,8 @@ impl PhotonTracer {
                 .int("u_store_direct", scene.photon_map.store_direct as i32);
             self.gpu.draw_region(&target, 0, bounce * fh, w, fh);
         }
+        query.end();
+        let gpu_seconds = query.seconds();
         self.gpu.check("photon tracing")?;
         Ok(PhotonFrames {
             position,
@@ -220,6 +229,7 @@ impl PhotonTracer {
             emitted,
             photons_used: emitted,
             power_scale: 1.0,
+            gpu_seconds,
         })
     }
 
@@ -245,9 +255,11 @@ impl PhotonTracer {
         };
         let mut emitted = target.max(64);
         let mut attempts = Vec::new();
+        let mut all_seconds = 0.0;
         loop {
             let mut frames = self.trace(scene, textures, seed, emitted)?;
             attempts.push(emitted);
+            all_seconds += frames.gpu_seconds;
             let counts = frames.stored_per_photon();
             let total: u64 = counts.iter().map(|&c| c as u64).sum();
             if total >= target as u64 {
@@ -268,6 +280,8 @@ impl PhotonTracer {
                     photons_used: used,
                     stored: sum,
                     target,
+                    gpu_seconds: frames.gpu_seconds,
+                    gpu_seconds_all_attempts: all_seconds,
                 };
                 return Ok((frames, report));
             }
@@ -321,6 +335,7 @@ impl PhotonFrames {
             emitted: width * frame_height,
             photons_used,
             power_scale: 1.0,
+            gpu_seconds: 0.0,
         })
     }
 }

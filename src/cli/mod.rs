@@ -1,0 +1,3 @@
+//! The command line's subcommands beyond `render` and `info`.
+pub mod bench;
+pub mod photons;

@@ -1,0 +1,162 @@
+//! `photonmap bench build`: both photon-map builds on n = 2^k synthetic photons,
+//! beside a plain copy pass over the same texture (the bandwidth bound).
+
+use glam::Vec3;
+
+use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture, TimerQuery};
+use crate::render::Timings;
+
+use super::bitonic::{sort_texture_size, BitonicBuild};
+use super::{Grid, PhotonFrames, StencilRouting, VertexFeed};
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BuildBenchRow {
+    pub photons: u64,
+    pub bitonic_passes: u32,
+    pub bitonic_sort_seconds: f64,
+    pub bitonic_seconds_per_pass: f64,
+    pub copy_pass_seconds: f64,
+    /// Wall clock (glFinish before and after) of the sort and of one copy pass.
+    pub bitonic_sort_wall_seconds: f64,
+    pub copy_pass_wall_seconds: f64,
+    /// bitonic_seconds_per_pass / copy_pass_seconds (target: <= 1.5)
+    pub pass_to_copy_ratio: f64,
+    pub keys_seconds: f64,
+    pub binary_search_seconds: f64,
+    pub gather_seconds: f64,
+    pub stencil_block: u32,
+    pub stencil_cells: u32,
+    /// GPU time of routing (pattern + route + count + redistribute), vertex fetch.
+    pub stencil_vertex_fetch_seconds: f64,
+    /// The same with the paper's read-back: GPU time plus the read-back's wall time.
+    pub stencil_readback_seconds: f64,
+    pub stencil_readback_wall_seconds: f64,
+}
+
+/// Photons at uniform random points of the unit cube, all stored, one frame.
+pub fn synthetic_frames(gpu: &Gpu, n: u64, seed: u32) -> Result<PhotonFrames, GpuError> {
+    let (width, height) = sort_texture_size(n);
+    let mut state = seed;
+    let mut next = || crate::reference::random::rng_next(&mut state);
+    let texels = (width * height) as usize;
+    let (mut pos, mut pow, inc) = (
+        vec![0f32; texels * 4],
+        vec![0f32; texels * 4],
+        vec![0f32; texels * 4],
+    );
+    for i in 0..texels {
+        pos[4 * i..4 * i + 4].copy_from_slice(&[next(), next(), next(), 0.0]);
+        pow[4 * i..4 * i + 4].copy_from_slice(&[1.0, 1.0, 1.0, 1.0]);
+    }
+    PhotonFrames::from_records(gpu, width, height, 1, &pos, &pow, &inc, width * height)
+}
+
+fn stage(t: &Timings, name: &str) -> f64 {
+    t.stages
+        .iter()
+        .filter(|s| s.name == name)
+        .map(|s| s.gpu_seconds)
+        .sum()
+}
+
+/// Benchmarks one size. `grid` is the paper's ~40^3 cells; `block` is m.
+pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBenchRow, GpuError> {
+    let frames = synthetic_frames(gpu, n, 0x5eed)?;
+    let bitonic = BitonicBuild::new(gpu)?;
+    let routing = StencilRouting::new(gpu)?;
+    // Warm-up: compile, first-touch allocation.
+    bitonic.build(&frames, grid, &mut Timings::default())?;
+    let mut t = Timings::default();
+    bitonic.build(&frames, grid, &mut t)?;
+    let sort = t
+        .stages
+        .iter()
+        .find(|s| s.name == "bitonic sort")
+        .cloned()
+        .unwrap_or_default();
+
+    // Copy passes over the same RGBA32I texture, ping-ponged like the sort (each
+    // reads what the last wrote), as many as the sort has passes.
+    let (w, h) = sort_texture_size(n);
+    let textures = [
+        Texture::new(gpu, w, h, TexFormat::Rg32I)?,
+        Texture::new(gpu, w, h, TexFormat::Rg32I)?,
+    ];
+    let targets = [
+        Target::new(gpu, &[&textures[0]])?,
+        Target::new(gpu, &[&textures[1]])?,
+    ];
+    let copy = Program::fullscreen(gpu, "bench/copy_pairs.frag")?;
+    let copies = sort.passes.max(1);
+    let q = TimerQuery::new(gpu)?;
+    gpu.finish();
+    let wall = std::time::Instant::now();
+    q.begin();
+    for i in 0..copies {
+        copy.bind().texture("u_pairs", &textures[i % 2]);
+        gpu.draw_fullscreen(&targets[1 - i % 2]);
+    }
+    q.end();
+    gpu.finish();
+    let copy_wall = wall.elapsed().as_secs_f64() / copies as f64;
+    let copy_pass = q.seconds() / copies as f64;
+
+    // The sort again under the wall clock, to cross-check the timer queries.
+    let keys = {
+        let mut t = Timings::default();
+        let map = bitonic.build(&frames, grid, &mut t)?;
+        map.pairs
+    };
+    gpu.finish();
+    let wall = std::time::Instant::now();
+    let (_, passes) = bitonic.sort(keys)?;
+    gpu.finish();
+    let sort_wall = wall.elapsed().as_secs_f64();
+
+    routing.build(
+        &frames,
+        grid,
+        block,
+        VertexFeed::VertexFetch,
+        &mut Timings::default(),
+    )?;
+    let mut fetch = Timings::default();
+    routing.build(&frames, grid, block, VertexFeed::VertexFetch, &mut fetch)?;
+    let mut readback = Timings::default();
+    routing.build(&frames, grid, block, VertexFeed::Readback, &mut readback)?;
+    let gpu_part = |t: &Timings| {
+        ["route", "count", "redistribute"]
+            .iter()
+            .map(|s| stage(t, s))
+            .sum::<f64>()
+    };
+    let readback_wall = stage(&readback, "read-back (wall)");
+    let per_pass = sort.gpu_seconds / sort.passes.max(1) as f64;
+    Ok(BuildBenchRow {
+        photons: n,
+        bitonic_passes: sort.passes as u32,
+        bitonic_sort_seconds: sort.gpu_seconds,
+        bitonic_seconds_per_pass: per_pass,
+        copy_pass_seconds: copy_pass,
+        bitonic_sort_wall_seconds: sort_wall * sort.passes as f64 / passes.max(1) as f64,
+        copy_pass_wall_seconds: copy_wall,
+        pass_to_copy_ratio: per_pass / copy_pass,
+        keys_seconds: stage(&t, "keys"),
+        binary_search_seconds: stage(&t, "binary search"),
+        gather_seconds: stage(&t, "gather"),
+        stencil_block: block,
+        stencil_cells: grid.cell_count(),
+        stencil_vertex_fetch_seconds: gpu_part(&fetch),
+        stencil_readback_seconds: gpu_part(&readback) + readback_wall,
+        stencil_readback_wall_seconds: readback_wall,
+    })
+}
+
+/// The paper's stencil-routing grid: about 40^3 cells over the unit cube.
+pub fn paper_grid() -> Grid {
+    Grid {
+        min: Vec3::ZERO,
+        max: Vec3::ONE,
+        resolution: [40, 40, 40],
+    }
+}
