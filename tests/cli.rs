@@ -158,3 +158,100 @@ fn info_names_the_renderer_and_limits() {
     assert!(v["max_texture_size"].as_i64().unwrap() >= 4096);
     assert_eq!(v["stencil_bits"], 8);
 }
+
+#[test]
+fn photons_reports_the_stored_count_for_both_builds() {
+    for build in ["bitonic", "stencil"] {
+        let out = photonmap()
+            .args(["photons", "--json", "--build", build])
+            .arg(scene("glass_ball"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["trace"]["target"], 5000);
+        let stored = v["trace"]["stored"].as_u64().unwrap();
+        assert!((5000..=5008).contains(&stored), "{v}");
+        let (in_map, in_grid) = (
+            v["photons_in_map"].as_u64().unwrap(),
+            v["photons_in_grid"].as_u64().unwrap(),
+        );
+        assert_eq!(
+            in_grid, stored,
+            "every GLASS BALL photon lands on the floor grid"
+        );
+        if build == "bitonic" {
+            assert_eq!(in_map, in_grid);
+        } else {
+            assert!(in_map <= in_grid && in_map > in_grid * 9 / 10, "{v}");
+        }
+    }
+}
+
+#[test]
+fn faithful_photons_match_the_default_ones() {
+    let run = |faithful: bool| {
+        let mut c = photonmap();
+        c.args(["photons", "--json", "--build", "stencil"])
+            .arg(scene("cornell_box"));
+        if faithful {
+            c.arg("--faithful");
+        }
+        let out = c.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (a, b) = (run(false), run(true));
+    // The random texture holds the hash's numbers: the same photons, the same map.
+    for field in ["attempts", "emitted", "photons_used", "stored"] {
+        assert_eq!(a["trace"][field], b["trace"][field], "{field}");
+    }
+    assert_eq!(a["photons_in_map"], b["photons_in_map"]);
+    assert!(b["timings"]["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|s| s["name"] == "read-back (wall)"));
+}
+
+#[test]
+fn bench_build_prints_json_rows() {
+    let out = photonmap()
+        .args([
+            "bench",
+            "build",
+            "--json",
+            "--quiet",
+            "--min-log2",
+            "10",
+            "--max-log2",
+            "11",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["bitonic_passes"], 55);
+    assert_eq!(rows[1]["bitonic_passes"], 66);
+    assert!(rows[0]["copy_pass_seconds"].as_f64().unwrap() > 0.0);
+    let bad = photonmap()
+        .args(["bench", "build", "--min-log2", "30"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("allowed range"));
+}
