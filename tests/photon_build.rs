@@ -334,6 +334,52 @@ fn stencil_routing_counts_past_255_and_never_overwrites() {
 }
 
 #[test]
+fn routed_power_equals_destined_power_when_photons_are_alike() {
+    // Equal-power photons, cells far over capacity: redistribution must conserve
+    // the total exactly (up to float rounding).
+    let gpu = common::gpu();
+    let grid = Grid {
+        min: glam::Vec3::ZERO,
+        max: glam::Vec3::ONE,
+        resolution: [3, 1, 2],
+    };
+    let mut rng = Rng(99);
+    let points: Vec<[f32; 3]> = (0..5000)
+        .map(|_| {
+            [
+                (rng.next() % 1000) as f32 / 1000.0,
+                0.5,
+                (rng.next() % 1000) as f32 / 1000.0,
+            ]
+        })
+        .collect();
+    let frames = frames_from_points(&gpu, &points, |_| [0.25, 0.5, 1.0]);
+    for block in [4u32, 16] {
+        let map = StencilRouting::new(&gpu)
+            .unwrap()
+            .build(
+                &frames,
+                &grid,
+                block,
+                VertexFeed::VertexFetch,
+                &mut Timings::default(),
+            )
+            .unwrap();
+        let stored: f64 = map
+            .power
+            .read_f32()
+            .chunks(4)
+            .map(|p| (p[0] + p[1] + p[2]) as f64)
+            .sum();
+        let destined = points.len() as f64 * 1.75;
+        assert!(
+            (stored - destined).abs() <= 1e-5 * destined,
+            "m = {block}: stored power {stored}, destined {destined}"
+        );
+    }
+}
+
+#[test]
 fn the_stencil_pattern_and_saturation_are_as_the_paper_describes() {
     // Read the stencil after routing 300 photons into one 16 x 16 cell: every
     // slot has counted min(255, slot + 300) = 255; with 10 photons, slot + 10.
