@@ -10,7 +10,10 @@ use clap::{Parser, Subcommand};
 
 use photonmap::gpu::{EglPlatform, Gpu};
 use photonmap::photon::{BuildMethod, VertexFeed};
-use photonmap::render::{self, RenderOptions};
+use photonmap::render::{
+    self, EstimateMode, EstimateOptions, GlobalIllumination, RenderOptions, SnapshotEvery,
+    Snapshots,
+};
 use photonmap::scene::load_scene;
 
 #[derive(Parser)]
@@ -54,6 +57,39 @@ enum Command {
         /// Print the per-stage timings as JSON on stdout.
         #[arg(long)]
         json: bool,
+        /// Photon-map build for indirect light and caustics.
+        #[arg(long, value_enum, default_value_t = BuildMethod::Bitonic)]
+        build: BuildMethod,
+        /// Direct light and specular paths only: no photons, no radiance estimate.
+        #[arg(long)]
+        direct_only: bool,
+        /// Stencil routing: each cell holds m x m photons (1..=16).
+        #[arg(long, default_value_t = 4)]
+        stencil_m: u32,
+        /// Stencil routing: how photons reach the vertex stage.
+        #[arg(long, value_enum, default_value_t = VertexFeed::VertexFetch)]
+        feed: VertexFeed,
+        /// The paper's 2003 constraints: a texture of random numbers, read-back before routing.
+        #[arg(long)]
+        faithful: bool,
+        /// Radiance estimate tiles of N x N pixels, each stopped by occlusion query (0: full screen).
+        #[arg(long, default_value_t = 16)]
+        tile: u32,
+        /// Full screen behind a per-pixel stencil mask of finished pixels, refreshed every N passes.
+        #[arg(long, value_name = "N")]
+        mask: Option<u32>,
+        /// Radiance estimate steps per pixel per pass (1..=100000).
+        #[arg(long, default_value_t = 64)]
+        budget: u32,
+        /// Write the running estimate as numbered PNGs (and snapshots.json) into DIR.
+        #[arg(long, value_name = "DIR")]
+        snapshots: Option<PathBuf>,
+        /// Snapshot interval: seconds ("0.5s") or passes ("10").
+        #[arg(long, default_value = "0.5s")]
+        every: String,
+        /// List every pass that runs and every pass skipped, with why.
+        #[arg(long)]
+        explain: bool,
     },
     /// Trace a scene's photons and build its photon map; report counts, passes and times.
     Photons {
@@ -107,6 +143,21 @@ enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+}
+
+/// "0.5s" -> every half second of estimate; "10" -> every 10 passes.
+fn parse_every(text: &str) -> Result<SnapshotEvery> {
+    let t = text.trim();
+    if let Some(secs) = t.strip_suffix('s') {
+        match secs.parse::<f64>() {
+            Ok(v) if v > 0.0 && v.is_finite() => return Ok(SnapshotEvery::Seconds(v)),
+            _ => bail!("--every {text}: seconds must be a positive number, as in 0.5s"),
+        }
+    }
+    match t.parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(SnapshotEvery::Passes(n)),
+        _ => bail!("--every {text}: give seconds (0.5s) or a number of passes (10, at least 1)"),
+    }
 }
 
 fn check_output(path: &Path, extension: &str, flag: &str) -> Result<()> {
@@ -217,14 +268,22 @@ fn run(cli: Cli) -> Result<()> {
             height,
             quiet,
             json,
+            build,
+            direct_only,
+            stencil_m,
+            feed,
+            faithful,
+            tile,
+            mask,
+            budget,
+            snapshots,
+            every,
+            explain,
         } => {
             check_output(&output, "png", "-o")?;
             if let Some(e) = &exr {
                 check_output(e, "exr", "--exr")?;
             }
-            let scene = load_scene(&scene)?;
-            let mut options = RenderOptions::for_scene(&scene);
-            options.seed = seed;
             for (name, v) in [("--width", width), ("--height", height)] {
                 if let Some(v) = v {
                     if !(1..=16384).contains(&v) {
@@ -232,8 +291,43 @@ fn run(cli: Cli) -> Result<()> {
                     }
                 }
             }
+            if !(1..=16).contains(&stencil_m) {
+                bail!("--stencil-m {stencil_m}: the allowed range is 1..=16 (m^2 slots must fit 8 stencil bits)");
+            }
+            if !(1..=100_000).contains(&budget) {
+                bail!("--budget {budget}: the allowed range is 1..=100000");
+            }
+            if tile > 255 {
+                bail!("--tile {tile}: the allowed range is 0 (full screen) or 1..=255 (llvmpipe's largest point size)");
+            }
+            let every = parse_every(&every)?;
+            if let Some(dir) = &snapshots {
+                if !dir.is_dir() {
+                    bail!("--snapshots {}: the folder does not exist", dir.display());
+                }
+            }
+            let scene = load_scene(&scene)?;
+            let mut options = RenderOptions::for_scene(&scene);
+            options.seed = seed;
             options.width = width.unwrap_or(options.width);
             options.height = height.unwrap_or(options.height);
+            let mode = match (mask, tile) {
+                (Some(n), _) => EstimateMode::Masked { every: n.max(1) },
+                (None, 0) => EstimateMode::FullScreen,
+                (None, t) => EstimateMode::Tiled { tile: t },
+            };
+            options.global = (!direct_only).then(|| GlobalIllumination {
+                build,
+                stencil_block: stencil_m,
+                feed,
+                faithful,
+                estimate: EstimateOptions {
+                    mode,
+                    budget,
+                    ..EstimateOptions::default()
+                },
+                snapshots: snapshots.map(|dir| Snapshots { dir, every }),
+            });
             let gpu = Gpu::new(cli.egl)?;
             let bar = if quiet {
                 indicatif::ProgressBar::hidden()
@@ -241,7 +335,7 @@ fn run(cli: Cli) -> Result<()> {
                 let b = indicatif::ProgressBar::new(1);
                 b.set_style(
                     indicatif::ProgressStyle::with_template(
-                        "{msg} [{bar:40}] {pos}/{len} passes {elapsed}",
+                        "{msg} [{bar:40}] {pos}/{len} {elapsed}",
                     )
                     .expect("valid template")
                     .progress_chars("=> "),
@@ -252,9 +346,10 @@ fn run(cli: Cli) -> Result<()> {
                 ));
                 b
             };
-            let progress = |done: usize, total: usize| {
-                bar.set_length(total as u64);
-                bar.set_position(done as u64);
+            let progress = |stage: &str, done: u64, total: u64| {
+                bar.set_message(format!("{} {}", scene.name, stage));
+                bar.set_length(total.max(1));
+                bar.set_position(done);
             };
             let out = render::render(&gpu, &scene, &options, &progress)?;
             bar.finish_and_clear();
@@ -274,8 +369,24 @@ fn run(cli: Cli) -> Result<()> {
             if json {
                 println!("{}", serde_json::to_string_pretty(&out.timings)?);
             }
+            if explain {
+                for l in &out.explain {
+                    let what = if l.ran { "run " } else { "skip" };
+                    eprintln!("{what} {:<34} {:>6} passes  {}", l.stage, l.passes, l.why);
+                }
+            }
             if !quiet {
                 eprint!("{}", out.timings.table());
+                if let Some(e) = &out.estimate {
+                    eprintln!(
+                        "radiance estimate: {} passes, {} of {} pixels searched, {} tile draws of {} tiles",
+                        e.passes,
+                        e.query_pixels,
+                        options.width as u64 * options.height as u64,
+                        e.tile_draws,
+                        e.tiles
+                    );
+                }
                 eprintln!("wrote {}", output.display());
             }
             Ok(())

@@ -404,3 +404,51 @@ fn the_stencil_pattern_and_saturation_are_as_the_paper_describes() {
         }
     }
 }
+
+#[test]
+fn compaction_gives_the_same_map_as_sorting_every_record() {
+    use photonmap::photon::PhotonTracer;
+    use photonmap::scene::pack::SceneTextures;
+    let gpu = common::gpu();
+    let scene = common::paper_scene("cornell_box");
+    let textures = SceneTextures::new(&gpu, &scene).unwrap();
+    let (frames, _) = PhotonTracer::new(&gpu)
+        .unwrap()
+        .trace_to_stored(&scene, &textures, 2)
+        .unwrap();
+    let grid = Grid::for_scene(&scene);
+    let mut build = BitonicBuild::new(&gpu).unwrap();
+    let compacted = build
+        .build(&frames, &grid, &mut Timings::default())
+        .unwrap();
+    build.compact = false;
+    let full = build
+        .build(&frames, &grid, &mut Timings::default())
+        .unwrap();
+    let first = |m: &photonmap::photon::SortedPhotonMap| {
+        m.grid_first
+            .read_i32()
+            .chunks(4)
+            .map(|c| c[0])
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(first(&compacted), first(&full), "cell ranges differ");
+    let valid = *first(&full).last().unwrap() as usize;
+    assert!(valid > 60_000, "{valid} photons in the map");
+    let pairs = |m: &photonmap::photon::SortedPhotonMap| {
+        m.pairs
+            .read_i32()
+            .chunks(2)
+            .take(valid)
+            .map(|c| (c[0], c[1]))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        pairs(&compacted),
+        pairs(&full),
+        "sorted (cell, record) pairs differ"
+    );
+    assert!(
+        compacted.pairs.width * compacted.pairs.height < full.pairs.width * full.pairs.height / 4
+    );
+}

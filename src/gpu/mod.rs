@@ -168,6 +168,14 @@ impl Gpu {
         }
     }
 
+    /// Draws points into whatever target is bound (for many small draws in a row).
+    pub fn draw_points_bound(&self, first: i32, count: i32) {
+        unsafe {
+            self.gl().bind_vertex_array(Some(self.empty_vao));
+            self.gl().draw_arrays(glow::POINTS, first, count);
+        }
+    }
+
     /// Additive blending (ONE, ONE) on every draw buffer, for accumulating passes.
     pub fn set_additive_blend(&self, on: bool) {
         unsafe {

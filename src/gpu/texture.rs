@@ -43,6 +43,17 @@ pub struct Texture {
 
 impl Texture {
     pub fn new(gpu: &Gpu, width: u32, height: u32, format: TexFormat) -> Result<Self, GpuError> {
+        Self::with_levels(gpu, width, height, format, 1)
+    }
+
+    /// A texture with `levels` mip levels (each half the size of the one below).
+    pub fn with_levels(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        format: TexFormat,
+        levels: u32,
+    ) -> Result<Self, GpuError> {
         let max = unsafe { gpu.gl().get_parameter_i32(glow::MAX_TEXTURE_SIZE) } as u32;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(GpuError::Gl(format!(
@@ -54,7 +65,13 @@ impl Texture {
         let (internal, _, _) = format.gl();
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
-            gl.tex_storage_2d(glow::TEXTURE_2D, 1, internal, width as i32, height as i32);
+            gl.tex_storage_2d(
+                glow::TEXTURE_2D,
+                levels as i32,
+                internal,
+                width as i32,
+                height as i32,
+            );
             for (p, v) in [
                 (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
                 (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
@@ -125,6 +142,36 @@ impl Texture {
         }
         gpu.check("uploading an integer texture")?;
         Ok(t)
+    }
+
+    /// Restricts which mip levels samplers see (texelFetch's lod counts from `base`).
+    pub fn set_level_range(&self, base: u32, max: u32) {
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_BASE_LEVEL, base as i32);
+            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAX_LEVEL, max as i32);
+        }
+    }
+
+    /// Reads a mip level of an integer texture (row 0 first).
+    pub fn read_i32_texel(&self, level: u32) -> Vec<i32> {
+        let (w, h) = ((self.width >> level).max(1), (self.height >> level).max(1));
+        let mut out = vec![0i32; (w * h) as usize * self.format.channels()];
+        let (_, fmt, ty) = self.format.gl();
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
+            gl.get_tex_image(
+                glow::TEXTURE_2D,
+                level as i32,
+                fmt,
+                ty,
+                glow::PixelPackData::Slice(Some(bytes_of_mut(&mut out))),
+            );
+        }
+        out
     }
 
     pub fn is_integer(&self) -> bool {
@@ -233,20 +280,29 @@ pub struct Target {
 
 impl Target {
     pub fn new(gpu: &Gpu, colors: &[&Texture]) -> Result<Self, GpuError> {
-        Self::build(gpu, colors, false)
+        Self::build(gpu, colors, false, 0)
+    }
+
+    /// A target over mip level `level` of one texture.
+    pub fn for_level(gpu: &Gpu, color: &Texture, level: u32) -> Result<Self, GpuError> {
+        Self::build(gpu, &[color], false, level)
     }
 
     pub fn with_stencil(gpu: &Gpu, colors: &[&Texture]) -> Result<Self, GpuError> {
-        Self::build(gpu, colors, true)
+        Self::build(gpu, colors, true, 0)
     }
 
-    fn build(gpu: &Gpu, colors: &[&Texture], depth_stencil: bool) -> Result<Self, GpuError> {
+    fn build(
+        gpu: &Gpu,
+        colors: &[&Texture],
+        depth_stencil: bool,
+        level: u32,
+    ) -> Result<Self, GpuError> {
         assert!(!colors.is_empty(), "a target needs a colour attachment");
-        let (width, height) = (colors[0].width, colors[0].height);
+        let size_at = |t: &Texture| ((t.width >> level).max(1), (t.height >> level).max(1));
+        let (width, height) = size_at(colors[0]);
         assert!(
-            colors
-                .iter()
-                .all(|t| t.width == width && t.height == height),
+            colors.iter().all(|t| size_at(t) == (width, height)),
             "all attachments of a target must have one size"
         );
         let gl = gpu.gl();
@@ -257,7 +313,13 @@ impl Target {
             let mut bufs = Vec::new();
             for (i, t) in colors.iter().enumerate() {
                 let att = glow::COLOR_ATTACHMENT0 + i as u32;
-                gl.framebuffer_texture_2d(glow::FRAMEBUFFER, att, glow::TEXTURE_2D, Some(t.raw), 0);
+                gl.framebuffer_texture_2d(
+                    glow::FRAMEBUFFER,
+                    att,
+                    glow::TEXTURE_2D,
+                    Some(t.raw),
+                    level as i32,
+                );
                 bufs.push(att);
             }
             gl.draw_buffers(&bufs);

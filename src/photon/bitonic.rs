@@ -39,6 +39,12 @@ pub fn pass_count(n: u64) -> u32 {
 
 pub struct BitonicBuild {
     gpu: Gpu,
+    /// Compact stored records on the GPU before sorting (a HistoPyramid); off
+    /// for the paper's way, sorting every record of every frame.
+    pub compact: bool,
+    pyramid_base: Program,
+    pyramid_reduce: Program,
+    compact_pass: Program,
     keys: Program,
     bitonic: Program,
     search: Program,
@@ -49,6 +55,10 @@ impl BitonicBuild {
     pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
         Ok(Self {
             gpu: gpu.clone(),
+            compact: true,
+            pyramid_base: Program::fullscreen(gpu, "photon/pyramid_base.frag")?,
+            pyramid_reduce: Program::fullscreen(gpu, "photon/pyramid_reduce.frag")?,
+            compact_pass: Program::fullscreen(gpu, "photon/compact.frag")?,
             keys: Program::fullscreen(gpu, "photon/keys.frag")?,
             bitonic: Program::fullscreen(gpu, "photon/bitonic.frag")?,
             search: Program::fullscreen(gpu, "photon/binary_search.frag")?,
@@ -120,6 +130,55 @@ impl BitonicBuild {
         Ok((first, grid_width))
     }
 
+    /// (cell, record) pairs of the stored records only, packed into the first
+    /// slots of a power-of-two texture: HistoPyramid count, reduce, traverse.
+    /// Returns the pairs and the number of stored records.
+    pub fn compacted_pairs(
+        &self,
+        frames: &PhotonFrames,
+        grid: &Grid,
+    ) -> Result<(Texture, u32), GpuError> {
+        let (w, h) = sort_texture_size(frames.record_count() as u64);
+        let levels = 32 - w.max(h).leading_zeros();
+        let pyramid = Texture::with_levels(&self.gpu, w, h, TexFormat::Rgba32I, levels)?;
+        {
+            let target = Target::for_level(&self.gpu, &pyramid, 0)?;
+            let mut b = self.pyramid_base.bind();
+            grid.bind(&mut b);
+            b.texture("u_position", &frames.position)
+                .texture("u_power", &frames.power)
+                .int("u_level_width", w as i32)
+                .int("u_record_width", frames.width as i32)
+                .int("u_record_count", frames.record_count() as i32)
+                .int("u_frame_height", frames.frame_height as i32)
+                .int("u_photons_used", frames.photons_used as i32);
+            self.gpu.draw_fullscreen(&target);
+        }
+        for level in 1..levels {
+            // Samplers see only the level below while this one is drawn.
+            pyramid.set_level_range(level - 1, level - 1);
+            let target = Target::for_level(&self.gpu, &pyramid, level)?;
+            self.pyramid_reduce.bind().texture("u_below", &pyramid);
+            self.gpu.draw_fullscreen(&target);
+        }
+        pyramid.set_level_range(0, levels - 1);
+        let count = pyramid.read_i32_texel(levels - 1)[0] as u32;
+        let (cw, ch) = sort_texture_size(count.max(2) as u64);
+        let pairs = Texture::new(&self.gpu, cw, ch, TexFormat::Rg32I)?;
+        let target = Target::new(&self.gpu, &[&pairs])?;
+        let mut b = self.compact_pass.bind();
+        grid.bind(&mut b);
+        b.texture("u_pyramid", &pyramid)
+            .int("u_top", levels as i32 - 1)
+            .texture("u_position", &frames.position)
+            .int("u_record_width", frames.width as i32)
+            .int("u_out_width", cw as i32)
+            .int("u_count", count as i32);
+        self.gpu.draw_fullscreen(&target);
+        self.gpu.check("compacting stored photons")?;
+        Ok((pairs, count))
+    }
+
     /// The whole build from traced photon frames, with its stages timed.
     pub fn build(
         &self,
@@ -128,10 +187,19 @@ impl BitonicBuild {
         timings: &mut Timings,
     ) -> Result<SortedPhotonMap, GpuError> {
         let query = TimerQuery::new(&self.gpu)?;
-        let (w, h) = sort_texture_size(frames.record_count() as u64);
-        // (key, record) in RG32I: 8 bytes a pair, all a pass moves.
-        let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
-        {
+        let pairs = if self.compact {
+            query.begin();
+            let (pairs, _) = self.compacted_pairs(frames, grid)?;
+            query.end();
+            let levels = 32
+                - sort_texture_size(frames.record_count() as u64)
+                    .0
+                    .leading_zeros();
+            timings.add("compact", query.seconds(), levels as usize + 1);
+            pairs
+        } else {
+            let (w, h) = sort_texture_size(frames.record_count() as u64);
+            let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
             let target = Target::new(&self.gpu, &[&pairs])?;
             query.begin();
             let mut b = self.keys.bind();
@@ -146,7 +214,10 @@ impl BitonicBuild {
             self.gpu.draw_fullscreen(&target);
             query.end();
             timings.add("keys", query.seconds(), 1);
-        }
+            drop(target);
+            pairs
+        };
+        let (w, h) = (pairs.width, pairs.height);
         query.begin();
         let (sorted, passes) = self.sort(pairs)?;
         query.end();

@@ -1,0 +1,42 @@
+// Access to a built photon map, whichever build made it: the photons of a grid
+// cell as a range [0, count) and the i-th photon's position and power.
+// ROUTED: stencil routing's m x m blocks; otherwise the sorted map.
+// src/reference/knn.rs reads the same layouts.
+#include "common/addressing.glsl"
+
+uniform sampler2D u_map_position;  // xyz, w = 1 valid
+uniform sampler2D u_map_power;     // rgb
+#ifdef ROUTED
+uniform sampler2D u_map_counts;    // photons destined to each cell (x)
+uniform int u_count_width;
+uniform int u_block;               // m
+uniform int u_blocks_per_row;
+#else
+uniform isampler2D u_grid_first;   // first sorted index of each cell
+uniform int u_grid_width;
+uniform int u_sorted_width;
+#endif
+
+// Photons stored in `cell`, and the offset that photon_texel takes.
+int cell_photon_count(int cell, out int base) {
+#ifdef ROUTED
+    base = cell;
+    float destined = texelFetch(u_map_counts, texel_of_index(cell, u_count_width), 0).x;
+    return min(int(destined), u_block * u_block);
+#else
+    base = texelFetch(u_grid_first, texel_of_index(cell, u_grid_width), 0).x;
+    return texelFetch(u_grid_first, texel_of_index(cell + 1, u_grid_width), 0).x - base;
+#endif
+}
+
+// The texel of the i-th photon of the cell whose `base` cell_photon_count gave.
+ivec2 photon_texel(int base, int i) {
+#ifdef ROUTED
+    // The k-th photon of a cell sits in slot m^2 - 1 - k, row by row in its block.
+    int slot = u_block * u_block - 1 - i;
+    ivec2 block = texel_of_index(base, u_blocks_per_row);
+    return block * u_block + ivec2(slot % u_block, slot / u_block);
+#else
+    return texel_of_index(base + i, u_sorted_width);
+#endif
+}

@@ -1,0 +1,47 @@
+#version 450 core
+// Stream compaction by HistoPyramid traversal: output slot i walks down from
+// the top level, at each level stepping over children (in a fixed order) until
+// the one holding its i-th stored record, and writes that record's
+// (cell, record) pair. Slots past the count get the invalid key. The order of
+// records does not matter: the sort breaks ties by record index.
+#include "common/addressing.glsl"
+#include "common/grid.glsl"
+
+uniform isampler2D u_pyramid;     // mip level 0: records; each level sums 2 x 2 below
+uniform int u_top;                // the one-texel level
+uniform sampler2D u_position;
+uniform int u_record_width;
+uniform int u_out_width;
+uniform int u_count;              // stored records in all
+
+layout(location = 0) out ivec4 o_pair;
+
+const int INVALID_KEY = 0x7fffffff;
+
+int count_at(int level, ivec2 t) {
+    ivec2 size = textureSize(u_pyramid, level);
+    if (t.x >= size.x || t.y >= size.y) return 0;
+    return texelFetch(u_pyramid, t, level).x;
+}
+
+void main() {
+    int slot = index_of_texel(ivec2(gl_FragCoord.xy), u_out_width);
+    o_pair = ivec4(INVALID_KEY, slot, 0, 0);
+    if (slot >= u_count) return;
+    int rest = slot;
+    ivec2 t = ivec2(0);
+    for (int level = u_top - 1; level >= 0; --level) {
+        ivec2 base = t * 2;
+        ivec2 chosen = base;
+        for (int k = 0; k < 4; ++k) {
+            ivec2 c = base + ivec2(k & 1, k >> 1);
+            int n = count_at(level, c);
+            if (rest < n) { chosen = c; break; }
+            rest -= n;
+        }
+        t = chosen;
+    }
+    int record = index_of_texel(t, textureSize(u_pyramid, 0).x);
+    vec3 p = texelFetch(u_position, texel_of_index(record, u_record_width), 0).xyz;
+    o_pair = ivec4(grid_cell(p), record, 0, 0);
+}

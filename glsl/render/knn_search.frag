@@ -1,0 +1,99 @@
+#version 450 core
+// One pass of the kNN-grid radiance estimate (section 2.3, figure 6) for every
+// pixel still searching: at most u_budget steps, each examining one photon or
+// moving to the next cell. State lives in textures updated in place: each
+// fragment reads and writes only its own texel, with a texture barrier between
+// passes (GL 4.5's one defined feedback case), so pixels not drawn (finished
+// tiles, masked pixels) keep their state. Finished pixels discard, so an
+// occlusion query over a draw counts the pixels that were still searching.
+//
+// Cells are visited in concentric cubic shells around the query point's cell
+// (ring r: cells at Chebyshev distance r). A photon beyond the maximum radius
+// is rejected; while fewer than k are accepted, each photon is accepted and the
+// radius grows to include it; after that only photons within the radius are
+// accepted. After ring r, every photon closer than d_min(r), the distance from
+// the query point to the faces of the box of rings 0..r, has been examined
+// (Elias): the search ends when k are accepted and the radius is within
+// d_min(r), when d_min(r) reaches the maximum radius, or when the box covers
+// the grid.
+#include "common/photon_map.glsl"
+
+uniform sampler2D u_query_position;  // first diffuse hit, w = 1 valid
+uniform sampler2D u_state_flux;      // rgb sum of accepted power, w = radius^2
+uniform isampler2D u_state_cursor;   // accepted, ring, cube cursor, photon cursor
+uniform isampler2D u_state_done;     // done, photons examined
+uniform vec3 u_grid_min;
+uniform vec3 u_grid_max;
+uniform ivec3 u_grid_resolution;
+uniform int u_k;
+uniform float u_max_radius;
+uniform int u_budget;
+
+layout(location = 0) out vec4 o_flux;
+layout(location = 1) out ivec4 o_cursor;
+layout(location = 2) out ivec4 o_done;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    ivec4 done = texelFetch(u_state_done, px, 0);
+    if (done.x != 0) discard;
+    vec4 flux = texelFetch(u_state_flux, px, 0);
+    ivec4 cursor = texelFetch(u_state_cursor, px, 0);
+    vec3 x = texelFetch(u_query_position, px, 0).xyz;
+    int accepted = cursor.x, ring = cursor.y, j = cursor.z, p = cursor.w;
+    int examined = done.y;
+    float r2 = flux.w;
+    float max_r2 = u_max_radius * u_max_radius;
+    vec3 cell_size = (u_grid_max - u_grid_min) / vec3(u_grid_resolution);
+    ivec3 c0 = clamp(ivec3(floor((x - u_grid_min) / cell_size)), ivec3(0), u_grid_resolution - 1);
+    bool finished = false;
+
+    for (int step = 0; step < u_budget; ++step) {
+        int side = 2 * ring + 1;
+        int plane = side * side;
+        if (j >= plane * side) {
+            // Ring done: every photon nearer than the examined box's faces is seen.
+            vec3 lo = u_grid_min + vec3(c0 - ring) * cell_size;
+            vec3 hi = u_grid_min + vec3(c0 + ring + 1) * cell_size;
+            vec3 inside = min(x - lo, hi - x);
+            float d_min = min(inside.x, min(inside.y, inside.z));
+            bool covers = all(lessThanEqual(c0 - ring, ivec3(0))) && all(greaterThanEqual(c0 + ring, u_grid_resolution - 1));
+            if (covers || d_min >= u_max_radius || (accepted >= u_k && d_min >= 0.0 && r2 <= d_min * d_min)) {
+                finished = true;
+                break;
+            }
+            ring += 1;
+            j = 0;
+            p = 0;
+            continue;
+        }
+        ivec3 d = ivec3(j % side, (j / side) % side, j / plane) - ring;
+        ivec3 cell = c0 + d;
+        // Cells outside the grid hold nothing: jump over whole planes, rows and
+        // runs of them (what makes thin grids such as 250 x 1 x 250 cheap).
+        if (cell.z < 0) { j = (-c0.z + ring) * plane; p = 0; continue; }
+        if (cell.z >= u_grid_resolution.z) { j = plane * side; p = 0; continue; }
+        if (cell.y < 0) { j = (d.z + ring) * plane + (-c0.y + ring) * side; p = 0; continue; }
+        if (cell.y >= u_grid_resolution.y) { j = (d.z + ring + 1) * plane; p = 0; continue; }
+        if (abs(d.y) < ring && abs(d.z) < ring && abs(d.x) < ring) { j += ring - d.x; p = 0; continue; } // interior: jump to the far face
+        if (cell.x < 0) { j += -cell.x; p = 0; continue; }
+        if (cell.x >= u_grid_resolution.x) { j = (j / side + 1) * side; p = 0; continue; }
+        int cell_index = cell.x + u_grid_resolution.x * (cell.y + u_grid_resolution.y * cell.z);
+        int base;
+        int count = cell_photon_count(cell_index, base);
+        if (p >= count) { j += 1; p = 0; continue; }
+        ivec2 t = photon_texel(base, p);
+        vec3 offset = texelFetch(u_map_position, t, 0).xyz - x;
+        float dist2 = dot(offset, offset);
+        if (dist2 <= max_r2 && (accepted < u_k || dist2 <= r2)) {
+            flux.rgb += texelFetch(u_map_power, t, 0).rgb;
+            if (accepted < u_k) r2 = max(r2, dist2);
+            accepted += 1;
+        }
+        p += 1;
+        examined += 1;
+    }
+    o_flux = vec4(flux.rgb, r2);
+    o_cursor = ivec4(accepted, ring, j, p);
+    o_done = ivec4(finished ? 1 : 0, examined, 0, 0);
+}

@@ -1,0 +1,302 @@
+//! Figure 1's "radiance estimate" box (sections 2.3, 3.3, 3.4): the kNN-grid
+//! search in many bounded passes, drawn as 16 x 16 point tiles that stop by
+//! occlusion query (or full screen, or full screen behind a per-pixel stencil
+//! mask), and the composed image, also of the running estimate.
+
+use crate::gpu::{Gpu, GpuError, OcclusionQuery, Program, Target, TexFormat, Texture, TimerQuery};
+use crate::photon::{Grid, PhotonMap};
+use crate::scene::pack::SceneTextures;
+
+use super::{DirectLight, Image};
+
+/// How the search passes are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum EstimateMode {
+    /// Points of tile x tile pixels, one occlusion query each; a tile with no
+    /// pixel still searching is not drawn again (section 3.3).
+    Tiled { tile: u32 },
+    /// One full-screen triangle per pass until no pixel searches.
+    FullScreen,
+    /// Full screen behind a stencil mask of finished pixels, refreshed every
+    /// `every` passes (the per-pixel "computation mask" of section 4.3).
+    Masked { every: u32 },
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EstimateOptions {
+    pub mode: EstimateMode,
+    /// Steps per pixel per pass (each examines one photon or moves one cell).
+    pub budget: u32,
+    /// A safety bound on passes.
+    pub max_passes: u32,
+}
+
+impl Default for EstimateOptions {
+    fn default() -> Self {
+        Self {
+            mode: EstimateMode::Tiled { tile: 16 },
+            budget: 64,
+            max_passes: 100_000,
+        }
+    }
+}
+
+/// What the search did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct EstimateStats {
+    pub passes: u32,
+    /// Pixels that took part (had a diffuse hit).
+    pub query_pixels: u64,
+    /// Pixels still searching at the start of each pass (occlusion-query counts).
+    pub searching_per_pass: Vec<u64>,
+    /// Tiles drawn in all passes, and tiles in the image (tiled mode).
+    pub tile_draws: u64,
+    pub tiles: u64,
+    pub gpu_seconds: f64,
+    pub wall_seconds: f64,
+}
+
+/// Seen after every pass: for progress and snapshots.
+pub struct PassReport<'a> {
+    pub pass: u32,
+    pub searching: u64,
+    pub query_pixels: u64,
+    pub elapsed_seconds: f64,
+    pub estimate: &'a RadianceEstimate,
+}
+
+pub struct RadianceEstimate {
+    gpu: Gpu,
+    pub flux: Texture,
+    pub cursor: Texture,
+    pub done: Texture,
+    target: Target,
+    pub image: Texture,
+    image_target: Target,
+    init: Program,
+    mask: Program,
+    compose: Program,
+    width: u32,
+    height: u32,
+}
+
+/// The search program for a map kind and a way of drawing.
+fn search_program(gpu: &Gpu, routed: bool, tiles: bool) -> Result<Program, GpuError> {
+    let defines: Vec<(&str, String)> = if routed {
+        vec![("ROUTED", "1".into())]
+    } else {
+        vec![]
+    };
+    let vertex = if tiles {
+        "render/tile.vert"
+    } else {
+        "common/fullscreen.vert"
+    };
+    Program::new(gpu, vertex, "render/knn_search.frag", &defines)
+}
+
+impl RadianceEstimate {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, GpuError> {
+        let flux = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let cursor = Texture::new(gpu, width, height, TexFormat::Rgba32I)?;
+        let done = Texture::new(gpu, width, height, TexFormat::Rgba32I)?;
+        let target = Target::with_stencil(gpu, &[&flux, &cursor, &done])?;
+        let image = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let image_target = Target::new(gpu, &[&image])?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            flux,
+            cursor,
+            done,
+            target,
+            image,
+            image_target,
+            init: Program::fullscreen(gpu, "render/knn_init.frag")?,
+            mask: Program::fullscreen(gpu, "render/knn_mask.frag")?,
+            compose: Program::fullscreen(gpu, "render/compose.frag")?,
+            width,
+            height,
+        })
+    }
+
+    /// Runs the search to the end; `on_pass` sees every pass.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        map: &PhotonMap,
+        direct: &DirectLight,
+        k: u32,
+        max_radius: f32,
+        options: &EstimateOptions,
+        on_pass: &mut dyn FnMut(&PassReport<'_>),
+    ) -> Result<EstimateStats, GpuError> {
+        self.gpu.finish();
+        let wall = std::time::Instant::now();
+        let routed = matches!(map, PhotonMap::Routed(_));
+        let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
+        let search = search_program(&self.gpu, routed, tiled)?;
+        let timer = TimerQuery::new(&self.gpu)?;
+        let mut stats = EstimateStats::default();
+
+        self.init
+            .bind()
+            .texture("u_query_position", &direct.diffuse_position);
+        self.gpu.draw_fullscreen(&self.target);
+        self.target.clear_depth_stencil(1.0, 0);
+        self.gpu.texture_barrier();
+
+        let bind_search = |b: &mut crate::gpu::Bindings<'_>| {
+            let grid: &Grid = match map {
+                PhotonMap::Sorted(m) => {
+                    b.texture("u_map_position", &m.position)
+                        .texture("u_map_power", &m.power)
+                        .texture("u_grid_first", &m.grid_first)
+                        .int("u_grid_width", m.grid_width as i32)
+                        .int("u_sorted_width", m.position.width as i32);
+                    &m.grid
+                }
+                PhotonMap::Routed(m) => {
+                    b.texture("u_map_position", &m.position)
+                        .texture("u_map_power", &m.power)
+                        .texture("u_map_counts", &m.counts)
+                        .int("u_count_width", m.count_width as i32)
+                        .int("u_block", m.block as i32)
+                        .int("u_blocks_per_row", m.blocks_per_row as i32);
+                    &m.grid
+                }
+            };
+            b.vec3("u_grid_min", grid.min.to_array())
+                .vec3("u_grid_max", grid.max.to_array())
+                .ivec3("u_grid_resolution", grid.resolution.map(|v| v as i32))
+                .texture("u_query_position", &direct.diffuse_position)
+                .texture("u_state_flux", &self.flux)
+                .texture("u_state_cursor", &self.cursor)
+                .texture("u_state_done", &self.done)
+                .int("u_k", k as i32)
+                .float("u_max_radius", max_radius)
+                .int("u_budget", options.budget as i32);
+        };
+
+        let (tile, tiles_per_row, tile_count) = match options.mode {
+            EstimateMode::Tiled { tile } => {
+                let per_row = self.width.div_ceil(tile);
+                (tile, per_row, per_row * self.height.div_ceil(tile))
+            }
+            _ => (0, 0, 0),
+        };
+        stats.tiles = tile_count as u64;
+        let mut active_tiles: Vec<u32> = (0..tile_count).collect();
+        let queries: Vec<OcclusionQuery> = (0..tile_count.max(1))
+            .map(|_| OcclusionQuery::new(&self.gpu))
+            .collect::<Result<_, _>>()?;
+
+        for pass in 0..options.max_passes {
+            timer.begin();
+            let searching = match options.mode {
+                EstimateMode::Tiled { .. } => {
+                    let mut b = search.bind();
+                    bind_search(&mut b);
+                    b.int("u_tile", tile as i32)
+                        .int("u_tiles_per_row", tiles_per_row as i32)
+                        .ivec2("u_target_size", [self.width as i32, self.height as i32]);
+                    self.target.bind();
+                    for (q, &t) in queries.iter().zip(&active_tiles) {
+                        q.begin();
+                        self.gpu.draw_points_bound(t as i32, 1);
+                        q.end();
+                    }
+                    stats.tile_draws += active_tiles.len() as u64;
+                    let counts: Vec<u64> = queries
+                        .iter()
+                        .take(active_tiles.len())
+                        .map(|q| q.samples())
+                        .collect();
+                    let mut kept = Vec::with_capacity(active_tiles.len());
+                    for (t, c) in active_tiles.iter().zip(&counts) {
+                        if *c > 0 {
+                            kept.push(*t);
+                        }
+                    }
+                    active_tiles = kept;
+                    counts.iter().sum()
+                }
+                EstimateMode::FullScreen | EstimateMode::Masked { .. } => {
+                    if let EstimateMode::Masked { every } = options.mode {
+                        self.gpu.set_stencil_routing(true);
+                        if pass % every.max(1) == 0 {
+                            // Stencil := 1 where the search is done.
+                            self.gpu.set_color_writes(false);
+                            self.gpu.set_depth_test_always_no_write();
+                            self.gpu.stencil(
+                                glow::ALWAYS,
+                                1,
+                                [glow::KEEP, glow::KEEP, glow::REPLACE],
+                            );
+                            self.mask.bind().texture("u_state_done", &self.done);
+                            self.gpu.draw_fullscreen(&self.target);
+                            self.gpu.set_color_writes(true);
+                        }
+                        self.gpu.set_depth_test_always_no_write();
+                        self.gpu
+                            .stencil(glow::EQUAL, 0, [glow::KEEP, glow::KEEP, glow::KEEP]);
+                    }
+                    let mut b = search.bind();
+                    bind_search(&mut b);
+                    queries[0].begin();
+                    self.gpu.draw_fullscreen(&self.target);
+                    queries[0].end();
+                    self.gpu.set_stencil_routing(false);
+                    queries[0].samples()
+                }
+            };
+            timer.end();
+            stats.gpu_seconds += timer.seconds();
+            self.gpu.texture_barrier();
+            if pass == 0 {
+                stats.query_pixels = searching;
+            }
+            if searching == 0 {
+                break;
+            }
+            stats.passes = pass + 1;
+            stats.searching_per_pass.push(searching);
+            on_pass(&PassReport {
+                pass,
+                searching,
+                query_pixels: stats.query_pixels,
+                elapsed_seconds: wall.elapsed().as_secs_f64(),
+                estimate: self,
+            });
+        }
+        self.gpu.check("radiance estimate")?;
+        self.gpu.finish();
+        stats.wall_seconds = wall.elapsed().as_secs_f64();
+        Ok(stats)
+    }
+
+    /// The image from the current state (final or running): direct light plus
+    /// the estimate at each first diffuse hit, as chosen.
+    pub fn compose(
+        &self,
+        scene: &SceneTextures,
+        direct: &DirectLight,
+        k: u32,
+        max_radius: f32,
+        include_direct: bool,
+        include_indirect: bool,
+    ) -> Image {
+        let mut b = self.compose.bind();
+        scene.bind(&mut b);
+        b.texture("u_direct", &direct.radiance)
+            .texture("u_diffuse_normal", &direct.diffuse_normal)
+            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
+            .texture("u_state_flux", &self.flux)
+            .texture("u_state_cursor", &self.cursor)
+            .int("u_k", k as i32)
+            .float("u_max_radius", max_radius)
+            .int("u_include_direct", include_direct as i32)
+            .int("u_include_indirect", include_indirect as i32);
+        self.gpu.draw_fullscreen(&self.image_target);
+        Image::from_gl_rgba(self.width, self.height, &self.image.read_f32())
+    }
+}
