@@ -183,25 +183,39 @@ fn every_glsl_file_compiles() {
         assert!(embedded.contains(&f.as_str()), "glsl/{f} is not embedded");
     }
     // Fragment programs drawn from points pair with their vertex program; the
-    // rest with the full-screen triangle. Vertex programs with #ifdef variants
-    // are built both ways.
-    let vertex_of = |frag: &str| match frag {
-        "photon/route.frag" | "photon/count.frag" => "photon/route.vert",
-        _ => "common/fullscreen.vert",
+    // rest with the full-screen triangle. Programs with #ifdef variants are
+    // built each way the program builds them.
+    let vertices_of = |frag: &str| -> Vec<&str> {
+        match frag {
+            "photon/route.frag" | "photon/count.frag" => vec!["photon/route.vert"],
+            "render/knn_search.frag" => vec!["common/fullscreen.vert", "render/tile.vert"],
+            _ => vec!["common/fullscreen.vert"],
+        }
+    };
+    let variants = |frag: &str| -> Vec<Vec<(&str, String)>> {
+        match frag {
+            "photon/route.frag" | "photon/count.frag" => {
+                vec![vec![], vec![("READBACK", "1".into())]]
+            }
+            "render/knn_search.frag" => vec![vec![], vec![("ROUTED", "1".into())]],
+            "photon/emit.frag" | "photon/trace.frag" => {
+                vec![vec![], vec![("RANDOM_TEXTURE", "1".into())]]
+            }
+            _ => vec![vec![]],
+        }
     };
     let mut compiled = 0;
-    for (name, _) in glsl_files() {
-        if name.ends_with(".frag") {
-            Program::new(&gpu, vertex_of(name), name, &[]).unwrap_or_else(|e| panic!("{e}"));
-            if vertex_of(name) == "photon/route.vert" {
-                Program::new(&gpu, vertex_of(name), name, &[("READBACK", "1".into())])
-                    .unwrap_or_else(|e| panic!("{e}"));
+    for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".frag")) {
+        for vertex in vertices_of(name) {
+            for defines in variants(name) {
+                Program::new(&gpu, vertex, name, &defines).unwrap_or_else(|e| panic!("{e}"));
+                compiled += 1;
             }
-            compiled += 1;
         }
     }
     for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".vert")) {
-        let used = glsl_files().any(|(f, _)| f.ends_with(".frag") && vertex_of(f) == name);
+        let used =
+            glsl_files().any(|(f, _)| f.ends_with(".frag") && vertices_of(f).contains(&name));
         assert!(
             used,
             "glsl/{name} is paired with no fragment program, so nothing compiles it"

@@ -102,9 +102,9 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
     let n = 256;
     let images: Vec<Image> = (0..n)
         .map(|seed| {
-            let mut o = RenderOptions::for_scene(&scene);
+            let mut o = RenderOptions::for_scene(&scene).direct_only();
             o.seed = seed + 1;
-            render(&gpu, &scene, &o, &|_, _| {}).unwrap().image
+            render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image
         })
         .collect();
     let mean = common::mean_image(&images);
@@ -147,9 +147,9 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
 fn an_emitter_seen_directly_shows_its_radiance() {
     let gpu = common::gpu();
     let scene = common::paper_scene("cornell_box");
-    let mut o = RenderOptions::for_scene(&scene);
+    let mut o = RenderOptions::for_scene(&scene).direct_only();
     (o.width, o.height) = (64, 64);
-    let img = render(&gpu, &scene, &o, &|_, _| {}).unwrap().image;
+    let img = render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image;
     let at_light = img
         .pixels
         .iter()
@@ -186,9 +186,14 @@ intensity = [8.0, 8.0, 8.0]
 "#;
     let scene = load_scene_str(text, std::path::Path::new("point.toml")).unwrap();
     let gpu = common::gpu();
-    let img = render(&gpu, &scene, &RenderOptions::for_scene(&scene), &|_, _| {})
-        .unwrap()
-        .image;
+    let img = render(
+        &gpu,
+        &scene,
+        &RenderOptions::for_scene(&scene).direct_only(),
+        &|_, _, _| {},
+    )
+    .unwrap()
+    .image;
     let centre = Vec3::from(img.get(4, 4));
     let expect = Vec3::new(0.5, 0.25, 1.0) / std::f32::consts::PI * 8.0 / 4.0;
     assert!(

@@ -51,7 +51,7 @@ fn reduced(scene: &Scene) -> RenderOptions {
 fn render_seed(gpu: &photonmap::gpu::Gpu, scene: &Scene, seed: u32) -> Image {
     let mut o = reduced(scene);
     o.seed = seed;
-    render(gpu, scene, &o, &|_, _| {}).unwrap().image
+    render(gpu, scene, &o, &|_, _, _| {}).unwrap().image
 }
 
 fn paths(name: &str) -> (PathBuf, PathBuf, PathBuf) {
@@ -203,17 +203,17 @@ fn load(name: &str) -> Reference {
 }
 
 /// Scores a render; the actual image and its |z| map go to target/ for a look.
-fn score(name: &str, actual: &Image, r: &Reference) -> f64 {
+fn score(label: &str, actual: &Image, r: &Reference) -> f64 {
     let dir = common::root().join("target").join("reference-images");
     std::fs::create_dir_all(&dir).unwrap();
-    common::write_exr(&dir.join(format!("{name}.actual.exr")), actual);
+    common::write_exr(&dir.join(format!("{label}.actual.exr")), actual);
     let mut diff = actual.clone();
     for (d, m) in diff.pixels.iter_mut().zip(&r.mean.pixels) {
         for c in 0..3 {
             d[c] = (d[c] - m[c]).abs();
         }
     }
-    common::write_exr(&dir.join(format!("{name}.diff.exr")), &diff);
+    common::write_exr(&dir.join(format!("{label}.diff.exr")), &diff);
     failing_fraction(actual, &r.mean, &r.var, r.tol.seeds)
 }
 
@@ -257,7 +257,11 @@ fn the_comparison_catches_defects() {
                 *radiance *= 1.1;
             }
         }
-        let f = score(name, &render_seed(&gpu, &bright, TEST_SEED), &r);
+        let f = score(
+            &format!("{name}.brighter"),
+            &render_seed(&gpu, &bright, TEST_SEED),
+            &r,
+        );
         eprintln!(
             "{name}: brighter light fails {:.3}% (tolerance {:.3}%)",
             100.0 * f,
@@ -278,7 +282,11 @@ fn the_comparison_catches_defects() {
             2.0 * dist * (shifted.camera.vfov_degrees.to_radians() * 0.5).tan() / o.height as f32;
         shifted.camera.position += u * pixel;
         shifted.camera.look_at += u * pixel;
-        let f = score(name, &render_seed(&gpu, &shifted, TEST_SEED), &r);
+        let f = score(
+            &format!("{name}.shifted"),
+            &render_seed(&gpu, &shifted, TEST_SEED),
+            &r,
+        );
         eprintln!(
             "{name}: shifted camera fails {:.3}% (tolerance {:.3}%)",
             100.0 * f,

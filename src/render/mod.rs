@@ -110,12 +110,23 @@ pub struct SnapshotRecord {
 /// What a render leaves behind.
 pub struct RenderOutput {
     pub image: Image,
+    /// The GPU state behind the image, for tests and the software reference.
+    pub state: RenderState,
     pub timings: Timings,
     pub passes: usize,
     pub photons: Option<crate::photon::TraceReport>,
     pub estimate: Option<EstimateStats>,
     pub snapshots: Vec<SnapshotRecord>,
     pub explain: Vec<ExplainLine>,
+}
+
+/// The GPU resources of a finished render.
+pub struct RenderState {
+    pub textures: SceneTextures,
+    /// Direct light and each eye path's first diffuse hit.
+    pub direct: DirectLight,
+    pub map: Option<PhotonMap>,
+    pub estimate: Option<RadianceEstimate>,
 }
 
 /// Something that wants to hear about progress: (stage, done, total).
@@ -260,8 +271,15 @@ pub fn render(
         });
         let image = direct.read_radiance();
         timings.wall_seconds = wall.elapsed().as_secs_f64();
+        let state = RenderState {
+            textures,
+            direct,
+            map: None,
+            estimate: None,
+        };
         return Ok(RenderOutput {
             image,
+            state,
             timings,
             passes: done,
             photons: None,
@@ -425,8 +443,15 @@ pub fn render(
             .map_err(GpuError::Gl)?;
     }
     timings.wall_seconds = wall.elapsed().as_secs_f64();
+    let state = RenderState {
+        textures,
+        direct,
+        map: Some(map),
+        estimate: Some(estimate),
+    };
     Ok(RenderOutput {
         image,
+        state,
         timings,
         passes: done,
         photons: Some(report),

@@ -1,0 +1,304 @@
+//! The kNN-grid radiance estimate on the GPU against its CPU twin, against
+//! brute force, across drawing modes, and against an analytic irradiance.
+
+mod common;
+
+use glam::Vec3;
+use photonmap::photon::{BuildMethod, Grid, PhotonFrames, PhotonMap};
+use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
+use photonmap::render::{render, EstimateMode, GlobalIllumination, RenderOptions, RenderOutput};
+use photonmap::scene::Scene;
+
+fn render_gi(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    build: BuildMethod,
+    mode: EstimateMode,
+) -> RenderOutput {
+    let gpu = common::gpu();
+    let mut o = RenderOptions::for_scene(scene);
+    (o.width, o.height, o.seed) = (width, height, 3);
+    let mut gi = GlobalIllumination {
+        build,
+        ..GlobalIllumination::default()
+    };
+    gi.estimate.mode = mode;
+    gi.estimate.budget = 48;
+    o.global = Some(gi);
+    render(&gpu, scene, &o, &|_, _, _| {}).unwrap()
+}
+
+/// Per query pixel: (position, GPU flux, GPU r^2, GPU accepted).
+fn gpu_results(out: &RenderOutput) -> Vec<(usize, Vec3, Vec3, f32, u32)> {
+    let est = out.state.estimate.as_ref().unwrap();
+    let flux = est.flux.read_f32();
+    let cursor = est.cursor.read_i32();
+    let done = est.done.read_i32();
+    let pos = out.state.direct.diffuse_position.read_f32();
+    let mut v = Vec::new();
+    for i in 0..pos.len() / 4 {
+        if pos[4 * i + 3] > 0.0 {
+            assert_eq!(done[4 * i], 1, "pixel {i} never finished");
+            v.push((
+                i,
+                Vec3::from_slice(&pos[4 * i..]),
+                Vec3::from_slice(&flux[4 * i..]),
+                flux[4 * i + 3],
+                cursor[4 * i] as u32,
+            ));
+        }
+    }
+    v
+}
+
+#[test]
+fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
+    for (name, w, h) in [
+        ("glass_ball", 64, 48),
+        ("cornell_box", 48, 48),
+        ("ring", 64, 48),
+    ] {
+        let scene = common::paper_scene(name);
+        for build in [BuildMethod::Bitonic, BuildMethod::Stencil] {
+            let out = render_gi(&scene, w, h, build, EstimateMode::Tiled { tile: 16 });
+            let cpu_map = CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap());
+            let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
+            let results = gpu_results(&out);
+            assert!(
+                results.len() > (w * h / 3) as usize,
+                "{name}: only {} query pixels",
+                results.len()
+            );
+            let mut mismatched = 0;
+            for (i, x, flux, r2, accepted) in &results {
+                let cpu = knn_grid(&cpu_map, *x, k, max_r);
+                let same = cpu.accepted == *accepted
+                    && (cpu.radius2 - r2).abs() <= 1e-5 * r2.max(1e-12)
+                    && (cpu.flux - *flux).abs().max_element()
+                        <= 1e-4 * cpu.flux.max_element().max(1e-20);
+                if !same {
+                    mismatched += 1;
+                    if mismatched < 4 {
+                        eprintln!(
+                            "{name} {build:?} pixel {i}: GPU {accepted} {r2} {flux}, CPU {} {} {}",
+                            cpu.accepted, cpu.radius2, cpu.flux
+                        );
+                    }
+                }
+            }
+            eprintln!(
+                "{name} {build:?}: {} query pixels, {mismatched} differ from the CPU kNN-grid",
+                results.len()
+            );
+            // A photon exactly at the radius can fall either side of f32 rounding.
+            assert!(
+                mismatched * 1000 <= results.len(),
+                "{name} {build:?}: {mismatched} pixels differ"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_knn_grid_holds_the_true_k_nearest() {
+    let scene = common::paper_scene("cornell_box");
+    let out = render_gi(
+        &scene,
+        32,
+        32,
+        BuildMethod::Bitonic,
+        EstimateMode::FullScreen,
+    );
+    let cpu_map = CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap());
+    let photons: Vec<(Vec3, Vec3)> = cpu_map.photons().copied().collect();
+    let (k, max_r) = (scene.photon_map.k as usize, scene.photon_map.max_radius);
+    let mut checked = 0;
+    let results = gpu_results(&out);
+    assert!(results.len() > 800, "{} query pixels", results.len());
+    for (i, x, _flux, r2, accepted) in results {
+        let mut d2: Vec<f32> = photons
+            .iter()
+            .map(|(p, _)| (*p - x).length_squared())
+            .filter(|d| *d <= max_r * max_r)
+            .collect();
+        d2.sort_by(f32::total_cmp);
+        if d2.len() >= k {
+            // At least k found, the radius reaches the true k-th nearest ...
+            assert!(
+                accepted as usize >= k,
+                "pixel {i}: {accepted} accepted of {} in range",
+                d2.len()
+            );
+            assert!(
+                r2 >= d2[k - 1],
+                "pixel {i}: radius^2 {r2} < k-th nearest {}",
+                d2[k - 1]
+            );
+            // ... and every photon inside the radius is in the estimate (a photon
+            // exactly at the radius may round either way in GLSL and in Rust).
+            let inside_surely = d2.iter().filter(|&&d| d <= r2 * (1.0 - 1e-6)).count();
+            let inside_maybe = d2.iter().filter(|&&d| d <= r2 * (1.0 + 1e-6)).count();
+            assert!(
+                (inside_surely..=inside_maybe).contains(&(accepted as usize)),
+                "pixel {i}: {inside_surely}..={inside_maybe} photons within the radius, {accepted} accepted"
+            );
+            checked += 1;
+        } else {
+            assert_eq!(
+                accepted as usize,
+                d2.len(),
+                "pixel {i}: fewer than k in range, all must be taken"
+            );
+        }
+    }
+    // With k = 500 and radius 0.2 only some pixels have k photons in range; the
+    // rest checked that every photon in range was taken.
+    assert!(checked > 50, "only {checked} pixels had k photons in range");
+}
+
+#[test]
+fn tiled_full_screen_and_masked_runs_give_identical_images() {
+    let scene = common::paper_scene("glass_ball");
+    let tiled = render_gi(
+        &scene,
+        96,
+        72,
+        BuildMethod::Bitonic,
+        EstimateMode::Tiled { tile: 16 },
+    );
+    let tiled8 = render_gi(
+        &scene,
+        96,
+        72,
+        BuildMethod::Bitonic,
+        EstimateMode::Tiled { tile: 8 },
+    );
+    let full = render_gi(
+        &scene,
+        96,
+        72,
+        BuildMethod::Bitonic,
+        EstimateMode::FullScreen,
+    );
+    let masked = render_gi(
+        &scene,
+        96,
+        72,
+        BuildMethod::Bitonic,
+        EstimateMode::Masked { every: 2 },
+    );
+    assert_eq!(tiled.image, full.image, "tiled vs full screen");
+    assert_eq!(tiled8.image, full.image, "8 x 8 tiles vs full screen");
+    assert_eq!(masked.image, full.image, "masked vs full screen");
+    let e = tiled.estimate.unwrap();
+    assert!(
+        e.tile_draws < e.tiles * e.passes as u64,
+        "no tile ever stopped early: {e:?}"
+    );
+}
+
+#[test]
+fn a_uniform_photon_plane_gives_the_analytic_irradiance() {
+    // 40,000 photons of equal power spread uniformly over the 2 x 2 floor: the
+    // irradiance is total power / 4 everywhere, and the radiance albedo/pi of it.
+    let text = r#"
+[camera]
+position = [0.0, 3.0, 0.0001]
+look_at = [0.0, 0.0, 0.0]
+vfov = 20.0
+width = 48
+height = 48
+[photon_map]
+photons_stored = 40000
+grid_resolution = [40, 1, 40]
+grid_min = [-1.0, -0.01, -1.0]
+grid_max = [1.0, 0.01, 1.0]
+k = 50
+max_radius = 0.2
+[materials]
+floor = { type = "diffuse", albedo = [0.6, 0.6, 0.6] }
+[[shape]]
+type = "parallelogram"
+corner = [-1.0, 0.0, -1.0]
+edge1 = [0.0, 0.0, 2.0]
+edge2 = [2.0, 0.0, 0.0]
+material = "floor"
+[[light]]
+type = "point"
+position = [0.0, 5.0, 0.0]
+intensity = [0.0, 0.0, 0.0]
+"#;
+    let scene = photonmap::scene::load_scene_str(text, std::path::Path::new("plane.toml")).unwrap();
+    let gpu = common::gpu();
+    let o = RenderOptions::for_scene(&scene).direct_only();
+    let out = render(&gpu, &scene, &o, &|_, _, _| {}).unwrap();
+    let n = 40_000usize;
+    let total_power = 8.0f32;
+    let mut state = 12345u32;
+    let mut next = || photonmap::reference::random::rng_next(&mut state);
+    let width = 256u32;
+    let frame_height = (n as u32).div_ceil(width);
+    let texels = (width * frame_height) as usize;
+    let (mut pos, mut pow, inc) = (
+        vec![0f32; texels * 4],
+        vec![0f32; texels * 4],
+        vec![0f32; texels * 4],
+    );
+    for i in 0..n {
+        pos[4 * i..4 * i + 4].copy_from_slice(&[next() * 2.0 - 1.0, 0.0, next() * 2.0 - 1.0, 0.0]);
+        let p = total_power / n as f32;
+        pow[4 * i..4 * i + 4].copy_from_slice(&[p, p, p, 1.0]);
+    }
+    let frames =
+        PhotonFrames::from_records(&gpu, width, frame_height, 1, &pos, &pow, &inc, n as u32)
+            .unwrap();
+    let grid = Grid::for_scene(&scene);
+    let map = PhotonMap::Sorted(
+        photonmap::photon::BitonicBuild::new(&gpu)
+            .unwrap()
+            .build(&frames, &grid, &mut Default::default())
+            .unwrap(),
+    );
+    let est = photonmap::render::RadianceEstimate::new(&gpu, 48, 48).unwrap();
+    let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
+    est.run(
+        &map,
+        &out.state.direct,
+        k,
+        max_r,
+        &Default::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    let img = est.compose(
+        &out.state.textures,
+        &out.state.direct,
+        k,
+        max_r,
+        false,
+        true,
+    );
+    // Pixels seeing the middle of the floor (the estimate's disc stays on it).
+    let mut sum = 0f64;
+    let mut count = 0;
+    for y in 12..36 {
+        for x in 12..36 {
+            sum += img.get(x, y)[0] as f64;
+            count += 1;
+        }
+    }
+    let mean = sum / count as f64;
+    let irradiance = total_power as f64 / 4.0;
+    // A k-nearest estimate is biased up by about k / (k - 1) (here accepted >= k).
+    let expected = 0.6 / std::f64::consts::PI * irradiance * k as f64 / (k as f64 - 1.0);
+    // Discs of radius sqrt(k / (pi density)) ~ 0.04 overlap little over the
+    // 1.1 x 1.1 middle: ~ 200 independent estimates of relative error 1/sqrt(k).
+    let independent = 1.1 * 1.1 / (std::f64::consts::PI * k as f64 / (n as f64 / 4.0));
+    let sigma = expected / (k as f64).sqrt() / independent.sqrt();
+    eprintln!("mean radiance {mean:.5}, expected {expected:.5}, sigma {sigma:.5}");
+    assert!(
+        (mean - expected).abs() < 4.0 * sigma + expected / k as f64,
+        "mean {mean} vs {expected}"
+    );
+}
