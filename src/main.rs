@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 
 use photonmap::gpu::{EglPlatform, Gpu};
 use photonmap::photon::{BuildMethod, VertexFeed};
+use photonmap::reference::knn::{software_image, SoftwareEstimate};
 use photonmap::render::{
     self, EstimateMode, EstimateOptions, GlobalIllumination, RenderOptions, SnapshotEvery,
     Snapshots,
@@ -90,6 +91,13 @@ enum Command {
         /// List every pass that runs and every pass skipped, with why.
         #[arg(long)]
         explain: bool,
+        /// Also write the software reference (the paper's figure 7c: the same eye
+        /// paths and photons, the estimate on the CPU) to this PNG.
+        #[arg(long, value_name = "PNG")]
+        reference_software: Option<PathBuf>,
+        /// The software reference's estimate: Jensen's kd-tree or the CPU kNN-grid.
+        #[arg(long, value_enum, default_value_t = SoftwareEstimate::KdTree)]
+        reference_estimate: SoftwareEstimate,
     },
     /// Trace a scene's photons and build its photon map; report counts, passes and times.
     Photons {
@@ -279,7 +287,15 @@ fn run(cli: Cli) -> Result<()> {
             snapshots,
             every,
             explain,
+            reference_software,
+            reference_estimate,
         } => {
+            if let Some(p) = &reference_software {
+                check_output(p, "png", "--reference-software")?;
+                if direct_only {
+                    bail!("--reference-software needs photons: drop --direct-only");
+                }
+            }
             check_output(&output, "png", "-o")?;
             if let Some(e) = &exr {
                 check_output(e, "exr", "--exr")?;
@@ -368,6 +384,20 @@ fn run(cli: Cli) -> Result<()> {
             }
             if json {
                 println!("{}", serde_json::to_string_pretty(&out.timings)?);
+            }
+            if let Some(path) = &reference_software {
+                let wall = std::time::Instant::now();
+                let img = software_image(&out.state, &scene, reference_estimate)
+                    .ok_or_else(|| anyhow::anyhow!("no photon map to estimate from"))?;
+                let png = img.png_bytes().map_err(anyhow::Error::msg)?;
+                render::image::write_atomically(path, &png).map_err(anyhow::Error::msg)?;
+                if !quiet {
+                    eprintln!(
+                        "software reference ({reference_estimate:?}) in {:.2} s: wrote {}",
+                        wall.elapsed().as_secs_f64(),
+                        path.display()
+                    );
+                }
             }
             if explain {
                 for l in &out.explain {

@@ -255,3 +255,56 @@ fn bench_build_prints_json_rows() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("allowed range"));
 }
+
+#[test]
+fn snapshots_record_the_running_estimate_and_end_with_the_final_image() {
+    let d = tmp("snapshots");
+    let snaps = d.join("snaps");
+    std::fs::create_dir_all(&snaps).unwrap();
+    let png = d.join("final.png");
+    let out = photonmap()
+        .args([
+            "render", "--quiet", "--width", "64", "--height", "48", "--budget", "16", "--every",
+            "3",
+        ])
+        .arg(scene("glass_ball"))
+        .arg("-o")
+        .arg(&png)
+        .arg("--snapshots")
+        .arg(&snaps)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(snaps.join("snapshots.json")).unwrap()).unwrap();
+    let list = index.as_array().unwrap();
+    assert!(list.len() >= 3, "{index}");
+    let passes: Vec<u64> = list.iter().map(|s| s["pass"].as_u64().unwrap()).collect();
+    assert!(passes.windows(2).all(|w| w[1] > w[0]), "{passes:?}");
+    for s in list {
+        assert!(snaps.join(s["file"].as_str().unwrap()).is_file());
+    }
+    assert_eq!(list.last().unwrap()["searching_pixels"], 0);
+    let last = std::fs::read(snaps.join(list.last().unwrap()["file"].as_str().unwrap())).unwrap();
+    assert_eq!(
+        last,
+        std::fs::read(&png).unwrap(),
+        "the last snapshot is the final image"
+    );
+    let first = std::fs::read(snaps.join(list[0]["file"].as_str().unwrap())).unwrap();
+    assert_ne!(first, last, "the running estimate changes");
+    let bad = photonmap()
+        .args(["render", "--every", "0"])
+        .arg(scene("ring"))
+        .arg("-o")
+        .arg(d.join("x.png"))
+        .arg("--snapshots")
+        .arg(&snaps)
+        .output()
+        .unwrap();
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--every"));
+}

@@ -214,13 +214,10 @@ impl KdTree {
                     axis as u8
                 },
             ));
-            // Children follow in pre-order; each subtree records its size implicitly.
-            let here = nodes.len() - 1;
-            let _ = here;
+            // Pre-order: the left subtree (len / 2 nodes) follows, then the right.
             build(left, nodes);
             build(right, nodes);
         }
-        // Pre-order layout needs subtree sizes to find the right child: keep them.
         build(&mut items, &mut nodes);
         Self { nodes }
     }
@@ -337,4 +334,63 @@ mod tests {
             }
         }
     }
+}
+
+/// Which CPU estimate the software reference uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SoftwareEstimate {
+    /// Jensen's balanced kd-tree, exactly the k nearest (figure 7c).
+    KdTree,
+    /// The kNN-grid on the CPU with the GPU's acceptance rules.
+    KnnGrid,
+}
+
+/// The paper's software column: the same eye paths (the GPU's first diffuse
+/// hits and direct light) and the same photons, with the radiance estimate
+/// computed on the CPU. Uses two threads of rows.
+pub fn software_image(
+    state: &crate::render::RenderState,
+    scene: &crate::scene::Scene,
+    estimate: SoftwareEstimate,
+) -> Option<crate::render::Image> {
+    let map = CpuPhotonMap::from_gpu(state.map.as_ref()?);
+    let (w, h) = (state.direct.radiance.width, state.direct.radiance.height);
+    let direct = state.direct.radiance.read_f32();
+    let pos = state.direct.diffuse_position.read_f32();
+    let normal = state.direct.diffuse_normal.read_f32();
+    let through = state.direct.diffuse_throughput.read_f32();
+    let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
+    let photons: Vec<(Vec3, Vec3)> = map.photons().copied().collect();
+    let tree = KdTree::new(&photons);
+    let mut rgba = vec![0f32; (w * h * 4) as usize];
+    let shade = |i: usize| -> [f32; 3] {
+        let mut l = Vec3::from_slice(&direct[4 * i..4 * i + 3]);
+        let mat = normal[4 * i + 3] as i32 - 1;
+        if pos[4 * i + 3] > 0.0 && mat >= 0 {
+            if let crate::scene::Material::Diffuse { albedo } = scene.materials[mat as usize] {
+                let x = Vec3::from_slice(&pos[4 * i..4 * i + 3]);
+                let r = match estimate {
+                    SoftwareEstimate::KdTree => tree.k_nearest(x, k as usize, max_r),
+                    SoftwareEstimate::KnnGrid => knn_grid(&map, x, k, max_r),
+                };
+                let e = r.irradiance(k, max_r);
+                l += Vec3::from_slice(&through[4 * i..4 * i + 3]) * albedo / std::f32::consts::PI
+                    * e;
+            }
+        }
+        l.to_array()
+    };
+    let half = (w * h / 2) as usize;
+    let (a, b) = rgba.split_at_mut(half * 4);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            for (j, px) in a.chunks_mut(4).enumerate() {
+                px[..3].copy_from_slice(&shade(j));
+            }
+        });
+        for (j, px) in b.chunks_mut(4).enumerate() {
+            px[..3].copy_from_slice(&shade(half + j));
+        }
+    });
+    Some(crate::render::Image::from_gl_rgba(w, h, &rgba))
 }
