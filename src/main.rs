@@ -135,6 +135,16 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// Whether the stencil test skips fragment work on this driver (the
+    /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
+    Mask {
+        #[arg(long, default_value_t = 512)]
+        size: u32,
+        #[arg(long, default_value_t = 200)]
+        iterations: i32,
+        #[arg(long)]
+        json: bool,
+    },
     /// Photon-map builds for n = 2^min .. 2^max synthetic photons: bitonic passes,
     /// time per pass against a copy pass, binary search, stencil routing with and
     /// without read-back.
@@ -234,6 +244,43 @@ fn run(cli: Cli) -> Result<()> {
                 println!("{}", serde_json::to_string_pretty(&bench)?);
             } else {
                 cli::bench::print_build_bench(&bench);
+            }
+            Ok(())
+        }
+        Command::Bench {
+            which:
+                BenchCommand::Mask {
+                    size,
+                    iterations,
+                    json,
+                },
+        } => {
+            if !(16..=8192).contains(&size) || !(1..=100_000).contains(&iterations) {
+                bail!("--size {size} --iterations {iterations}: the allowed ranges are 16..=8192 and 1..=100000");
+            }
+            let gpu = Gpu::new(cli.egl)?;
+            let rows = photonmap::photon::bench::bench_mask(&gpu, size, iterations)?;
+            if json {
+                let caps = gpu.capabilities();
+                println!(
+                    "{}",
+                    serde_json::json!({ "renderer": caps.gl_renderer, "size": size, "iterations": iterations, "rows": rows })
+                );
+            } else {
+                println!(
+                    "{:>8} {:>11} {:>8} {:>10} {:>9}",
+                    "masked", "where", "stencil", "wall ms", "relative"
+                );
+                for r in &rows {
+                    let place = if r.contiguous { "contiguous" } else { "spread" };
+                    println!(
+                        "{:>7.0}% {place:>11} {:>8} {:>10.2} {:>9.3}",
+                        r.masked_fraction * 100.0,
+                        r.stencil_test,
+                        r.wall_seconds * 1e3,
+                        r.relative
+                    );
+                }
             }
             Ok(())
         }

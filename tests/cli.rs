@@ -308,3 +308,30 @@ fn snapshots_record_the_running_estimate_and_end_with_the_final_image() {
         .unwrap();
     assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--every"));
 }
+
+#[test]
+fn bench_mask_reports_each_masking() {
+    let out = photonmap()
+        .args([
+            "bench",
+            "mask",
+            "--json",
+            "--size",
+            "64",
+            "--iterations",
+            "5",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 6);
+    assert!(rows
+        .iter()
+        .all(|r| r["wall_seconds"].as_f64().unwrap() > 0.0));
+}
