@@ -120,6 +120,25 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Reproduce the paper's tables and figures into results/<renderer>/ (or --out).
+    Tables {
+        /// Output folder (default: results/<renderer>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// A reduced run for CI: quarter resolution, one run, fewer sizes and modes.
+        #[arg(long)]
+        quick: bool,
+        /// The paper's 2003 constraints (random-number texture, read-back, no compaction).
+        #[arg(long)]
+        faithful: bool,
+        /// Runs per Table 1 cell (median and spread quoted).
+        #[arg(long, default_value_t = 3)]
+        runs: u32,
+        #[arg(long)]
+        json: bool,
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Benchmarks (commands, not tests): `bench build`.
     Bench {
         #[command(subcommand)]
@@ -281,6 +300,35 @@ fn run(cli: Cli) -> Result<()> {
                         r.relative
                     );
                 }
+            }
+            Ok(())
+        }
+        Command::Tables {
+            out,
+            quick,
+            faithful,
+            runs,
+            json,
+            quiet,
+        } => {
+            let gpu = Gpu::new(cli.egl)?;
+            let options = cli::tables::TablesOptions {
+                out,
+                quick,
+                faithful,
+                runs,
+            };
+            let progress = |msg: &str| {
+                if !quiet {
+                    eprintln!("{msg}");
+                }
+            };
+            let (report, dir) = cli::tables::run_tables(&gpu, &options, &progress)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                print!("{}", cli::tables::markdown(&report));
+                eprintln!("wrote {}", dir.display());
             }
             Ok(())
         }

@@ -168,6 +168,11 @@ fn stored_flux_on_a_plane_matches_the_solid_angle() {
         "{report:?}"
     );
     assert_eq!(frames.stored(), report.stored);
+    // The GPU count pass equals the read-back count, photon by photon.
+    assert_eq!(
+        tracer.stored_per_photon(&frames).unwrap(),
+        frames.stored_per_photon()
+    );
     let per_frame = (frames.width * frames.frame_height) as usize;
     let flux: f64 = records(&frames)
         .iter()

@@ -1,3 +1,4 @@
 //! The command line's subcommands beyond `render` and `info`.
 pub mod bench;
 pub mod photons;
+pub mod tables;

@@ -21,6 +21,13 @@ fn source_of(name: &str) -> Option<&'static str> {
         .map(|(_, s)| *s)
 }
 
+/// The source a driver receives for `name` (includes resolved, `defines`
+/// after #version), for offline compilers; None if a file is missing.
+pub fn preprocessed_source(name: &str, defines: &[(&str, String)]) -> Option<String> {
+    let lookup = |n: &str| source_of(n).map(str::to_string);
+    preprocess(&lookup, name, defines).ok().map(|p| p.text)
+}
+
 /// A shader that did not compile or link, located in its glsl/ file.
 #[derive(Debug, thiserror::Error)]
 #[error("glsl/{file}:{line}: {message}\n--- driver log ---\n{log}")]

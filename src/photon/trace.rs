@@ -36,8 +36,8 @@ impl PhotonFrames {
         self.width * self.frame_height * self.frames
     }
 
-    /// Stored records per photon index (read back; used to choose how many
-    /// emitted photons to keep, never to move photons).
+    /// Stored records per photon index, from a read-back of every frame's power
+    /// (the CPU twin of `PhotonTracer::stored_per_photon`).
     pub fn stored_per_photon(&self) -> Vec<u32> {
         let power = self.power.read_f32();
         let per_frame = (self.width * self.frame_height) as usize;
@@ -105,6 +105,7 @@ pub struct PhotonTracer {
     gpu: Gpu,
     emit: Program,
     bounce: Program,
+    count: Program,
     random: RandomSource,
 }
 
@@ -125,6 +126,7 @@ impl PhotonTracer {
             gpu: gpu.clone(),
             emit: Program::fullscreen_with(gpu, "photon/emit.frag", &defines)?,
             bounce: Program::fullscreen_with(gpu, "photon/trace.frag", &defines)?,
+            count: Program::fullscreen(gpu, "photon/stored_count.frag")?,
             random,
         })
     }
@@ -174,8 +176,8 @@ impl PhotonTracer {
         let height = frame_height * frames;
         let t = || Texture::new(&self.gpu, width, height, TexFormat::Rgba32F);
         let (position, power, incoming, outgoing) = (t()?, t()?, t()?, t()?);
+        // No clear: emission and every bounce write each texel of their frame.
         let target = Target::new(&self.gpu, &[&position, &power, &incoming, &outgoing])?;
-        target.clear([0.0; 4]);
         let (w, fh) = (width as i32, frame_height as i32);
         let query = crate::gpu::TimerQuery::new(&self.gpu)?;
         let random = match self.random {
@@ -233,6 +235,30 @@ impl PhotonTracer {
         })
     }
 
+    /// Stored records per photon index, counted on the GPU (one float per
+    /// photon read back, not the power texture of every frame).
+    pub fn stored_per_photon(&self, frames: &PhotonFrames) -> Result<Vec<u32>, GpuError> {
+        let counts = Texture::new(
+            &self.gpu,
+            frames.width,
+            frames.frame_height,
+            TexFormat::R32F,
+        )?;
+        let target = Target::new(&self.gpu, &[&counts])?;
+        self.count
+            .bind()
+            .texture("u_power", &frames.power)
+            .int("u_frame_height", frames.frame_height as i32)
+            .int("u_frames", frames.frames as i32);
+        self.gpu.draw_fullscreen(&target);
+        Ok(counts
+            .read_f32()
+            .into_iter()
+            .take(frames.emitted as usize)
+            .map(|c| c as u32)
+            .collect())
+    }
+
     /// Traces until the map can hold exactly `photons_stored` photons: trace N,
     /// count the stored records of each photon (in index order), and if they
     /// fall short, trace again with N scaled by target / stored (x 1.1 + 64).
@@ -260,7 +286,7 @@ impl PhotonTracer {
             let mut frames = self.trace(scene, textures, seed, emitted)?;
             attempts.push(emitted);
             all_seconds += frames.gpu_seconds;
-            let counts = frames.stored_per_photon();
+            let counts = self.stored_per_photon(&frames)?;
             let total: u64 = counts.iter().map(|&c| c as u64).sum();
             if total >= target as u64 {
                 let mut sum = 0u32;
