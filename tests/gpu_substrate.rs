@@ -197,7 +197,17 @@ fn every_glsl_file_compiles() {
             "photon/route.frag" | "photon/count.frag" => {
                 vec![vec![], vec![("READBACK", "1".into())]]
             }
-            "render/knn_search.frag" => vec![vec![], vec![("ROUTED", "1".into())]],
+            "render/knn_search.frag" => vec![
+                vec![],
+                vec![("ROUTED", "1".into())],
+                vec![("FLOAT_ADDRESSING", "1".into())],
+            ],
+            "photon/bitonic.frag"
+            | "photon/keys.frag"
+            | "photon/binary_search.frag"
+            | "photon/gather.frag" => {
+                vec![vec![], vec![("FLOAT_ADDRESSING", "1".into())]]
+            }
             "photon/emit.frag" | "photon/trace.frag" => {
                 vec![vec![], vec![("RANDOM_TEXTURE", "1".into())]]
             }

@@ -452,3 +452,32 @@ fn compaction_gives_the_same_map_as_sorting_every_record() {
         compacted.pairs.width * compacted.pairs.height < full.pairs.width * full.pairs.height / 4
     );
 }
+
+#[test]
+fn float_addressing_refuses_sorts_past_2_pow_24() {
+    let gpu = common::gpu();
+    let build = BitonicBuild::with_addressing(&gpu, true).unwrap();
+    // 2^25 pairs: float indices would no longer be exact.
+    let big = Texture::new(&gpu, 8192, 4096, TexFormat::Rg32I).unwrap();
+    let err = build.sort(big).err().expect("must refuse").to_string();
+    assert!(err.contains("2^24") && err.contains("--faithful"), "{err}");
+    // Below the limit it sorts like the integer version.
+    let keys: Vec<i32> = (0..4096).map(|i| i * 7919 % 1000).collect();
+    let (w, h) = sort_texture_size(keys.len() as u64);
+    let data: Vec<i32> = keys
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &k)| [k, i as i32])
+        .collect();
+    let (sorted, _) = build
+        .sort(Texture::from_i32_format(&gpu, w, h, TexFormat::Rg32I, &data).unwrap())
+        .unwrap();
+    let got: Vec<(i32, i32)> = sorted.read_i32().chunks(2).map(|c| (c[0], c[1])).collect();
+    let mut cpu: Vec<(i32, i32)> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| (k, i as i32))
+        .collect();
+    cpu.sort();
+    assert_eq!(got, cpu);
+}

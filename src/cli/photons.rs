@@ -65,8 +65,7 @@ pub fn trace_and_build(gpu: &Gpu, scene: &Scene, o: &PhotonOptions) -> Result<Ph
     };
     let (in_map, in_grid, per_cell, over, block) = match o.build {
         BuildMethod::Bitonic => {
-            let mut bitonic = BitonicBuild::new(gpu)?;
-            bitonic.compact = !o.faithful;
+            let bitonic = BitonicBuild::with_addressing(gpu, o.faithful)?;
             let map = bitonic.build(&frames, &grid, &mut timings)?;
             let first: Vec<i32> = map.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
             let cells = grid.cell_count() as usize;

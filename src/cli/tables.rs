@@ -350,7 +350,15 @@ fn spirv_counts(
 
 fn table2() -> Result<Vec<KernelCount>, String> {
     let routed = vec![("ROUTED", "1".to_string())];
-    let kernels: [(&str, Option<&str>, &str, Vec<(&str, String)>, [usize; 4]); 5] = [
+    // (name, vertex program, fragment program, defines, the paper's counts)
+    type Kernel<'a> = (
+        &'a str,
+        Option<&'a str>,
+        &'a str,
+        Vec<(&'a str, String)>,
+        [usize; 4],
+    );
+    let kernels: [Kernel; 5] = [
         (
             "Bitonic Sort",
             None,

@@ -8,6 +8,9 @@ use crate::render::Timings;
 
 use super::{Grid, PhotonFrames};
 
+/// Float addresses are exact below 2^24 (the float mantissa).
+pub const FLOAT_ADDRESS_LIMIT: u64 = 1 << 24;
+
 /// The key of records that are not in the map: they sort last.
 pub const INVALID_KEY: i32 = i32::MAX;
 
@@ -42,6 +45,8 @@ pub struct BitonicBuild {
     /// Compact stored records on the GPU before sorting (a HistoPyramid); off
     /// for the paper's way, sorting every record of every frame.
     pub compact: bool,
+    /// Float 1D -> 2D addressing (the paper's); exact below 2^24 only.
+    pub float_addressing: bool,
     pyramid_base: Program,
     pyramid_reduce: Program,
     compact_pass: Program,
@@ -53,16 +58,29 @@ pub struct BitonicBuild {
 
 impl BitonicBuild {
     pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
+        Self::with_addressing(gpu, false)
+    }
+
+    /// `float_addressing`: the paper's convert1dto2d in floats (`--faithful`),
+    /// which also sorts every record (no compaction).
+    pub fn with_addressing(gpu: &Gpu, float_addressing: bool) -> Result<Self, GpuError> {
+        let defines: Vec<(&str, String)> = if float_addressing {
+            vec![("FLOAT_ADDRESSING", "1".into())]
+        } else {
+            vec![]
+        };
+        let p = |name: &str| Program::fullscreen_with(gpu, name, &defines);
         Ok(Self {
             gpu: gpu.clone(),
-            compact: true,
-            pyramid_base: Program::fullscreen(gpu, "photon/pyramid_base.frag")?,
-            pyramid_reduce: Program::fullscreen(gpu, "photon/pyramid_reduce.frag")?,
-            compact_pass: Program::fullscreen(gpu, "photon/compact.frag")?,
-            keys: Program::fullscreen(gpu, "photon/keys.frag")?,
-            bitonic: Program::fullscreen(gpu, "photon/bitonic.frag")?,
-            search: Program::fullscreen(gpu, "photon/binary_search.frag")?,
-            gather: Program::fullscreen(gpu, "photon/gather.frag")?,
+            compact: !float_addressing,
+            float_addressing,
+            pyramid_base: p("photon/pyramid_base.frag")?,
+            pyramid_reduce: p("photon/pyramid_reduce.frag")?,
+            compact_pass: p("photon/compact.frag")?,
+            keys: p("photon/keys.frag")?,
+            bitonic: p("photon/bitonic.frag")?,
+            search: p("photon/binary_search.frag")?,
+            gather: p("photon/gather.frag")?,
         })
     }
 
@@ -75,6 +93,11 @@ impl BitonicBuild {
             n.is_power_of_two(),
             "bitonic sort needs a power-of-two texel count"
         );
+        if self.float_addressing && n > FLOAT_ADDRESS_LIMIT {
+            return Err(GpuError::Gl(format!(
+                "--faithful float addressing is exact only below 2^24 = {FLOAT_ADDRESS_LIMIT} texels; this sort has {n}: use fewer photons or drop --faithful"
+            )));
+        }
         // Ping-pong between the input and one more texture: read one, draw the other.
         let other = Texture::new(&self.gpu, w, h, pairs.format)?;
         let textures = [pairs, other];
@@ -98,7 +121,8 @@ impl BitonicBuild {
                 let mut b = self.bitonic.bind();
                 b.texture("u_pairs", &textures[current])
                     .ivec2("u_stage_xy", split(stage))
-                    .ivec2("u_distance_xy", split(distance));
+                    .ivec2("u_distance_xy", split(distance))
+                    .int("u_width", w as i32);
                 self.gpu.draw_fullscreen(&targets[1 - current]);
                 current = 1 - current;
                 passes += 1;

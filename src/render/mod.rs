@@ -331,8 +331,7 @@ pub fn render(
     let t0 = std::time::Instant::now();
     let map = match gi.build {
         BuildMethod::Bitonic => {
-            let mut bitonic = BitonicBuild::new(gpu)?;
-            bitonic.compact = !gi.faithful;
+            let bitonic = BitonicBuild::with_addressing(gpu, gi.faithful)?;
             PhotonMap::Sorted(bitonic.build(&frames, &grid, &mut build_timings)?)
         }
         BuildMethod::Stencil => PhotonMap::Routed(StencilRouting::new(gpu)?.build(
@@ -368,7 +367,11 @@ pub fn render(
     let mut snapshot_seconds = 0.0;
     let mut last_snapshot = (0u32, 0.0f64);
     let mut snapshot_error = None;
-    let stats = estimate.run(&map, &direct, k, max_radius, &gi.estimate, &mut |r| {
+    let estimate_options = EstimateOptions {
+        float_addressing: gi.faithful,
+        ..gi.estimate.clone()
+    };
+    let stats = estimate.run(&map, &direct, k, max_radius, &estimate_options, &mut |r| {
         progress(
             "radiance estimate",
             r.query_pixels - r.searching,

@@ -29,6 +29,8 @@ pub struct EstimateOptions {
     pub budget: u32,
     /// A safety bound on passes.
     pub max_passes: u32,
+    /// The paper's float convert1dto2d for photon addresses (`--faithful`).
+    pub float_addressing: bool,
 }
 
 impl Default for EstimateOptions {
@@ -37,6 +39,7 @@ impl Default for EstimateOptions {
             mode: EstimateMode::Tiled { tile: 16 },
             budget: 64,
             max_passes: 100_000,
+            float_addressing: false,
         }
     }
 }
@@ -81,12 +84,20 @@ pub struct RadianceEstimate {
 }
 
 /// The search program for a map kind and a way of drawing.
-fn search_program(gpu: &Gpu, routed: bool, tiles: bool) -> Result<Program, GpuError> {
-    let defines: Vec<(&str, String)> = if routed {
+fn search_program(
+    gpu: &Gpu,
+    routed: bool,
+    tiles: bool,
+    float_addressing: bool,
+) -> Result<Program, GpuError> {
+    let mut defines: Vec<(&str, String)> = if routed {
         vec![("ROUTED", "1".into())]
     } else {
         vec![]
     };
+    if float_addressing {
+        defines.push(("FLOAT_ADDRESSING", "1".into()));
+    }
     let vertex = if tiles {
         "render/tile.vert"
     } else {
@@ -134,7 +145,7 @@ impl RadianceEstimate {
         let wall = std::time::Instant::now();
         let routed = matches!(map, PhotonMap::Routed(_));
         let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
-        let search = search_program(&self.gpu, routed, tiled)?;
+        let search = search_program(&self.gpu, routed, tiled, options.float_addressing)?;
         let timer = TimerQuery::new(&self.gpu)?;
         let mut stats = EstimateStats::default();
 
