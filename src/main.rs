@@ -46,6 +46,10 @@ enum Command {
         /// Random seed: the same seed on the same driver gives the same image.
         #[arg(long, default_value_t = 1)]
         seed: u32,
+        /// Eye samples per pixel: 1 (the paper) through the pixel centre; more are
+        /// stratified, jittered and box-filtered, each with its own estimate (1..=1024).
+        #[arg(long, default_value_t = 1)]
+        spp: u32,
         /// Image width in pixels (default: the scene's).
         #[arg(long)]
         width: Option<u32>,
@@ -367,6 +371,7 @@ fn run(cli: Cli) -> Result<()> {
             output,
             exr,
             seed,
+            spp,
             width,
             height,
             quiet,
@@ -405,6 +410,9 @@ fn run(cli: Cli) -> Result<()> {
             if !(1..=16).contains(&stencil_m) {
                 bail!("--stencil-m {stencil_m}: the allowed range is 1..=16 (m^2 slots must fit 8 stencil bits)");
             }
+            if !(1..=1024).contains(&spp) {
+                bail!("--spp {spp}: the allowed range is 1..=1024");
+            }
             if !(1..=100_000).contains(&budget) {
                 bail!("--budget {budget}: the allowed range is 1..=100000");
             }
@@ -420,6 +428,7 @@ fn run(cli: Cli) -> Result<()> {
             let scene = load_scene(&scene)?;
             let mut options = RenderOptions::for_scene(&scene);
             options.seed = seed;
+            options.spp = spp;
             options.width = width.unwrap_or(options.width);
             options.height = height.unwrap_or(options.height);
             let mode = match (mask, tile) {

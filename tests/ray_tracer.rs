@@ -201,3 +201,36 @@ intensity = [8.0, 8.0, 8.0]
         "{centre} vs {expect}"
     );
 }
+
+#[test]
+fn samples_per_pixel_cut_noise_and_antialias_edges() {
+    let gpu = common::gpu();
+    let run = |scene: &Scene, spp: u32, seed: u32| {
+        let mut o = RenderOptions::for_scene(scene).direct_only();
+        (o.width, o.height, o.spp, o.seed) = (64, 48, spp, seed);
+        render(&gpu, scene, &o, &|_, _, _| {}).unwrap().image
+    };
+    // Seed-to-seed difference (soft shadows, the glass choice) falls roughly as 1/sqrt(spp).
+    let glass = common::paper_scene("glass_ball");
+    let d1 = common::rmse(&run(&glass, 1, 1), &run(&glass, 1, 2));
+    let d16 = common::rmse(&run(&glass, 16, 1), &run(&glass, 16, 2));
+    eprintln!("seed-to-seed RMSE: {d1:.5} at 1 spp, {d16:.5} at 16 spp");
+    assert!(d16 < d1 / 2.0, "16 spp: {d16}, 1 spp: {d1}");
+    // The light's edge: with one ray per pixel centre an emitter pixel is Le or
+    // not; with 16 jittered samples, border pixels take values in between.
+    let cornell = common::paper_scene("cornell_box");
+    let between = |img: &photonmap::render::Image| {
+        img.pixels
+            .iter()
+            .filter(|p| p[0] > 3.0 && p[0] < 22.0)
+            .count()
+    };
+    let (one, many) = (
+        between(&run(&cornell, 1, 1)),
+        between(&run(&cornell, 16, 1)),
+    );
+    assert!(
+        many > one + 4,
+        "pixels between ceiling and light: {one} at 1 spp, {many} at 16 spp"
+    );
+}

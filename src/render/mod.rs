@@ -29,6 +29,9 @@ pub struct RenderOptions {
     pub height: u32,
     /// Shadow samples per area light drawn in one pass (bounds work per pass).
     pub shadow_batch: u32,
+    /// Eye samples per pixel: 1 (the paper) shoots through the pixel centre;
+    /// more are stratified, jittered and box-filtered.
+    pub spp: u32,
     /// Photon map and radiance estimate; None draws direct light and specular paths only.
     pub global: Option<GlobalIllumination>,
 }
@@ -78,6 +81,7 @@ impl RenderOptions {
             width: scene.camera.width,
             height: scene.camera.height,
             shadow_batch: 8,
+            spp: 1,
             global: Some(GlobalIllumination::default()),
         }
     }
@@ -132,9 +136,102 @@ pub struct RenderState {
 /// Something that wants to hear about progress: (stage, done, total).
 pub type Progress<'a> = &'a dyn Fn(&str, u64, u64);
 
+/// The seed of eye sample `sample`: the render's own for sample 0 (so one
+/// sample per pixel is exactly the paper's render), a hash of it for the rest.
+pub fn sample_seed(seed: u32, sample: u32) -> u32 {
+    use crate::reference::random::pcg_hash;
+    if sample == 0 {
+        seed
+    } else {
+        pcg_hash(seed ^ pcg_hash(sample.wrapping_add(0x5bd1e995)))
+    }
+}
+
+/// The ray tracer's passes for one eye sample: eye rays, then per specular
+/// depth the closest hits, shadow rays and the specular continuation.
+#[allow(clippy::too_many_arguments)]
+fn trace_eye_paths(
+    gpu: &Gpu,
+    scene: &Scene,
+    textures: &SceneTextures,
+    tracer: &RayTracer,
+    direct: &DirectLight,
+    options: &RenderOptions,
+    sample: u32,
+    timings: &mut Timings,
+    progress: Progress<'_>,
+) -> Result<(), GpuError> {
+    let seed = sample_seed(options.seed, sample);
+    let depths = if scene.has_specular() {
+        scene.render.max_specular_depth + 1
+    } else {
+        1
+    };
+    let has_area = scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, crate::scene::Light::Area { .. }));
+    let direct_passes = if has_area {
+        scene
+            .render
+            .shadow_rays
+            .div_ceil(options.shadow_batch.max(1))
+    } else {
+        1
+    };
+    let total = (1 + depths as usize * (1 + direct_passes as usize) + (depths as usize - 1)) as u64;
+    let query = TimerQuery::new(gpu)?;
+    let mut done = 0u64;
+    // Each pass: GPU time by timer query, wall time with glFinish on both sides.
+    direct.clear();
+    gpu.finish();
+    let mut stage_wall = std::time::Instant::now();
+    let mut tick = |timings: &mut Timings, name: &str, q: &TimerQuery| {
+        gpu.finish();
+        timings.add_both(name, q.seconds(), stage_wall.elapsed().as_secs_f64(), 1);
+        stage_wall = std::time::Instant::now();
+        done += 1;
+        progress("ray tracing", done, total);
+    };
+    query.begin();
+    tracer.eye_rays(&scene.camera, options, sample, seed);
+    query.end();
+    tick(timings, "eye rays", &query);
+    for depth in 0..depths {
+        query.begin();
+        tracer.intersect(textures);
+        query.end();
+        tick(timings, "intersect", &query);
+        for b in 0..direct_passes {
+            let begin = b * options.shadow_batch;
+            let end = ((b + 1) * options.shadow_batch).min(scene.render.shadow_rays);
+            query.begin();
+            direct.shade(
+                textures,
+                &tracer.hits,
+                scene.render.shadow_rays,
+                begin..end,
+                depth,
+                seed,
+            );
+            query.end();
+            tick(timings, "shadow rays", &query);
+        }
+        if depth + 1 < depths {
+            query.begin();
+            tracer.specular(textures, depth, seed);
+            query.end();
+            tick(timings, "specular", &query);
+        }
+    }
+    gpu.check("ray tracing")
+}
+
 /// Renders a scene: the paper's ray tracer (direct light, specular paths) and,
 /// with `options.global`, photon tracing, the photon map and the kNN-grid
-/// radiance estimate at each eye path's first diffuse hit.
+/// radiance estimate at each eye path's first diffuse hit. With `spp` > 1 the
+/// photon map is built once and each eye sample (stratified, jittered) runs the
+/// ray tracer and the estimate; the image is their mean (a box filter).
 pub fn render(
     gpu: &Gpu,
     scene: &Scene,
@@ -148,317 +245,317 @@ pub fn render(
             options.width, options.height
         )));
     }
+    let spp = options.spp.max(1);
     let textures = SceneTextures::new(gpu, scene)?;
     let tracer = RayTracer::new(gpu, options.width, options.height)?;
     let direct = DirectLight::new(gpu, options.width, options.height)?;
-    let mut explain = Vec::new();
+    let mut timings = Timings::default();
+    let wall = std::time::Instant::now();
 
-    // With nothing specular, an eye path ends at its first hit.
     let specular = scene.has_specular();
     let depths = if specular {
         scene.render.max_specular_depth + 1
     } else {
         1
     };
-    let batches = scene
-        .render
-        .shadow_rays
-        .div_ceil(options.shadow_batch.max(1));
     let has_area = scene
         .lights
         .iter()
         .any(|l| matches!(l, crate::scene::Light::Area { .. }));
-    let direct_passes = if has_area { batches } else { 1 };
-    let total = 1 + depths as usize * (1 + direct_passes as usize) + (depths as usize - 1);
-    let mut done = 0;
-    let mut timings = Timings::default();
-    let wall = std::time::Instant::now();
-    let query = TimerQuery::new(gpu)?;
-
-    // Each pass: GPU time by timer query, wall time with glFinish on both sides.
-    direct.clear();
-    gpu.finish();
-    let mut stage_wall = std::time::Instant::now();
-    let mut tick = |timings: &mut Timings, name: &str, q: &TimerQuery| {
-        gpu.finish();
-        timings.add_both(name, q.seconds(), stage_wall.elapsed().as_secs_f64(), 1);
-        stage_wall = std::time::Instant::now();
-        done += 1;
-        progress("ray tracing", done as u64, total as u64);
-    };
-
-    query.begin();
-    tracer.eye_rays(&scene.camera, options);
-    query.end();
-    tick(&mut timings, "eye rays", &query);
-    for depth in 0..depths {
-        query.begin();
-        tracer.intersect(&textures);
-        query.end();
-        tick(&mut timings, "intersect", &query);
-        for b in 0..direct_passes {
-            let begin = b * options.shadow_batch;
-            let end = ((b + 1) * options.shadow_batch).min(scene.render.shadow_rays);
-            query.begin();
-            direct.shade(
-                &textures,
-                &tracer.hits,
-                scene.render.shadow_rays,
-                begin..end,
-                depth,
-                options.seed,
-            );
-            query.end();
-            tick(&mut timings, "shadow rays", &query);
-        }
-        if depth + 1 < depths {
-            query.begin();
-            tracer.specular(&textures, depth, options.seed);
-            query.end();
-            tick(&mut timings, "specular", &query);
-        }
-    }
-    gpu.check("ray tracing")?;
-    explain.push(ExplainLine {
-        stage: "eye rays".into(),
-        passes: 1,
-        ran: true,
-        why: "one ray per pixel centre".into(),
-    });
-    explain.push(ExplainLine {
-        stage: "intersect".into(),
-        passes: depths as usize,
-        ran: true,
-        why: if specular {
-            format!(
-                "one per specular depth 0..={}",
-                scene.render.max_specular_depth
-            )
-        } else {
-            "depth 0 only: the scene has no mirror or glass".into()
-        },
-    });
-    explain.push(ExplainLine {
-        stage: "shadow rays".into(),
-        passes: depths as usize * direct_passes as usize,
-        ran: true,
-        why: if has_area {
-            format!(
-                "{} samples per area light in batches of {} at each depth",
-                scene.render.shadow_rays, options.shadow_batch
-            )
-        } else {
-            "one ray per point light at each depth".into()
-        },
-    });
-    explain.push(ExplainLine {
-        stage: "specular".into(),
-        passes: depths as usize - 1,
-        ran: specular,
-        why: if specular {
-            "reflect or refract at mirror and glass hits".into()
-        } else {
-            "skipped: no specular surface".into()
-        },
-    });
-
-    let Some(gi) = &options.global else {
-        explain.push(ExplainLine {
-            stage: "photons, map, estimate".into(),
-            passes: 0,
-            ran: false,
-            why: "skipped: direct light only".into(),
-        });
-        let image = direct.read_radiance();
-        timings.wall_seconds = wall.elapsed().as_secs_f64();
-        let state = RenderState {
-            textures,
-            direct,
-            map: None,
-            estimate: None,
-        };
-        return Ok(RenderOutput {
-            image,
-            state,
-            timings,
-            passes: done,
-            photons: None,
-            estimate: None,
-            snapshots: vec![],
-            explain,
-        });
-    };
-
-    // Trace photons and build the map.
-    let random = if gi.faithful {
-        RandomSource::Texture
+    let direct_passes = if has_area {
+        scene
+            .render
+            .shadow_rays
+            .div_ceil(options.shadow_batch.max(1))
     } else {
-        RandomSource::Hash
+        1
     };
-    let photon_tracer = PhotonTracer::with_random(gpu, random)?;
-    progress("photons", 0, 1);
-    gpu.finish();
-    let t0 = std::time::Instant::now();
-    let (frames, report) = photon_tracer.trace_to_stored(scene, &textures, options.seed)?;
-    gpu.finish();
-    // Wall time covers every attempt at the stored count, and its read-backs.
-    timings.add_both(
-        "trace photons",
-        report.gpu_seconds,
-        t0.elapsed().as_secs_f64(),
-        frames.frames as usize,
-    );
-    explain.push(ExplainLine {
-        stage: "trace photons".into(),
-        passes: frames.frames as usize,
-        ran: true,
-        why: format!(
-            "emission + {} bounces; {} photons traced ({} attempts), the first {} kept: {} stored",
-            frames.frames - 1,
-            report.emitted,
-            report.attempts.len(),
-            report.photons_used,
-            report.stored
-        ),
-    });
-    let grid = Grid::for_scene(scene);
-    let mut build_timings = Timings::default();
-    let feed = if gi.faithful {
-        VertexFeed::Readback
-    } else {
-        gi.feed
-    };
-    let t0 = std::time::Instant::now();
-    let map = match gi.build {
-        BuildMethod::Bitonic => {
-            let bitonic = BitonicBuild::with_addressing(gpu, gi.faithful)?;
-            PhotonMap::Sorted(bitonic.build(&frames, &grid, &mut build_timings)?)
-        }
-        BuildMethod::Stencil => PhotonMap::Routed(StencilRouting::new(gpu)?.build(
-            &frames,
-            &grid,
-            gi.stencil_block,
-            feed,
-            &mut build_timings,
-        )?),
-    };
-    for s in &build_timings.stages {
-        explain.push(ExplainLine {
-            stage: format!("build map: {}", s.name),
-            passes: s.passes,
+    let mut explain = vec![
+        ExplainLine {
+            stage: "eye rays".into(),
+            passes: spp as usize,
             ran: true,
-            why: format!("{:?} build", gi.build),
-        });
-    }
-    gpu.finish();
-    let build_passes = build_timings.stages.iter().map(|s| s.passes).sum();
-    timings.add_both(
-        "build map",
-        build_timings.gpu_total(),
-        t0.elapsed().as_secs_f64(),
-        build_passes,
-    );
-    drop(frames);
+            why: if spp == 1 {
+                "one ray per pixel centre".into()
+            } else {
+                format!("{spp} stratified, jittered samples per pixel, one pass each")
+            },
+        },
+        ExplainLine {
+            stage: "intersect".into(),
+            passes: (depths * spp) as usize,
+            ran: true,
+            why: if specular {
+                format!(
+                    "one per specular depth 0..={} per sample",
+                    scene.render.max_specular_depth
+                )
+            } else {
+                "depth 0 only: the scene has no mirror or glass".into()
+            },
+        },
+        ExplainLine {
+            stage: "shadow rays".into(),
+            passes: (depths * direct_passes * spp) as usize,
+            ran: true,
+            why: if has_area {
+                format!(
+                    "{} samples per area light in batches of {} at each depth",
+                    scene.render.shadow_rays, options.shadow_batch
+                )
+            } else {
+                "one ray per point light at each depth".into()
+            },
+        },
+        ExplainLine {
+            stage: "specular".into(),
+            passes: ((depths - 1) * spp) as usize,
+            ran: specular,
+            why: if specular {
+                "reflect or refract at mirror and glass hits".into()
+            } else {
+                "skipped: no specular surface".into()
+            },
+        },
+    ];
 
-    // The radiance estimate, with snapshots of the running image.
-    let (k, max_radius) = (scene.photon_map.k, scene.photon_map.max_radius);
-    let estimate = RadianceEstimate::new(gpu, options.width, options.height)?;
-    let mut snapshots = Vec::new();
-    let mut snapshot_seconds = 0.0;
-    let mut last_snapshot = (0u32, 0.0f64);
-    let mut snapshot_error = None;
-    let estimate_options = EstimateOptions {
-        float_addressing: gi.faithful,
-        ..gi.estimate.clone()
+    // Photons first: one map serves every eye sample.
+    let mut photon_report = None;
+    let map = match &options.global {
+        None => {
+            explain.push(ExplainLine {
+                stage: "photons, map, estimate".into(),
+                passes: 0,
+                ran: false,
+                why: "skipped: direct light only".into(),
+            });
+            None
+        }
+        Some(gi) => {
+            let random = if gi.faithful {
+                RandomSource::Texture
+            } else {
+                RandomSource::Hash
+            };
+            let photon_tracer = PhotonTracer::with_random(gpu, random)?;
+            progress("photons", 0, 1);
+            gpu.finish();
+            let t0 = std::time::Instant::now();
+            let (frames, report) = photon_tracer.trace_to_stored(scene, &textures, options.seed)?;
+            gpu.finish();
+            // Wall time covers every attempt at the stored count.
+            timings.add_both(
+                "trace photons",
+                report.gpu_seconds,
+                t0.elapsed().as_secs_f64(),
+                frames.frames as usize,
+            );
+            explain.push(ExplainLine {
+                stage: "trace photons".into(),
+                passes: frames.frames as usize,
+                ran: true,
+                why: format!(
+                    "emission + {} bounces; {} photons traced ({} attempts), the first {} kept: {} stored",
+                    frames.frames - 1,
+                    report.emitted,
+                    report.attempts.len(),
+                    report.photons_used,
+                    report.stored
+                ),
+            });
+            let grid = Grid::for_scene(scene);
+            let mut build_timings = Timings::default();
+            let feed = if gi.faithful {
+                VertexFeed::Readback
+            } else {
+                gi.feed
+            };
+            let t0 = std::time::Instant::now();
+            let map = match gi.build {
+                BuildMethod::Bitonic => {
+                    let bitonic = BitonicBuild::with_addressing(gpu, gi.faithful)?;
+                    PhotonMap::Sorted(bitonic.build(&frames, &grid, &mut build_timings)?)
+                }
+                BuildMethod::Stencil => PhotonMap::Routed(StencilRouting::new(gpu)?.build(
+                    &frames,
+                    &grid,
+                    gi.stencil_block,
+                    feed,
+                    &mut build_timings,
+                )?),
+            };
+            gpu.finish();
+            for st in &build_timings.stages {
+                explain.push(ExplainLine {
+                    stage: format!("build map: {}", st.name),
+                    passes: st.passes,
+                    ran: true,
+                    why: format!("{:?} build", gi.build),
+                });
+            }
+            let build_passes = build_timings.stages.iter().map(|s| s.passes).sum();
+            timings.add_both(
+                "build map",
+                build_timings.gpu_total(),
+                t0.elapsed().as_secs_f64(),
+                build_passes,
+            );
+            photon_report = Some(report);
+            Some(map)
+        }
     };
-    let stats = estimate.run(&map, &direct, k, max_radius, &estimate_options, &mut |r| {
-        progress(
-            "radiance estimate",
-            r.query_pixels - r.searching,
-            r.query_pixels,
-        );
-        let Some(snap) = &gi.snapshots else { return };
-        let seconds = r.elapsed_seconds - snapshot_seconds;
-        let due = match snap.every {
-            SnapshotEvery::Passes(n) => r.pass == 0 || r.pass >= last_snapshot.0 + n.max(1),
-            SnapshotEvery::Seconds(s) => r.pass == 0 || seconds >= last_snapshot.1 + s,
+    let estimate = match &map {
+        Some(_) => Some(RadianceEstimate::new(gpu, options.width, options.height)?),
+        None => None,
+    };
+
+    let mut sum: Option<Image> = None;
+    let mut snapshots = Vec::new();
+    let mut stats = None;
+    for sample in 0..spp {
+        trace_eye_paths(
+            gpu,
+            scene,
+            &textures,
+            &tracer,
+            &direct,
+            options,
+            sample,
+            &mut timings,
+            progress,
+        )?;
+        let image = match (&options.global, &map, &estimate) {
+            (Some(gi), Some(map), Some(estimate)) => {
+                let (k, max_radius) = (scene.photon_map.k, scene.photon_map.max_radius);
+                let mut snapshot_seconds = 0.0;
+                let mut last_snapshot = (0u32, 0.0f64);
+                let mut snapshot_error = None;
+                let estimate_options = EstimateOptions {
+                    float_addressing: gi.faithful,
+                    ..gi.estimate.clone()
+                };
+                let snap_config = if sample == 0 {
+                    gi.snapshots.as_ref()
+                } else {
+                    None
+                };
+                let s = estimate.run(map, &direct, k, max_radius, &estimate_options, &mut |r| {
+                    progress(
+                        "radiance estimate",
+                        r.query_pixels - r.searching,
+                        r.query_pixels,
+                    );
+                    let Some(snap) = snap_config else { return };
+                    let seconds = r.elapsed_seconds - snapshot_seconds;
+                    let due = match snap.every {
+                        SnapshotEvery::Passes(n) => {
+                            r.pass == 0 || r.pass >= last_snapshot.0 + n.max(1)
+                        }
+                        SnapshotEvery::Seconds(s) => r.pass == 0 || seconds >= last_snapshot.1 + s,
+                    };
+                    if !due || snapshot_error.is_some() {
+                        return;
+                    }
+                    let t0 = std::time::Instant::now();
+                    let img = r
+                        .estimate
+                        .compose(&textures, &direct, k, max_radius, true, true);
+                    let file = format!("snapshot_{:04}.png", snapshots.len());
+                    match img
+                        .png_bytes()
+                        .and_then(|b| image::write_atomically(&snap.dir.join(&file), &b))
+                    {
+                        Ok(()) => snapshots.push(SnapshotRecord {
+                            file,
+                            pass: r.pass,
+                            seconds,
+                            searching_pixels: r.searching,
+                        }),
+                        Err(e) => snapshot_error = Some(e),
+                    }
+                    last_snapshot = (r.pass, seconds);
+                    snapshot_seconds += t0.elapsed().as_secs_f64();
+                })?;
+                if let Some(e) = snapshot_error {
+                    return Err(GpuError::Gl(format!("writing a snapshot: {e}")));
+                }
+                timings.add_both(
+                    "radiance estimate",
+                    s.gpu_seconds,
+                    s.wall_seconds - snapshot_seconds,
+                    s.passes as usize,
+                );
+                let image = estimate.compose(&textures, &direct, k, max_radius, true, true);
+                if let Some(snap) = snap_config {
+                    let final_file = format!("snapshot_{:04}.png", snapshots.len());
+                    image
+                        .png_bytes()
+                        .and_then(|b| image::write_atomically(&snap.dir.join(&final_file), &b))
+                        .map_err(GpuError::Gl)?;
+                    snapshots.push(SnapshotRecord {
+                        file: final_file,
+                        pass: s.passes,
+                        seconds: s.wall_seconds - snapshot_seconds,
+                        searching_pixels: 0,
+                    });
+                    let index = serde_json::to_string_pretty(&snapshots).unwrap_or_default();
+                    image::write_atomically(&snap.dir.join("snapshots.json"), index.as_bytes())
+                        .map_err(GpuError::Gl)?;
+                }
+                explain.push(ExplainLine {
+                    stage: "radiance estimate".into(),
+                    passes: s.passes as usize,
+                    ran: true,
+                    why: format!(
+                        "kNN-grid, k = {k}, max radius {max_radius}, {} steps per pixel per pass, {:?}; {} of {} pixels have a diffuse hit, {} tile draws{}",
+                        gi.estimate.budget,
+                        gi.estimate.mode,
+                        s.query_pixels,
+                        options.width as u64 * options.height as u64,
+                        s.tile_draws,
+                        if spp > 1 { format!(" (sample {})", sample + 1) } else { String::new() }
+                    ),
+                });
+                stats = Some(s);
+                image
+            }
+            _ => direct.read_radiance(),
         };
-        if !due || snapshot_error.is_some() {
-            return;
-        }
-        let t0 = std::time::Instant::now();
-        let img = r
-            .estimate
-            .compose(&textures, &direct, k, max_radius, true, true);
-        let file = format!("snapshot_{:04}.png", snapshots.len());
-        match img
-            .png_bytes()
-            .and_then(|b| image::write_atomically(&snap.dir.join(&file), &b))
-        {
-            Ok(()) => snapshots.push(SnapshotRecord {
-                file,
-                pass: r.pass,
-                seconds,
-                searching_pixels: r.searching,
-            }),
-            Err(e) => snapshot_error = Some(e),
-        }
-        last_snapshot = (r.pass, seconds);
-        snapshot_seconds += t0.elapsed().as_secs_f64();
-    })?;
-    if let Some(e) = snapshot_error {
-        return Err(GpuError::Gl(format!("writing a snapshot: {e}")));
-    }
-    timings.add_both(
-        "radiance estimate",
-        stats.gpu_seconds,
-        stats.wall_seconds - snapshot_seconds,
-        stats.passes as usize,
-    );
-    explain.push(ExplainLine {
-        stage: "radiance estimate".into(),
-        passes: stats.passes as usize,
-        ran: true,
-        why: format!(
-            "kNN-grid, k = {k}, max radius {max_radius}, {} steps per pixel per pass, {:?}; {} of {} pixels have a diffuse hit, {} tile draws",
-            gi.estimate.budget,
-            gi.estimate.mode,
-            stats.query_pixels,
-            options.width as u64 * options.height as u64,
-            stats.tile_draws
-        ),
-    });
-    let image = estimate.compose(&textures, &direct, k, max_radius, true, true);
-    if let Some(snap) = &gi.snapshots {
-        let final_file = format!("snapshot_{:04}.png", snapshots.len());
-        image
-            .png_bytes()
-            .and_then(|b| image::write_atomically(&snap.dir.join(&final_file), &b))
-            .map_err(GpuError::Gl)?;
-        snapshots.push(SnapshotRecord {
-            file: final_file,
-            pass: stats.passes,
-            seconds: stats.wall_seconds - snapshot_seconds,
-            searching_pixels: 0,
+        sum = Some(match sum {
+            None => image,
+            Some(mut acc) => {
+                for (a, p) in acc.pixels.iter_mut().zip(&image.pixels) {
+                    for c in 0..3 {
+                        a[c] += p[c];
+                    }
+                }
+                acc
+            }
         });
-        let index = serde_json::to_string_pretty(&snapshots).unwrap_or_default();
-        image::write_atomically(&snap.dir.join("snapshots.json"), index.as_bytes())
-            .map_err(GpuError::Gl)?;
+    }
+    let mut image = sum.expect("at least one sample");
+    if spp > 1 {
+        for p in &mut image.pixels {
+            for c in p.iter_mut() {
+                *c /= spp as f32;
+            }
+        }
     }
     timings.wall_seconds = wall.elapsed().as_secs_f64();
+    let passes = timings.stages.iter().map(|s| s.passes).sum();
     let state = RenderState {
         textures,
         direct,
-        map: Some(map),
-        estimate: Some(estimate),
+        map,
+        estimate,
     };
     Ok(RenderOutput {
         image,
         state,
         timings,
-        passes: done,
-        photons: Some(report),
-        estimate: Some(stats),
+        passes,
+        photons: photon_report,
+        estimate: stats,
         snapshots,
         explain,
     })

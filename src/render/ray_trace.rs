@@ -88,8 +88,10 @@ impl RayTracer {
         })
     }
 
-    /// One ray per pixel through its centre.
-    pub fn eye_rays(&self, camera: &Camera, options: &RenderOptions) {
+    /// One ray per pixel: through its centre with one sample per pixel (the
+    /// paper), else through a jittered point of stratum `sample` of spp.
+    pub fn eye_rays(&self, camera: &Camera, options: &RenderOptions, sample: u32, seed: u32) {
+        let (strata_x, strata_y) = super::direct::strata(options.spp.max(1));
         let (u, v, w) = camera.basis();
         let tan_v = (camera.vfov_degrees.to_radians() * 0.5).tan();
         let aspect = options.width as f32 / options.height as f32;
@@ -103,7 +105,10 @@ impl RayTracer {
                 "u_image_size",
                 [options.width as f32, options.height as f32],
             )
-            .vec2("u_subpixel", [0.5, 0.5]);
+            .int("u_jitter", (options.spp > 1) as i32)
+            .int("u_sample", sample as i32)
+            .ivec2("u_strata", [strata_x as i32, strata_y as i32])
+            .uint("u_seed", seed);
         self.gpu.draw_fullscreen(&self.rays.target);
     }
 
