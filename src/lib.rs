@@ -3,6 +3,7 @@
 //! ARCHITECTURE.md maps each box of the paper's Figure 1 to a module here.
 
 pub mod gpu;
+pub mod metrics;
 pub mod photon;
 pub mod reference;
 pub mod render;

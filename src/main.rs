@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 use photonmap::gpu::{EglPlatform, Gpu};
 use photonmap::photon::{BuildMethod, VertexFeed};
 use photonmap::reference::knn::{software_image, SoftwareEstimate};
+use photonmap::render::Image;
 use photonmap::render::{
     self, EstimateMode, EstimateOptions, GlobalIllumination, RenderOptions, SnapshotEvery,
     Snapshots,
@@ -121,6 +122,20 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u32,
         /// As JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Compare two linear EXR images (the second is the reference): RMSE,
+    /// relative MSE, SSIM, and optionally a false-colour difference image.
+    Compare {
+        image: PathBuf,
+        reference: PathBuf,
+        /// Only pixels where this PNG (same size) is bright (> 50%) count.
+        #[arg(long)]
+        mask: Option<PathBuf>,
+        /// Write |a - b| / (|b| + 0.01) as a false-colour PNG (black 0 .. red >= 1).
+        #[arg(long, value_name = "PNG")]
+        diff: Option<PathBuf>,
         #[arg(long)]
         json: bool,
     },
@@ -333,6 +348,57 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 print!("{}", cli::tables::markdown(&report));
                 eprintln!("wrote {}", dir.display());
+            }
+            Ok(())
+        }
+        Command::Compare {
+            image,
+            reference,
+            mask,
+            diff,
+            json,
+        } => {
+            if let Some(d) = &diff {
+                check_output(d, "png", "--diff")?;
+            }
+            let a = Image::read_exr(&image).map_err(anyhow::Error::msg)?;
+            let b = Image::read_exr(&reference).map_err(anyhow::Error::msg)?;
+            let mask = match &mask {
+                None => None,
+                Some(path) => {
+                    let m = ::image::open(path)
+                        .map_err(|e| {
+                            anyhow::anyhow!("cannot read the mask {}: {e}", path.display())
+                        })?
+                        .to_luma8();
+                    if m.dimensions() != (a.width, a.height) {
+                        bail!(
+                            "--mask {}: {} x {} pixels, the images are {} x {}",
+                            path.display(),
+                            m.width(),
+                            m.height(),
+                            a.width,
+                            a.height
+                        );
+                    }
+                    Some(m.pixels().map(|p| p[0] > 127).collect::<Vec<bool>>())
+                }
+            };
+            let metrics =
+                photonmap::metrics::compare(&a, &b, mask.as_deref()).map_err(anyhow::Error::msg)?;
+            if let Some(d) = &diff {
+                let png = photonmap::metrics::false_colour(&a, &b)
+                    .png_bytes()
+                    .map_err(anyhow::Error::msg)?;
+                render::image::write_atomically(d, &png).map_err(anyhow::Error::msg)?;
+            }
+            if json {
+                println!("{}", serde_json::to_string_pretty(&metrics)?);
+            } else {
+                println!("pixels compared  {}", metrics.pixels_compared);
+                println!("RMSE (linear)    {:.6}", metrics.rmse);
+                println!("relative MSE     {:.6}", metrics.rel_mse);
+                println!("SSIM (luminance) {:.6}", metrics.ssim);
             }
             Ok(())
         }

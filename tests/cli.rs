@@ -427,3 +427,84 @@ fn tables_quick_produces_every_table_with_sane_values() {
         }
     }
 }
+
+#[test]
+fn compare_prints_metrics_writes_a_difference_image_and_checks_its_inputs() {
+    let d = tmp("compare");
+    let render_exr = |seed: &str, name: &str| {
+        let exr = d.join(name);
+        let st = photonmap()
+            .args([
+                "render",
+                "--quiet",
+                "--direct-only",
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "--seed",
+                seed,
+            ])
+            .arg(scene("glass_ball"))
+            .arg("-o")
+            .arg(d.join("x.png"))
+            .arg("--exr")
+            .arg(&exr)
+            .status()
+            .unwrap();
+        assert!(st.success());
+        exr
+    };
+    let (a, b) = (render_exr("1", "a.exr"), render_exr("2", "b.exr"));
+    let metrics = |x: &PathBuf, y: &PathBuf, extra: &[&str]| {
+        let out = photonmap()
+            .arg("compare")
+            .arg(x)
+            .arg(y)
+            .arg("--json")
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let same = metrics(&a, &a, &[]);
+    assert_eq!(same["rmse"], 0.0);
+    assert_eq!(same["ssim"], 1.0);
+    let diff_png = d.join("diff.png");
+    let other = metrics(&a, &b, &["--diff", diff_png.to_str().unwrap()]);
+    assert!(
+        other["rmse"].as_f64().unwrap() > 0.0 && other["ssim"].as_f64().unwrap() < 1.0,
+        "{other}"
+    );
+    assert_eq!(
+        image::open(&diff_png).unwrap().to_rgb8().dimensions(),
+        (40, 30)
+    );
+    // A mask of the wrong size is refused, naming both sizes.
+    let small = d.join("mask.png");
+    image::RgbImage::new(10, 10).save(&small).unwrap();
+    let out = photonmap()
+        .arg("compare")
+        .arg(&a)
+        .arg(&b)
+        .arg("--mask")
+        .arg(&small)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("10 x 10"));
+    let missing = photonmap()
+        .arg("compare")
+        .arg(d.join("nope.exr"))
+        .arg(&b)
+        .output()
+        .unwrap();
+    assert!(
+        !missing.status.success() && String::from_utf8_lossy(&missing.stderr).contains("nope.exr")
+    );
+}

@@ -1,0 +1,186 @@
+//! Image error metrics, for `compare`, the accuracy benchmark and tests: RMSE
+//! (linear), relative MSE, and SSIM (Wang et al. 2004) on display luminance,
+//! all optionally restricted by a mask.
+
+use crate::render::image::linear_to_srgb;
+use crate::render::Image;
+
+#[derive(Clone, Debug, serde::Serialize, PartialEq)]
+pub struct Metrics {
+    /// Root mean square difference of linear RGB over the pixels compared.
+    pub rmse: f64,
+    /// Mean over pixel channels of (a - b)^2 / (b^2 + 0.01): error relative to
+    /// the reference `b`, stable where it is dark (Rousselle et al.'s form).
+    pub rel_mse: f64,
+    /// Mean structural similarity of sRGB luminance (11 x 11 Gaussian window,
+    /// sigma 1.5, K1 = 0.01, K2 = 0.03): 1 is identical.
+    pub ssim: f64,
+    pub pixels_compared: usize,
+}
+
+/// Compares `a` with the reference `b`; `mask` (same size) keeps pixels where it is true.
+pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics, String> {
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(format!(
+            "image sizes differ: {} x {} and {} x {}",
+            a.width, a.height, b.width, b.height
+        ));
+    }
+    if let Some(m) = mask {
+        if m.len() != a.pixels.len() {
+            return Err(format!(
+                "the mask has {} pixels, the images {}",
+                m.len(),
+                a.pixels.len()
+            ));
+        }
+    }
+    let keep = |i: usize| mask.is_none_or(|m| m[i]);
+    let (mut se, mut rel, mut n) = (0f64, 0f64, 0usize);
+    for (i, (p, q)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+        if !keep(i) {
+            continue;
+        }
+        for c in 0..3 {
+            let d = p[c] as f64 - q[c] as f64;
+            se += d * d;
+            rel += d * d / (q[c] as f64 * q[c] as f64 + 0.01);
+        }
+        n += 1;
+    }
+    if n == 0 {
+        return Err("the mask keeps no pixel".into());
+    }
+    let ssim_map = ssim_map(a, b);
+    let ssim: f64 = ssim_map
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| keep(*i))
+        .map(|(_, v)| *v)
+        .sum::<f64>()
+        / n as f64;
+    Ok(Metrics {
+        rmse: (se / (3 * n) as f64).sqrt(),
+        rel_mse: rel / (3 * n) as f64,
+        ssim,
+        pixels_compared: n,
+    })
+}
+
+fn luminance(img: &Image) -> Vec<f64> {
+    img.pixels
+        .iter()
+        .map(|p| {
+            0.2126 * linear_to_srgb(p[0]) as f64
+                + 0.7152 * linear_to_srgb(p[1]) as f64
+                + 0.0722 * linear_to_srgb(p[2]) as f64
+        })
+        .collect()
+}
+
+/// Per-pixel SSIM of display luminance, Gaussian windows clipped at the borders.
+pub fn ssim_map(a: &Image, b: &Image) -> Vec<f64> {
+    let (w, h) = (a.width as i64, a.height as i64);
+    let (la, lb) = (luminance(a), luminance(b));
+    let weights: Vec<f64> = (-5..=5)
+        .map(|d: i64| (-((d * d) as f64) / (2.0 * 1.5 * 1.5)).exp())
+        .collect();
+    let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
+    let mut out = vec![0f64; (w * h) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let (mut sw, mut ma, mut mb, mut vaa, mut vbb, mut vab) =
+                (0f64, 0f64, 0f64, 0f64, 0f64, 0f64);
+            for dy in -5..=5i64 {
+                for dx in -5..=5i64 {
+                    let (xx, yy) = (x + dx, y + dy);
+                    if xx < 0 || yy < 0 || xx >= w || yy >= h {
+                        continue;
+                    }
+                    let wt = weights[(dx + 5) as usize] * weights[(dy + 5) as usize];
+                    let i = (yy * w + xx) as usize;
+                    sw += wt;
+                    ma += wt * la[i];
+                    mb += wt * lb[i];
+                    vaa += wt * la[i] * la[i];
+                    vbb += wt * lb[i] * lb[i];
+                    vab += wt * la[i] * lb[i];
+                }
+            }
+            let (ma, mb) = (ma / sw, mb / sw);
+            let (va, vb, cov) = (vaa / sw - ma * ma, vbb / sw - mb * mb, vab / sw - ma * mb);
+            out[(y * w + x) as usize] = ((2.0 * ma * mb + c1) * (2.0 * cov + c2))
+                / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+        }
+    }
+    out
+}
+
+/// A false-colour picture of |a - b| / (|b| + 0.01) (luminance-weighted):
+/// black 0, through blue, green and yellow, to red at 1 or more.
+pub fn false_colour(a: &Image, b: &Image) -> Image {
+    let ramp = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+    ];
+    let pixels = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| {
+            let la = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            let lb = 0.2126 * q[0] + 0.7152 * q[1] + 0.0722 * q[2];
+            let e = ((la - lb).abs() / (lb.abs() + 0.01)).clamp(0.0, 1.0) * 4.0;
+            let i = (e.floor() as usize).min(3);
+            let t = e - i as f32;
+            let c: [f32; 3] = std::array::from_fn(|k| ramp[i][k] * (1.0 - t) + ramp[i + 1][k] * t);
+            // png_bytes applies sRGB; store linear values that encode to the ramp.
+            c.map(|v: f32| {
+                if v <= 0.04045 {
+                    v / 12.92
+                } else {
+                    ((v + 0.055) / 1.055).powf(2.4)
+                }
+            })
+        })
+        .collect();
+    Image {
+        width: a.width,
+        height: a.height,
+        pixels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient(w: u32, h: u32, k: f32) -> Image {
+        let mut img = Image::new(w, h);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            let v = ((i as u32 % w) as f32 / w as f32) * k;
+            *p = [v, v * 0.5, 0.2];
+        }
+        img
+    }
+
+    #[test]
+    fn identical_images_are_perfect_and_differences_show() {
+        let a = gradient(40, 30, 1.0);
+        let m = compare(&a, &a, None).unwrap();
+        assert_eq!((m.rmse, m.rel_mse), (0.0, 0.0));
+        assert!((m.ssim - 1.0).abs() < 1e-12);
+        let b = gradient(40, 30, 1.2);
+        let d = compare(&b, &a, None).unwrap();
+        assert!(d.rmse > 0.01 && d.rel_mse > 0.0 && d.ssim < 1.0, "{d:?}");
+        // A mask that keeps only the left column sees almost no difference.
+        let mask: Vec<bool> = (0..a.pixels.len()).map(|i| i % 40 == 0).collect();
+        let left = compare(&b, &a, Some(&mask)).unwrap();
+        assert_eq!(left.pixels_compared, 30);
+        assert!(left.rmse < d.rmse / 10.0);
+        assert!(compare(&a, &gradient(41, 30, 1.0), None).is_err());
+    }
+}
