@@ -139,6 +139,24 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Render a converged reference of a scene (more photons, larger k, several
+    /// eye samples, many seeds averaged) as EXR, with its command and residual noise.
+    Reference {
+        scene: PathBuf,
+        /// Output EXR (default: reference_images/<scene>.converged.exr; a .json goes beside it).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Render at 1/scale of the scene's resolution.
+        #[arg(long, default_value_t = 2)]
+        scale: u32,
+        /// Photons stored x this; k x its square root.
+        #[arg(long, default_value_t = 8)]
+        photons_factor: u32,
+        #[arg(long, default_value_t = 8)]
+        seeds: u32,
+        #[arg(long, default_value_t = 4)]
+        spp: u32,
+    },
     /// Reproduce the paper's tables and figures into results/<renderer>/ (or --out).
     Tables {
         /// Output folder (default: results/<renderer>/).
@@ -173,6 +191,26 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// Run time against error around a scene's defaults (photons, k, maximum
+    /// radius, shadow rays, build, tiling, samples), against its converged
+    /// reference; CSV, JSON, SVG and PNG plots of the Pareto front.
+    Accuracy {
+        #[arg(long)]
+        scene: PathBuf,
+        /// The converged reference (default: reference_images/<scene>.converged.exr).
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        /// Output folder (default: results/<renderer>/accuracy/<scene>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// A small sweep.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long)]
+        json: bool,
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Whether the stencil test skips fragment work on this driver (the
     /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
     Mask {
@@ -399,6 +437,110 @@ fn run(cli: Cli) -> Result<()> {
                 println!("RMSE (linear)    {:.6}", metrics.rmse);
                 println!("relative MSE     {:.6}", metrics.rel_mse);
                 println!("SSIM (luminance) {:.6}", metrics.ssim);
+            }
+            Ok(())
+        }
+        Command::Reference {
+            scene: scene_path,
+            out,
+            scale,
+            photons_factor,
+            seeds,
+            spp,
+        } => {
+            let scene = load_scene(&scene_path)?;
+            let out = out.unwrap_or_else(|| cli::accuracy::default_reference(&scene_path));
+            check_output(&out, "exr", "--out")?;
+            let gpu = Gpu::new(cli.egl)?;
+            let command = format!(
+                "photonmap reference {} --scale {scale} --photons-factor {photons_factor} --seeds {seeds} --spp {spp}",
+                scene_path.display()
+            );
+            let options = cli::accuracy::ReferenceOptions {
+                scale,
+                photons_factor,
+                seeds,
+                spp,
+            };
+            let (img, info) =
+                cli::accuracy::make_reference(&gpu, &scene, &options, command, &|m: &str| {
+                    eprintln!("{m}")
+                })?;
+            cli::accuracy::write_reference(&img, &info, &out)?;
+            eprintln!(
+                "wrote {} (residual RMSE {:.6})",
+                out.display(),
+                info.residual_rmse
+            );
+            Ok(())
+        }
+        Command::Bench {
+            which:
+                BenchCommand::Accuracy {
+                    scene: scene_path,
+                    reference,
+                    out,
+                    quick,
+                    json,
+                    quiet,
+                },
+        } => {
+            let scene = load_scene(&scene_path)?;
+            let reference =
+                reference.unwrap_or_else(|| cli::accuracy::default_reference(&scene_path));
+            if !reference.is_file() {
+                bail!(
+                    "no converged reference at {}: make one with `photonmap reference {}`",
+                    reference.display(),
+                    scene_path.display()
+                );
+            }
+            let gpu = Gpu::new(cli.egl)?;
+            let progress = |m: &str| {
+                if !quiet {
+                    eprintln!("{m}");
+                }
+            };
+            let report = cli::accuracy::bench_accuracy(&gpu, &scene, &reference, quick, &progress)?;
+            let stem = scene_path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let dir = out.unwrap_or_else(|| {
+                cli::tables::default_out(&report.renderer)
+                    .join("accuracy")
+                    .join(&stem)
+            });
+            std::fs::create_dir_all(&dir)?;
+            let write = |name: &str, bytes: &[u8]| {
+                render::image::write_atomically(&dir.join(name), bytes).map_err(anyhow::Error::msg)
+            };
+            write("accuracy.csv", cli::accuracy::csv(&report).as_bytes())?;
+            write(
+                "accuracy.json",
+                serde_json::to_string_pretty(&report)?.as_bytes(),
+            )?;
+            write("accuracy.svg", cli::accuracy::svg_plot(&report).as_bytes())?;
+            write("accuracy.png", &cli::accuracy::png_plot(&report))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                println!(
+                    "{:<18} {:>9} {:>11} {:>8} {:>7}",
+                    "run", "seconds", "rel. MSE", "SSIM", "front"
+                );
+                for r in &report.runs {
+                    println!(
+                        "{:<18} {:>9.3} {:>11.5} {:>8.4} {:>7}",
+                        r.label,
+                        r.total_seconds,
+                        r.metrics.rel_mse,
+                        r.metrics.ssim,
+                        if r.on_pareto_front { "*" } else { "" }
+                    );
+                }
+                println!("recommended: {}", report.recommended);
+                eprintln!("wrote {}", dir.display());
             }
             Ok(())
         }

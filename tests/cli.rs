@@ -508,3 +508,111 @@ fn compare_prints_metrics_writes_a_difference_image_and_checks_its_inputs() {
         !missing.status.success() && String::from_utf8_lossy(&missing.stderr).contains("nope.exr")
     );
 }
+
+#[test]
+fn reference_and_accuracy_bench_write_their_results() {
+    let d = tmp("accuracy");
+    let reference = d.join("gb.converged.exr");
+    let out = photonmap()
+        .args([
+            "reference",
+            "--scale",
+            "8",
+            "--seeds",
+            "2",
+            "--spp",
+            "1",
+            "--photons-factor",
+            "2",
+            "--out",
+        ])
+        .arg(&reference)
+        .arg(scene("glass_ball"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(reference.with_extension("json")).unwrap()).unwrap();
+    assert_eq!(
+        (
+            info["width"].as_u64(),
+            info["photons_stored"].as_u64(),
+            info["seeds"].as_u64()
+        ),
+        (Some(64), Some(10000), Some(2))
+    );
+    assert!(info["residual_rmse"].as_f64().unwrap() > 0.0);
+    assert!(info["command"]
+        .as_str()
+        .unwrap()
+        .starts_with("photonmap reference"));
+
+    let results = d.join("results");
+    let out = photonmap()
+        .args([
+            "bench", "accuracy", "--quick", "--quiet", "--json", "--scene",
+        ])
+        .arg(scene("glass_ball"))
+        .arg("--reference")
+        .arg(&reference)
+        .arg("--out")
+        .arg(&results)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let runs = v["runs"].as_array().unwrap();
+    assert!(runs.len() >= 10, "{} runs", runs.len());
+    assert!(runs
+        .iter()
+        .all(|r| r["total_seconds"].as_f64().unwrap() > 0.0
+            && r["metrics"]["rel_mse"].as_f64().unwrap() >= 0.0));
+    let front: Vec<&serde_json::Value> = runs
+        .iter()
+        .filter(|r| r["on_pareto_front"] == true)
+        .collect();
+    assert!(!front.is_empty());
+    // No run on the front is beaten on both time and error by another.
+    for f in &front {
+        let (t, e) = (
+            f["total_seconds"].as_f64().unwrap(),
+            f["metrics"]["rel_mse"].as_f64().unwrap(),
+        );
+        assert!(
+            !runs.iter().any(|r| r["total_seconds"].as_f64().unwrap() < t
+                && r["metrics"]["rel_mse"].as_f64().unwrap() < e)
+        );
+    }
+    assert!(runs.iter().any(|r| r["label"] == v["recommended"]));
+    for f in [
+        "accuracy.csv",
+        "accuracy.json",
+        "accuracy.svg",
+        "accuracy.png",
+    ] {
+        assert!(results.join(f).is_file(), "{f}");
+    }
+    assert!(std::fs::read_to_string(results.join("accuracy.svg"))
+        .unwrap()
+        .contains("<polyline"));
+    // Without a reference it says how to make one.
+    let none = photonmap()
+        .args(["bench", "accuracy", "--scene"])
+        .arg(scene("ring"))
+        .args(["--reference"])
+        .arg(d.join("none.exr"))
+        .output()
+        .unwrap();
+    assert!(
+        !none.status.success()
+            && String::from_utf8_lossy(&none.stderr).contains("photonmap reference")
+    );
+}

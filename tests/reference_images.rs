@@ -238,7 +238,8 @@ fn paper_scenes_match_their_references() {
     }
 }
 
-/// The comparison can fail: a 10% brighter light, and a camera one pixel off.
+/// The comparison can fail: a 10% brighter light, a camera one pixel off, and
+/// (where there is one) a missing caustic.
 #[test]
 fn the_comparison_catches_defects() {
     let gpu = common::gpu();
@@ -297,5 +298,25 @@ fn the_comparison_catches_defects() {
             "{name}: a camera one pixel off passed ({f}, tolerance {})",
             r.tol.tolerance
         );
+        if name != "cornell_box" {
+            // In these two scenes the floor is the only diffuse surface and
+            // nothing above it is diffuse, so every stored photon is a caustic
+            // photon: without the caustic, the render is direct light only.
+            let scene = common::paper_scene(name);
+            let mut o = reduced(&scene).direct_only();
+            o.seed = TEST_SEED;
+            let img = render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image;
+            let f = score(&format!("{name}.no_caustic"), &img, &r);
+            eprintln!(
+                "{name}: missing caustic fails {:.3}% (tolerance {:.3}%)",
+                100.0 * f,
+                100.0 * r.tol.tolerance
+            );
+            assert!(
+                f > r.tol.tolerance,
+                "{name}: a render without its caustic passed ({f}, tolerance {})",
+                r.tol.tolerance
+            );
+        }
     }
 }
