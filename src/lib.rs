@@ -8,3 +8,4 @@ pub mod photon;
 pub mod reference;
 pub mod render;
 pub mod scene;
+pub mod stress;

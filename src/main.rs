@@ -191,6 +191,17 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// The stress suite: scale and place, sizes, crowding, grids, search edges,
+    /// difficult paths, the furnace; one JSON object per case with --json.
+    Stress {
+        /// Only the cases that take seconds.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long)]
+        json: bool,
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Run time against error around a scene's defaults (photons, k, maximum
     /// radius, shadow rays, build, tiling, samples), against its converged
     /// reference; CSV, JSON, SVG and PNG plots of the Pareto front.
@@ -541,6 +552,40 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 println!("recommended: {}", report.recommended);
                 eprintln!("wrote {}", dir.display());
+            }
+            Ok(())
+        }
+        Command::Bench {
+            which: BenchCommand::Stress { quick, json, quiet },
+        } => {
+            let gpu = Gpu::new(cli.egl)?;
+            let progress = |m: &str| {
+                if !quiet {
+                    eprintln!("{m}");
+                }
+            };
+            let cases = photonmap::stress::run(&gpu, quick, &progress);
+            if json {
+                for c in &cases {
+                    println!("{}", serde_json::to_string(c)?);
+                }
+            } else {
+                for c in &cases {
+                    println!(
+                        "{:<8} {:<70} {:>12.5} {:>7.2} s  {}",
+                        format!("{:?}", c.outcome).to_lowercase(),
+                        c.name,
+                        c.value,
+                        c.seconds,
+                        c.message
+                    );
+                }
+            }
+            if cases
+                .iter()
+                .any(|c| c.outcome == photonmap::stress::Outcome::Fail)
+            {
+                bail!("some stress cases failed");
             }
             Ok(())
         }

@@ -13,9 +13,9 @@
 // radius grows to include it; after that only photons within the radius are
 // accepted. After ring r, every photon closer than d_min(r), the distance from
 // the query point to the faces of the box of rings 0..r, has been examined
-// (Elias): the search ends when k are accepted and the radius is within
-// d_min(r), when d_min(r) reaches the maximum radius, or when the box covers
-// the grid.
+// (Elias; faces on the grid's boundary do not count): the search ends when k
+// are accepted and the radius is within d_min(r), when d_min(r) reaches the
+// maximum radius, or when the box covers the grid.
 #include "common/photon_map.glsl"
 
 uniform sampler2D u_query_position;  // first diffuse hit, w = 1 valid
@@ -53,9 +53,13 @@ void main() {
         int plane = side * side;
         if (j >= plane * side) {
             // Ring done: every photon nearer than the examined box's faces is seen.
+                        // A face on the grid's boundary bounds nothing: no photon lies beyond.
             vec3 lo = u_grid_min + vec3(c0 - ring) * cell_size;
             vec3 hi = u_grid_min + vec3(c0 + ring + 1) * cell_size;
-            vec3 inside = min(x - lo, hi - x);
+            const float FAR = 3.0e38;
+            vec3 lo_gap = mix(x - lo, vec3(FAR), lessThanEqual(c0 - ring, ivec3(0)));
+            vec3 hi_gap = mix(hi - x, vec3(FAR), greaterThanEqual(c0 + ring, u_grid_resolution - 1));
+            vec3 inside = min(lo_gap, hi_gap);
             float d_min = min(inside.x, min(inside.y, inside.z));
             bool covers = all(lessThanEqual(c0 - ring, ivec3(0))) && all(greaterThanEqual(c0 + ring, u_grid_resolution - 1));
             if (covers || d_min >= u_max_radius || (accepted >= u_k && d_min >= 0.0 && r2 <= d_min * d_min)) {

@@ -81,7 +81,23 @@ impl Texture {
                 gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
             }
         }
-        gpu.check("creating a texture")?;
+        let err = unsafe { gl.get_error() };
+        if err != glow::NO_ERROR {
+            unsafe { gl.delete_texture(raw) };
+            let bytes = width as u64
+                * height as u64
+                * format.channels() as u64
+                * 4
+                * (1 + (levels > 1) as u64 / 3);
+            return Err(GpuError::Gl(if err == glow::OUT_OF_MEMORY {
+                format!(
+                    "out of memory creating a {width} x {height} {format:?} texture ({:.1} GiB)",
+                    bytes as f64 / (1u64 << 30) as f64
+                )
+            } else {
+                format!("creating a {width} x {height} {format:?} texture: GL error 0x{err:04x}")
+            }));
+        }
         Ok(Self {
             gpu: gpu.clone(),
             raw,

@@ -62,9 +62,10 @@ impl PhotonFrames {
 /// Frame width and height for `emitted` photons and `frames` frames: square-ish
 /// frames (width a power of two) stacked within the driver's texture size.
 pub fn frame_layout(emitted: u32, frames: u32, max_size: u32) -> Result<(u32, u32), GpuError> {
-    let width = ((emitted as f64).sqrt().ceil() as u32)
-        .next_power_of_two()
-        .clamp(1, max_size);
+    // Square-ish, but wide enough that all frames fit the driver's height.
+    let square = (emitted as f64).sqrt().ceil() as u64;
+    let needed = (emitted as u64 * frames as u64).div_ceil(max_size as u64);
+    let width = (square.max(needed).next_power_of_two() as u32).clamp(1, max_size);
     let frame_height = emitted.div_ceil(width).max(1);
     if frame_height as u64 * frames as u64 > max_size as u64 {
         return Err(GpuError::Gl(format!(
@@ -276,8 +277,8 @@ impl PhotonTracer {
         let max_emitted = {
             let frames = scene.photon_map.max_bounces + 1;
             let max = max_texture_size(&self.gpu) as u64;
-            // Texels available per frame, rounded down to whole rows of the widest frame.
-            ((max * max / frames as u64).min(u32::MAX as u64 / 2)) as u32
+            // Whole rows per frame of the widest frame.
+            ((max / frames as u64) * max).min(u32::MAX as u64 / 2) as u32
         };
         let mut emitted = target.max(64);
         let mut attempts = Vec::new();
@@ -310,6 +311,11 @@ impl PhotonTracer {
                     gpu_seconds_all_attempts: all_seconds,
                 };
                 return Ok((frames, report));
+            }
+            if total == 0 && emitted >= 250_000 {
+                return Err(GpuError::Gl(format!(
+                    "{emitted} photons emitted and none stored: no diffuse surface is reached after a bounce (photon maps store diffuse hits after the first; add a diffuse surface or set store_direct)"
+                )));
             }
             if emitted >= max_emitted || attempts.len() >= 8 {
                 return Err(GpuError::Gl(format!(

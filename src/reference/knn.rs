@@ -160,8 +160,23 @@ pub fn knn_grid(map: &CpuPhotonMap, x: Vec3, k: u32, max_radius: f32) -> KnnResu
                 (c0[1] + ring + 1) as f32,
                 (c0[2] + ring + 1) as f32,
             ) * cell_size;
-        let inside = (x - lo).min(hi - x);
-        let d_min = inside.min_element();
+        // A face on the grid's boundary bounds nothing: no photon lies beyond.
+        let far = 3.0e38f32;
+        let lo_gap = Vec3::from_array(std::array::from_fn(|a| {
+            if c0[a] - ring <= 0 {
+                far
+            } else {
+                x[a] - lo[a]
+            }
+        }));
+        let hi_gap = Vec3::from_array(std::array::from_fn(|a| {
+            if c0[a] + ring >= res[a] - 1 {
+                far
+            } else {
+                hi[a] - x[a]
+            }
+        }));
+        let d_min = lo_gap.min(hi_gap).min_element();
         let covers = (0..3).all(|a| c0[a] - ring <= 0 && c0[a] + ring >= res[a] - 1);
         if covers || d_min >= max_radius || (accepted >= k && d_min >= 0.0 && r2 <= d_min * d_min) {
             return KnnResult {

@@ -1,0 +1,505 @@
+//! The stress suite (`photonmap bench stress`): each case reports a figure and
+//! an outcome (pass, fail, or refused with a clear message), and every render
+//! is checked for NaN or Inf in every GPU buffer it leaves.
+
+use glam::Vec3;
+
+use crate::gpu::{Gpu, GpuError, TexFormat, Texture};
+use crate::metrics::compare;
+use crate::photon::{BitonicBuild, BuildMethod, PhotonMap};
+use crate::render::{render, GlobalIllumination, RenderOptions, RenderOutput};
+use crate::scene::{load_scene_str, Geometry, Light, Scene};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    Pass,
+    Fail,
+    Refused,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct StressCase {
+    pub name: String,
+    /// What `value` measures.
+    pub figure: String,
+    pub value: f64,
+    pub outcome: Outcome,
+    pub message: String,
+    pub seconds: f64,
+}
+
+/// Non-finite values in every buffer a render leaves (direct light, hit
+/// records, the photon map, the estimate's state, the image): "" if none.
+pub fn non_finite_buffers(out: &RenderOutput) -> String {
+    let mut bad = Vec::new();
+    let mut check = |name: &str, t: &Texture| {
+        if t.is_integer() {
+            return;
+        }
+        let n = t.read_f32().iter().filter(|v| !v.is_finite()).count();
+        if n > 0 {
+            bad.push(format!("{name}: {n}"));
+        }
+    };
+    let d = &out.state.direct;
+    check("direct radiance", &d.radiance);
+    check("diffuse positions", &d.diffuse_position);
+    check("diffuse normals", &d.diffuse_normal);
+    check("diffuse throughput", &d.diffuse_throughput);
+    match &out.state.map {
+        Some(PhotonMap::Sorted(m)) => {
+            check("map positions", &m.position);
+            check("map power", &m.power);
+        }
+        Some(PhotonMap::Routed(m)) => {
+            check("map positions", &m.position);
+            check("map power", &m.power);
+            check("map counts", &m.counts);
+        }
+        None => {}
+    }
+    if let Some(e) = &out.state.estimate {
+        check("estimate flux", &e.flux);
+    }
+    if out.image.has_non_finite() {
+        bad.push("image".into());
+    }
+    bad.join(", ")
+}
+
+/// The scene scaled by `s` about the origin and then moved by `t`: lengths,
+/// the photon-map radius and grid bounds scale; point-light intensity scales by
+/// s^2 so irradiance (I / r^2) and so the image stay the same.
+pub fn transformed(scene: &Scene, s: f32, t: Vec3) -> Scene {
+    let p = |v: Vec3| v * s + t;
+    let mut out = scene.clone();
+    out.camera.position = p(scene.camera.position);
+    out.camera.look_at = p(scene.camera.look_at);
+    for shape in &mut out.shapes {
+        shape.geometry = match shape.geometry {
+            Geometry::Sphere { center, radius } => Geometry::Sphere {
+                center: p(center),
+                radius: radius * s,
+            },
+            Geometry::Cylinder {
+                base,
+                axis,
+                radius,
+                height,
+            } => Geometry::Cylinder {
+                base: p(base),
+                axis,
+                radius: radius * s,
+                height: height * s,
+            },
+            Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            } => Geometry::Parallelogram {
+                corner: p(corner),
+                edge1: edge1 * s,
+                edge2: edge2 * s,
+            },
+            Geometry::Triangle { v0, v1, v2 } => Geometry::Triangle {
+                v0: p(v0),
+                v1: p(v1),
+                v2: p(v2),
+            },
+        };
+    }
+    for light in &mut out.lights {
+        *light = match *light {
+            Light::Area {
+                corner,
+                edge1,
+                edge2,
+                normal,
+                radiance,
+            } => Light::Area {
+                corner: p(corner),
+                edge1: edge1 * s,
+                edge2: edge2 * s,
+                normal,
+                radiance,
+            },
+            Light::Point {
+                position,
+                intensity,
+            } => Light::Point {
+                position: p(position),
+                intensity: intensity * s * s,
+            },
+        };
+    }
+    out.photon_map.max_radius *= s;
+    out.photon_map.grid_bounds = scene.photon_map.grid_bounds.map(|(lo, hi)| (p(lo), p(hi)));
+    out
+}
+
+fn small(scene: &Scene, w: u32, h: u32, seed: u32) -> RenderOptions {
+    let mut o = RenderOptions::for_scene(scene);
+    (o.width, o.height, o.seed) = (w, h, seed);
+    o
+}
+
+fn case(
+    name: &str,
+    figure: &str,
+    f: impl FnOnce() -> Result<(f64, Outcome, String), GpuError>,
+) -> StressCase {
+    let t0 = std::time::Instant::now();
+    let (value, outcome, message) = match f() {
+        Ok(r) => r,
+        // An error is a refusal when it explains itself; every GpuError does.
+        Err(e) => (f64::NAN, Outcome::Refused, e.to_string()),
+    };
+    StressCase {
+        name: name.into(),
+        figure: figure.into(),
+        value,
+        outcome,
+        message,
+        seconds: t0.elapsed().as_secs_f64(),
+    }
+}
+
+fn finite_render(
+    gpu: &Gpu,
+    scene: &Scene,
+    o: &RenderOptions,
+) -> Result<(RenderOutput, String), GpuError> {
+    let out = render(gpu, scene, o, &|_, _, _| {})?;
+    let bad = non_finite_buffers(&out);
+    Ok((out, bad))
+}
+
+fn verdict(ok: bool, bad: &str, detail: String) -> (Outcome, String) {
+    if !bad.is_empty() {
+        (Outcome::Fail, format!("non-finite values in {bad}"))
+    } else if ok {
+        (Outcome::Pass, detail)
+    } else {
+        (Outcome::Fail, detail)
+    }
+}
+
+/// A closed diffuse sphere of albedo rho and radius R lit by a point light of
+/// intensity I at its centre: every wall point has L = rho I / (pi R^2 (1 - rho))
+/// (direct rho I / (pi R^2) by shadow rays, the rest by photons).
+pub const FURNACE: &str = r#"
+[camera]
+position = [0.0, 0.0, 0.5]
+look_at = [0.0, 0.0, -1.0]
+vfov = 60.0
+width = 48
+height = 48
+[photon_map]
+photons_stored = 60000
+grid_resolution = [24, 24, 24]
+k = 100
+max_radius = 0.3
+max_bounces = 24
+[materials]
+wall = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
+[[shape]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "wall"
+[[light]]
+type = "point"
+position = [0.0, 0.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+
+pub fn furnace(gpu: &Gpu) -> Result<(f64, f64, f64, String), GpuError> {
+    let scene = load_scene_str(FURNACE, std::path::Path::new("furnace.toml"))
+        .map_err(|e| GpuError::Gl(e.to_string()))?;
+    let (out, bad) = finite_render(gpu, &scene, &small(&scene, 48, 48, 3))?;
+    let mean = out.image.mean()[0];
+    let (rho, k) = (0.5f64, scene.photon_map.k as f64);
+    let expected = rho / (std::f64::consts::PI * (1.0 - rho));
+    // Indirect is rho of the total; each estimate has relative error 1/sqrt(k),
+    // over ~ (viewed area / disc area) independent discs; plus the k/(k-1) bias
+    // of a k-nearest estimate and rho^24 of truncation.
+    let density = scene.photon_map.photons_stored as f64 / (4.0 * std::f64::consts::PI);
+    let disc = k / density;
+    let viewed = 2.0 * std::f64::consts::PI * (1.0 - (60f64.to_radians() / 2.0).cos()) * 1.5 * 1.5;
+    let sigma = rho * expected / k.sqrt() / (viewed / disc).max(1.0).sqrt();
+    let tolerance = 4.0 * sigma + rho * expected / (k - 1.0) + expected * rho.powi(24);
+    Ok((mean, expected, tolerance, bad))
+}
+
+/// Runs the stress cases; `quick` keeps those that take seconds.
+pub fn run(gpu: &Gpu, quick: bool, progress: &dyn Fn(&str)) -> Vec<StressCase> {
+    let mut cases = Vec::new();
+    let paper = |name: &str| {
+        crate::scene::load_scene(
+            &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("scenes")
+                .join(format!("{name}.toml")),
+        )
+    };
+
+    // Scale and place: each scene scaled by 1e-3 and 1e3 and moved by 1e4 renders
+    // within twice the seed-to-seed relative MSE of the original.
+    let scenes: &[&str] = if quick {
+        &["glass_ball"]
+    } else {
+        &["glass_ball", "ring", "cornell_box"]
+    };
+    for name in scenes {
+        let Ok(scene) = paper(name) else { continue };
+        let (w, h) = (64, 48);
+        let Ok(base) = render(gpu, &scene, &small(&scene, w, h, 1), &|_, _, _| {}) else {
+            continue;
+        };
+        let Ok(other_seed) = render(gpu, &scene, &small(&scene, w, h, 2), &|_, _, _| {}) else {
+            continue;
+        };
+        let noise = compare(&other_seed.image, &base.image, None)
+            .map(|m| m.rel_mse)
+            .unwrap_or(f64::NAN);
+        for (label, s, t) in [
+            ("scaled by 1e-3", 1e-3f32, Vec3::ZERO),
+            ("scaled by 1e3", 1e3, Vec3::ZERO),
+            ("moved by 1e4", 1.0, Vec3::new(1e4, -1e4, 1e4)),
+        ] {
+            progress(&format!("{name} {label}"));
+            cases.push(case(
+                &format!("{name} {label}"),
+                "relative MSE against the original (limit: 2 x seed-to-seed)",
+                || {
+                    let moved = transformed(&scene, s, t);
+                    let (out, bad) = finite_render(gpu, &moved, &small(&moved, w, h, 1))?;
+                    let e = compare(&out.image, &base.image, None)
+                        .map_err(GpuError::Gl)?
+                        .rel_mse;
+                    let (o, m) =
+                        verdict(e <= 2.0 * noise, &bad, format!("seed-to-seed {noise:.5}"));
+                    Ok((e, o, m))
+                },
+            ));
+        }
+    }
+
+    // Size: sorting stays exact up to the largest sizes.
+    let sizes: &[u32] = if quick { &[18] } else { &[22, 24] };
+    for &k in sizes {
+        progress(&format!("sort 2^{k}"));
+        cases.push(case(
+            &format!("bitonic sort of 2^{k} pairs"),
+            "pairs out of order against a CPU sort",
+            || {
+                let n = 1usize << k;
+                let (w, h) = crate::photon::bitonic::sort_texture_size(n as u64);
+                let mut state = 99u32;
+                let keys: Vec<i32> = (0..n)
+                    .map(|_| {
+                        (crate::reference::random::pcg_hash({
+                            state = state.wrapping_add(1);
+                            state
+                        }) % 100_000) as i32
+                    })
+                    .collect();
+                let data: Vec<i32> = keys
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(i, &key)| [key, i as i32])
+                    .collect();
+                let tex = Texture::from_i32_format(gpu, w, h, TexFormat::Rg32I, &data)?;
+                let (sorted, _) = BitonicBuild::new(gpu)?.sort(tex)?;
+                let got = sorted.read_i32();
+                let mut cpu: Vec<(i32, i32)> = keys
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &k)| (k, i as i32))
+                    .collect();
+                cpu.sort_unstable();
+                let wrong = cpu
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, p)| got[2 * i] != p.0 || got[2 * i + 1] != p.1)
+                    .count();
+                Ok((
+                    wrong as f64,
+                    if wrong == 0 {
+                        Outcome::Pass
+                    } else {
+                        Outcome::Fail
+                    },
+                    String::new(),
+                ))
+            },
+        ));
+    }
+    cases.push(case(
+        "--faithful float addressing past 2^24",
+        "texels",
+        || {
+            let tex = Texture::new(gpu, 8192, 4096, TexFormat::Rg32I)?;
+            match BitonicBuild::with_addressing(gpu, true)?.sort(tex) {
+                Err(e) => Ok(((1u64 << 25) as f64, Outcome::Refused, e.to_string())),
+                Ok(_) => Ok((
+                    (1u64 << 25) as f64,
+                    Outcome::Fail,
+                    "sorted past 2^24 with float addresses".into(),
+                )),
+            }
+        },
+    ));
+
+    // Grids and search edges, on GLASS BALL at a small size.
+    if let Ok(glass) = paper("glass_ball") {
+        let mut grid_cases: Vec<(String, Scene, BuildMethod)> = Vec::new();
+        let mut g = glass.clone();
+        g.photon_map.grid_resolution = [1, 1, 1];
+        grid_cases.push((
+            "grid 1 x 1 x 1, all photons in one cell (bitonic)".into(),
+            g.clone(),
+            BuildMethod::Bitonic,
+        ));
+        grid_cases.push((
+            "grid 1 x 1 x 1, all photons in one cell (stencil, 16 of 5000 kept)".into(),
+            g,
+            BuildMethod::Stencil,
+        ));
+        if !quick {
+            let mut g = glass.clone();
+            g.photon_map.grid_resolution = [512, 512, 512];
+            grid_cases.push((
+                "grid 512^3 (stencil routing)".into(),
+                g.clone(),
+                BuildMethod::Stencil,
+            ));
+            grid_cases.push(("grid 512^3 (bitonic)".into(), g, BuildMethod::Bitonic));
+        }
+        let mut g = glass.clone();
+        g.photon_map.grid_bounds = Some((Vec3::new(10.0, 10.0, 10.0), Vec3::new(11.0, 11.0, 11.0)));
+        grid_cases.push((
+            "grid bounds that miss every photon".into(),
+            g,
+            BuildMethod::Bitonic,
+        ));
+        let mut g = glass.clone();
+        g.photon_map.k = 4096;
+        g.photon_map.photons_stored = 1000;
+        grid_cases.push(("k = 4096 with 1000 photons".into(), g, BuildMethod::Bitonic));
+        for (label, scene, build) in grid_cases {
+            progress(&label);
+            cases.push(case(&label, "mean image radiance", || {
+                let mut o = small(&scene, 64, 48, 1);
+                o.global = Some(GlobalIllumination {
+                    build,
+                    ..GlobalIllumination::default()
+                });
+                let (out, bad) = finite_render(gpu, &scene, &o)?;
+                let mean = out.image.mean()[0];
+                let (o, m) = verdict(true, &bad, String::new());
+                Ok((mean, o, m))
+            }));
+        }
+    }
+    for (label, text) in [
+        (
+            "maximum radius zero",
+            "max_radius = 0.25",
+            "max_radius = 0.0",
+        ),
+        (
+            "zero-area light",
+            "edge2 = [0.0, 0.0, 0.6]",
+            "edge2 = [0.0, 0.0, 0.0]",
+        ),
+        (
+            "NaN in a position",
+            "center = [0.0, 0.8, 0.0]",
+            "center = [0.0, nan, 0.0]",
+        ),
+    ]
+    .map(|(l, a, b)| (l, (a, b)))
+    {
+        cases.push(case(label, "-", || {
+            let src = std::fs::read_to_string(
+                std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/glass_ball.toml"),
+            )
+            .map_err(|e| GpuError::Gl(e.to_string()))?;
+            match load_scene_str(
+                &src.replace(text.0, text.1),
+                std::path::Path::new("scenes/glass_ball.toml"),
+            ) {
+                Err(e) => Ok((f64::NAN, Outcome::Refused, e.to_string())),
+                Ok(_) => Ok((f64::NAN, Outcome::Fail, "accepted".into())),
+            }
+        }));
+    }
+    cases.push(case(
+        "an empty photon map (no diffuse surface)",
+        "-",
+        || {
+            let text = FURNACE.replace(
+                "type = \"diffuse\", albedo = [0.5, 0.5, 0.5]",
+                "type = \"mirror\", reflectance = [0.5, 0.5, 0.5]",
+            );
+            let scene = load_scene_str(&text, std::path::Path::new("mirror_sphere.toml"))
+                .map_err(|e| GpuError::Gl(e.to_string()))?;
+            let out = render(gpu, &scene, &small(&scene, 32, 32, 1), &|_, _, _| {});
+            match out {
+                Err(e) => Ok((0.0, Outcome::Refused, e.to_string())),
+                Ok(o) => Ok((
+                    o.image.mean()[0],
+                    Outcome::Fail,
+                    "rendered without photons".into(),
+                )),
+            }
+        },
+    ));
+
+    // Paths: photons trapped in glass, grazing views, coincident surfaces.
+    let trapped = FURNACE.replace("type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }", "type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\nglass = { type = \"glass\", ior = 9.0 }")
+        + "[[shape]]\ntype = \"sphere\"\ncenter = [0.3, 0.0, -0.4]\nradius = 0.25\nmaterial = \"glass\"\n[[shape]]\ntype = \"parallelogram\"\ncorner = [-0.5, -0.5, -0.6]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [0.0, 1.0, 0.0]\nmaterial = \"wall\"\n[[shape]]\ntype = \"parallelogram\"\ncorner = [-0.5, -0.5, -0.6]\nedge1 = [0.0, 1.0, 0.0]\nedge2 = [1.0, 0.0, 0.0]\nmaterial = \"wall\"\n";
+    cases.push(case(
+        "glass of ior 9 (total internal reflection, trapped photons), coincident surfaces",
+        "mean image radiance",
+        || {
+            let scene = load_scene_str(&trapped, std::path::Path::new("trapped.toml"))
+                .map_err(|e| GpuError::Gl(e.to_string()))?;
+            let (out, bad) = finite_render(gpu, &scene, &small(&scene, 48, 48, 1))?;
+            let (o, m) = verdict(true, &bad, String::new());
+            Ok((out.image.mean()[0], o, m))
+        },
+    ));
+    if let Ok(ring) = paper("ring") {
+        cases.push(case(
+            "grazing view along the floor (RING, camera at y = 0.001)",
+            "mean image radiance",
+            || {
+                let mut s = ring.clone();
+                s.camera.position = Vec3::new(0.0, 0.001, 2.9);
+                s.camera.look_at = Vec3::new(0.0, 0.001, 0.0);
+                let (out, bad) = finite_render(gpu, &s, &small(&s, 64, 48, 1))?;
+                let (o, m) = verdict(true, &bad, String::new());
+                Ok((out.image.mean()[0], o, m))
+            },
+        ));
+    }
+
+    // Energy: the furnace.
+    progress("furnace");
+    cases.push(case(
+        "furnace: closed diffuse sphere, point light at its centre",
+        "mean radiance (expected rho I / (pi R^2 (1 - rho)))",
+        || {
+            let (mean, expected, tolerance, bad) = furnace(gpu)?;
+            let (o, m) = verdict(
+                (mean - expected).abs() <= tolerance,
+                &bad,
+                format!("expected {expected:.5} +- {tolerance:.5}"),
+            );
+            Ok((mean, o, m))
+        },
+    ));
+    cases
+}
