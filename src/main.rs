@@ -679,6 +679,13 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
             let scene = load_scene(&scene)?;
+            let ratio = scene.offset_ratio();
+            if ratio > 1000.0 && !quiet {
+                eprintln!(
+                    "warning: coordinates reach {ratio:.0} x the scene's size; 32-bit floats resolve them only to ~{:.0e} of it, so fine detail (sharp caustics) may blur: move the scene near the origin",
+                    ratio * f32::EPSILON
+                );
+            }
             let mut options = RenderOptions::for_scene(&scene);
             options.seed = seed;
             options.spp = spp;

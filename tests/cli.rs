@@ -616,3 +616,38 @@ fn reference_and_accuracy_bench_write_their_results() {
             && String::from_utf8_lossy(&none.stderr).contains("photonmap reference")
     );
 }
+
+#[test]
+fn far_from_the_origin_a_render_warns_about_precision() {
+    let d = tmp("far");
+    let text = std::fs::read_to_string(scene("ring"))
+        .unwrap()
+        .replace(
+            "position = [0.0, 3.2, 3.2]",
+            "position = [20000.0, 3.2, 3.2]",
+        )
+        .replace("look_at = [0.0, 0.0, 0.1]", "look_at = [20000.0, 0.0, 0.1]");
+    let far = d.join("far.toml");
+    std::fs::write(&far, text).unwrap();
+    let out = photonmap()
+        .args(["render", "--direct-only", "--width", "8", "--height", "6"])
+        .arg(&far)
+        .arg("-o")
+        .arg(d.join("x.png"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("warning: coordinates reach"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let near = photonmap()
+        .args(["render", "--direct-only", "--width", "8", "--height", "6"])
+        .arg(scene("ring"))
+        .arg("-o")
+        .arg(d.join("y.png"))
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&near.stderr).contains("warning"));
+}

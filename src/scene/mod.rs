@@ -243,6 +243,19 @@ impl Scene {
         }
     }
 
+    /// The largest coordinate magnitude over the scene's size: past ~1e3, f32
+    /// positions are coarse against the scene's own details, which blur
+    /// (stress suite: RING moved by 1e4 leaves the seed-to-seed tolerance).
+    pub fn offset_ratio(&self) -> f32 {
+        let (lo, hi) = self.bounds();
+        let far = lo
+            .abs()
+            .max(hi.abs())
+            .max_element()
+            .max(self.camera.position.abs().max_element());
+        far / self.size()
+    }
+
     pub fn has_specular(&self) -> bool {
         self.shapes
             .iter()
