@@ -286,3 +286,36 @@ fn mutated_obj_files_never_panic_and_accepted_ones_are_finite() {
     eprintln!("{accepted} mutated OBJ files accepted, {refused} refused");
     assert!(accepted > 0 && refused > 0);
 }
+
+/// The cargo-fuzz corpus (tests/fuzz/corpus/, kept minimised) replayed
+/// through the loaders on every test run, without libFuzzer.
+#[test]
+fn the_cargo_fuzz_corpus_loads_without_panics() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus");
+    let mut replayed = 0;
+    for entry in std::fs::read_dir(root.join("scene_toml")).unwrap().flatten() {
+        let bytes = std::fs::read(entry.path()).unwrap();
+        if let Ok(text) = std::str::from_utf8(&bytes) {
+            match catch_unwind(AssertUnwindSafe(|| load_scene_str(text, Path::new("corpus.toml")))) {
+                Err(_) => panic!("the loader panicked on {}", entry.path().display()),
+                Ok(Ok(scene)) => assert_sane(&scene, text),
+                Ok(Err(_)) => {}
+            }
+        }
+        replayed += 1;
+    }
+    let dir = std::env::temp_dir().join(format!("photonmap-corpus-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene_text = "[camera]\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"fuzz.obj\"\nmaterial = \"m\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
+    std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
+    for entry in std::fs::read_dir(root.join("obj_mesh")).unwrap().flatten() {
+        std::fs::copy(entry.path(), dir.join("fuzz.obj")).unwrap();
+        match catch_unwind(AssertUnwindSafe(|| load_scene(&dir.join("scene.toml")))) {
+            Err(_) => panic!("OBJ loading panicked on {}", entry.path().display()),
+            Ok(Ok(scene)) => assert_sane(&scene, &entry.path().display().to_string()),
+            Ok(Err(_)) => {}
+        }
+        replayed += 1;
+    }
+    assert!(replayed > 1000, "{replayed} corpus files");
+}
