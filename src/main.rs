@@ -96,6 +96,9 @@ enum Command {
         /// List every pass that runs and every pass skipped, with why.
         #[arg(long)]
         explain: bool,
+        /// Trace all max_bounces photon bounces even when none is left alive.
+        #[arg(long)]
+        all_bounces: bool,
         /// Also write the software reference (the paper's figure 7c: the same eye
         /// paths and photons, the estimate on the CPU) to this PNG.
         #[arg(long, value_name = "PNG")]
@@ -640,6 +643,7 @@ fn run(cli: Cli) -> Result<()> {
             snapshots,
             every,
             explain,
+            all_bounces,
             reference_software,
             reference_estimate,
         } => {
@@ -707,6 +711,7 @@ fn run(cli: Cli) -> Result<()> {
                     ..EstimateOptions::default()
                 },
                 snapshots: snapshots.map(|dir| Snapshots { dir, every }),
+                all_bounces,
             });
             let gpu = Gpu::new(cli.egl)?;
             let bar = if quiet {

@@ -293,10 +293,15 @@ fn mutated_obj_files_never_panic_and_accepted_ones_are_finite() {
 fn the_cargo_fuzz_corpus_loads_without_panics() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus");
     let mut replayed = 0;
-    for entry in std::fs::read_dir(root.join("scene_toml")).unwrap().flatten() {
+    for entry in std::fs::read_dir(root.join("scene_toml"))
+        .unwrap()
+        .flatten()
+    {
         let bytes = std::fs::read(entry.path()).unwrap();
         if let Ok(text) = std::str::from_utf8(&bytes) {
-            match catch_unwind(AssertUnwindSafe(|| load_scene_str(text, Path::new("corpus.toml")))) {
+            match catch_unwind(AssertUnwindSafe(|| {
+                load_scene_str(text, Path::new("corpus.toml"))
+            })) {
                 Err(_) => panic!("the loader panicked on {}", entry.path().display()),
                 Ok(Ok(scene)) => assert_sane(&scene, text),
                 Ok(Err(_)) => {}

@@ -205,3 +205,33 @@ fn the_random_texture_traces_the_same_photons_as_the_hash() {
     let c = records(&texture.trace(&scene, &textures, 4, 5000).unwrap());
     assert_ne!(a, c, "another seed, other photons");
 }
+
+#[test]
+fn bounces_stop_when_no_photon_is_left_and_the_image_does_not_change() {
+    use photonmap::render::{render, RenderOptions};
+    let gpu = common::gpu();
+    let text = photonmap::stress::FURNACE.replace("max_bounces = 24", "max_bounces = 64");
+    let scene = load_scene_str(&text, std::path::Path::new("furnace64.toml")).unwrap();
+    let run = |all: bool| {
+        let mut o = RenderOptions::for_scene(&scene);
+        (o.width, o.height) = (32, 32);
+        if let Some(gi) = &mut o.global {
+            gi.all_bounces = all;
+        }
+        render(&gpu, &scene, &o, &|_, _, _| {}).unwrap()
+    };
+    let (stopped, full) = (run(false), run(true));
+    assert_eq!(
+        stopped.image, full.image,
+        "stopping early must not change the image"
+    );
+    let frames = |r: &photonmap::render::RenderOutput| {
+        r.explain
+            .iter()
+            .find(|l| l.stage == "trace photons")
+            .unwrap()
+            .passes
+    };
+    assert_eq!(frames(&full), 65);
+    assert!(frames(&stopped) < 40, "{} frames traced", frames(&stopped));
+}

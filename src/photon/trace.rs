@@ -107,6 +107,10 @@ pub struct PhotonTracer {
     emit: Program,
     bounce: Program,
     count: Program,
+    probe: Program,
+    /// Stop bouncing once an occlusion query finds no live photon (issue 8's
+    /// skip; the frames not traced are left out of every build).
+    pub stop_when_dead: bool,
     random: RandomSource,
 }
 
@@ -128,6 +132,8 @@ impl PhotonTracer {
             emit: Program::fullscreen_with(gpu, "photon/emit.frag", &defines)?,
             bounce: Program::fullscreen_with(gpu, "photon/trace.frag", &defines)?,
             count: Program::fullscreen(gpu, "photon/stored_count.frag")?,
+            probe: Program::fullscreen(gpu, "photon/alive_probe.frag")?,
+            stop_when_dead: true,
             random,
         })
     }
@@ -187,6 +193,14 @@ impl PhotonTracer {
                 Some(self.random_texture(seed, width, frame_height, frames)?)
             }
         };
+        let alive_query = crate::gpu::OcclusionQuery::new(&self.gpu)?;
+        let mut probe_target: Option<Result<(Texture, Target), GpuError>> = None;
+        let mut frames_used = frames;
+        // Each pass timed alone: a timer query spanning the probes' occlusion
+        // read-backs reads nonsense on llvmpipe.
+        let mut gpu_seconds = 0.0;
+        self.gpu.finish();
+        let wall = std::time::Instant::now();
         query.begin();
         {
             let mut b = self.emit.bind();
@@ -199,6 +213,8 @@ impl PhotonTracer {
                 .int("u_width", w);
             self.gpu.draw_region(&target, 0, 0, w, fh);
         }
+        query.end();
+        gpu_seconds += query.seconds();
         for bounce in 1..frames as i32 {
             // The previous frame was drawn into these very textures.
             self.gpu.texture_barrier();
@@ -215,10 +231,45 @@ impl PhotonTracer {
                 .int("u_bounce", bounce)
                 .int("u_frame_height", fh)
                 .int("u_store_direct", scene.photon_map.store_direct as i32);
+            query.begin();
             self.gpu.draw_region(&target, 0, bounce * fh, w, fh);
+            query.end();
+            gpu_seconds += query.seconds();
+            if self.stop_when_dead && bounce + 1 < frames as i32 {
+                // How many photons of this frame go on? None: the rest is dark.
+                self.gpu.texture_barrier();
+                let probe_target = probe_target.get_or_insert_with(|| {
+                    Texture::new(&self.gpu, width, frame_height, TexFormat::R32F)
+                        .and_then(|t| Target::new(&self.gpu, &[&t]).map(|target| (t, target)))
+                });
+                let (_, probe) = probe_target
+                    .as_ref()
+                    .map_err(|e| GpuError::Gl(e.to_string()))?;
+                self.probe
+                    .bind()
+                    .texture("u_incoming", &incoming)
+                    .int("u_frame_row", bounce * fh);
+                self.gpu.set_color_writes(false);
+                alive_query.begin();
+                self.gpu.draw_fullscreen(probe);
+                alive_query.end();
+                self.gpu.set_color_writes(true);
+                if alive_query.samples() == 0 {
+                    frames_used = bounce as u32 + 1;
+                    break;
+                }
+            }
         }
-        query.end();
-        let gpu_seconds = query.seconds();
+
+        self.gpu.finish();
+        // llvmpipe has been seen to return nonsense (hours) for these timer
+        // queries once occlusion queries are read between them: a GPU time
+        // longer than the wall clock cannot be, so keep the wall clock then.
+        let gpu_seconds = if gpu_seconds > wall.elapsed().as_secs_f64() {
+            wall.elapsed().as_secs_f64()
+        } else {
+            gpu_seconds
+        };
         self.gpu.check("photon tracing")?;
         Ok(PhotonFrames {
             position,
@@ -228,7 +279,7 @@ impl PhotonTracer {
             target,
             width,
             frame_height,
-            frames,
+            frames: frames_used,
             emitted,
             photons_used: emitted,
             power_scale: 1.0,

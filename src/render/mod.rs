@@ -46,6 +46,8 @@ pub struct GlobalIllumination {
     pub faithful: bool,
     pub estimate: EstimateOptions,
     pub snapshots: Option<Snapshots>,
+    /// Trace every bounce up to max_bounces even when no photon is left alive.
+    pub all_bounces: bool,
 }
 
 impl Default for GlobalIllumination {
@@ -57,6 +59,7 @@ impl Default for GlobalIllumination {
             faithful: false,
             estimate: EstimateOptions::default(),
             snapshots: None,
+            all_bounces: false,
         }
     }
 }
@@ -337,7 +340,8 @@ pub fn render(
             } else {
                 RandomSource::Hash
             };
-            let photon_tracer = PhotonTracer::with_random(gpu, random)?;
+            let mut photon_tracer = PhotonTracer::with_random(gpu, random)?;
+            photon_tracer.stop_when_dead = !gi.all_bounces;
             progress("photons", 0, 1);
             gpu.finish();
             let t0 = std::time::Instant::now();
@@ -354,9 +358,14 @@ pub fn render(
                 stage: "trace photons".into(),
                 passes: frames.frames as usize,
                 ran: true,
-                why: format!(
-                    "emission + {} bounces; {} photons traced ({} attempts), the first {} kept: {} stored",
+                                why: format!(
+                    "emission + {} bounces{}; {} photons traced ({} attempts), the first {} kept: {} stored",
                     frames.frames - 1,
+                    if frames.frames < scene.photon_map.max_bounces + 1 {
+                        format!(" (stopped: no photon alive; {} more skipped)", scene.photon_map.max_bounces + 1 - frames.frames)
+                    } else {
+                        String::new()
+                    },
                     report.emitted,
                     report.attempts.len(),
                     report.photons_used,
