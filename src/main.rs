@@ -38,9 +38,9 @@ enum Command {
     Render {
         /// Scene file (TOML; see README.md).
         scene: PathBuf,
-        /// Output PNG path.
+        /// Output PNG path (with --camera-path: the frames go to --out instead).
         #[arg(short, long)]
-        output: PathBuf,
+        output: Option<PathBuf>,
         /// Also write linear float RGB to this OpenEXR path.
         #[arg(long)]
         exr: Option<PathBuf>,
@@ -96,6 +96,13 @@ enum Command {
         /// List every pass that runs and every pass skipped, with why.
         #[arg(long)]
         explain: bool,
+        /// Render a fly-through: a TOML of key cameras (and `frames = N`), all on one
+        /// photon map, into --out as frame_NNNN.png.
+        #[arg(long, value_name = "TOML")]
+        camera_path: Option<PathBuf>,
+        /// The folder for --camera-path frames.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
         /// Trace all max_bounces photon bounces even when none is left alive.
         #[arg(long)]
         all_bounces: bool,
@@ -644,6 +651,8 @@ fn run(cli: Cli) -> Result<()> {
             every,
             explain,
             all_bounces,
+            camera_path,
+            out,
             reference_software,
             reference_estimate,
         } => {
@@ -653,6 +662,21 @@ fn run(cli: Cli) -> Result<()> {
                     bail!("--reference-software needs photons: drop --direct-only");
                 }
             }
+            let output = match (&output, &camera_path, &out) {
+                (Some(o), None, _) => o.clone(),
+                (None, Some(_), Some(dir)) => {
+                    if !dir.is_dir() {
+                        bail!("--out {}: the folder does not exist", dir.display());
+                    }
+                    // Not written: each frame goes to the folder as it is made.
+                    dir.join("frames.png")
+                }
+                (None, Some(_), None) => bail!("--camera-path needs --out DIR for its frames"),
+                (Some(_), Some(_), _) => bail!(
+                    "give either -o (one image) or --camera-path with --out (frames), not both"
+                ),
+                (None, None, _) => bail!("-o OUTPUT.png is required"),
+            };
             check_output(&output, "png", "-o")?;
             if let Some(e) = &exr {
                 check_output(e, "exr", "--exr")?;
@@ -736,7 +760,31 @@ fn run(cli: Cli) -> Result<()> {
                 bar.set_length(total.max(1));
                 bar.set_position(done);
             };
-            let out = render::render(&gpu, &scene, &options, &progress)?;
+            let cameras = match &camera_path {
+                Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera)?,
+                None => vec![scene.camera.clone()],
+            };
+            let frame_dir = out.clone();
+            let mut frame_times = Vec::new();
+            let frame_clock = std::time::Instant::now();
+            let mut on_frame = |i: usize, img: &Image| -> Result<(), String> {
+                if let Some(dir) = &frame_dir {
+                    let file = dir.join(format!("frame_{i:04}.png"));
+                    render::image::write_atomically(&file, &img.png_bytes()?)?;
+                    frame_times.push(frame_clock.elapsed().as_secs_f64());
+                }
+                Ok(())
+            };
+            let out =
+                render::render_views(&gpu, &scene, &options, &cameras, &progress, &mut on_frame)?;
+            if let Some(dir) = &frame_dir {
+                let index = serde_json::json!({ "frames": cameras.len(), "seconds_since_start": frame_times });
+                render::image::write_atomically(
+                    &dir.join("frames.json"),
+                    index.to_string().as_bytes(),
+                )
+                .map_err(anyhow::Error::msg)?;
+            }
             bar.finish_and_clear();
             if out.image.has_non_finite() {
                 bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
@@ -747,7 +795,9 @@ fn run(cli: Cli) -> Result<()> {
                 .map(|_| out.image.exr_bytes())
                 .transpose()
                 .map_err(anyhow::Error::msg)?;
-            render::image::write_atomically(&output, &png).map_err(anyhow::Error::msg)?;
+            if camera_path.is_none() {
+                render::image::write_atomically(&output, &png).map_err(anyhow::Error::msg)?;
+            }
             if let (Some(path), Some(bytes)) = (&exr, exr_bytes) {
                 render::image::write_atomically(path, &bytes).map_err(anyhow::Error::msg)?;
             }

@@ -651,3 +651,71 @@ fn far_from_the_origin_a_render_warns_about_precision() {
         .unwrap();
     assert!(!String::from_utf8_lossy(&near.stderr).contains("warning"));
 }
+
+#[test]
+fn a_camera_path_renders_every_frame_on_one_photon_map() {
+    let d = tmp("path");
+    let path = d.join("path.toml");
+    std::fs::write(&path, "frames = 3\n[[key]]\nposition = [0.0, 2.0, 5.5]\nlook_at = [0.0, 0.6, 0.0]\n[[key]]\nposition = [3.0, 1.5, 3.0]\nlook_at = [0.0, 0.4, 0.0]\n").unwrap();
+    let frames = d.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let out = photonmap()
+        .args([
+            "render",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--explain",
+            "--camera-path",
+        ])
+        .arg(&path)
+        .arg("--out")
+        .arg(&frames)
+        .arg(scene("glass_ball"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    for i in 0..3 {
+        assert!(
+            frames.join(format!("frame_{i:04}.png")).is_file(),
+            "frame {i}"
+        );
+    }
+    // One photon trace and one map for the three frames, three estimates.
+    assert_eq!(err.matches("run  trace photons").count(), 1, "{err}");
+    assert_eq!(err.matches("run  radiance estimate").count(), 3, "{err}");
+    let first = std::fs::read(frames.join("frame_0000.png")).unwrap();
+    assert_ne!(
+        first,
+        std::fs::read(frames.join("frame_0002.png")).unwrap(),
+        "the camera moved"
+    );
+    // The first key is the scene's own camera: frame 0 is the plain render.
+    let single = d.join("single.png");
+    assert!(photonmap()
+        .args(["render", "--quiet", "--width", "48", "--height", "36"])
+        .arg(scene("glass_ball"))
+        .arg("-o")
+        .arg(&single)
+        .status()
+        .unwrap()
+        .success());
+    assert_eq!(first, std::fs::read(&single).unwrap());
+    // Bad paths are refused by name.
+    std::fs::write(
+        &path,
+        "[[key]]\nposition = [0.0, 0.0, 0.0]\nlook_at = [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    let bad = photonmap()
+        .args(["render", "--camera-path"])
+        .arg(&path)
+        .arg("--out")
+        .arg(&frames)
+        .arg(scene("glass_ball"))
+        .output()
+        .unwrap();
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("key[0]"));
+}

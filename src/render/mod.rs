@@ -156,6 +156,7 @@ pub fn sample_seed(seed: u32, sample: u32) -> u32 {
 fn trace_eye_paths(
     gpu: &Gpu,
     scene: &Scene,
+    camera: &crate::scene::Camera,
     textures: &SceneTextures,
     tracer: &RayTracer,
     direct: &DirectLight,
@@ -197,7 +198,7 @@ fn trace_eye_paths(
         progress("ray tracing", done, total);
     };
     query.begin();
-    tracer.eye_rays(&scene.camera, options, sample, seed);
+    tracer.eye_rays(camera, options, sample, seed);
     query.end();
     tick(timings, "eye rays", &query);
     for depth in 0..depths {
@@ -241,6 +242,30 @@ pub fn render(
     options: &RenderOptions,
     progress: Progress<'_>,
 ) -> Result<RenderOutput, GpuError> {
+    render_views(
+        gpu,
+        scene,
+        options,
+        std::slice::from_ref(&scene.camera),
+        progress,
+        &mut |_, _| Ok(()),
+    )
+}
+
+/// Renders the scene from each camera in turn on one photon map (the paper's
+/// figure 1: photons are traced and the map built only when geometry or lights
+/// change). `on_frame` receives each view's image; the output holds the last.
+pub fn render_views(
+    gpu: &Gpu,
+    scene: &Scene,
+    options: &RenderOptions,
+    cameras: &[crate::scene::Camera],
+    progress: Progress<'_>,
+    on_frame: &mut dyn FnMut(usize, &Image) -> Result<(), String>,
+) -> Result<RenderOutput, GpuError> {
+    if cameras.is_empty() {
+        return Err(GpuError::Gl("no camera to render from".into()));
+    }
     let max = crate::gpu::max_texture_size(gpu);
     if options.width > max || options.height > max {
         return Err(GpuError::Gl(format!(
@@ -418,138 +443,148 @@ pub fn render(
         None => None,
     };
 
-    let mut sum: Option<Image> = None;
     let mut snapshots = Vec::new();
     let mut stats = None;
-    for sample in 0..spp {
-        trace_eye_paths(
-            gpu,
-            scene,
-            &textures,
-            &tracer,
-            &direct,
-            options,
-            sample,
-            &mut timings,
-            progress,
-        )?;
-        let image = match (&options.global, &map, &estimate) {
-            (Some(gi), Some(map), Some(estimate)) => {
-                let (k, max_radius) = (scene.photon_map.k, scene.photon_map.max_radius);
-                let mut snapshot_seconds = 0.0;
-                let mut last_snapshot = (0u32, 0.0f64);
-                let mut snapshot_error = None;
-                let estimate_options = EstimateOptions {
-                    float_addressing: gi.faithful,
-                    ..gi.estimate.clone()
-                };
-                let snap_config = if sample == 0 {
-                    gi.snapshots.as_ref()
-                } else {
-                    None
-                };
-                let s = estimate.run(map, &direct, k, max_radius, &estimate_options, &mut |r| {
-                    progress(
-                        "radiance estimate",
-                        r.query_pixels - r.searching,
-                        r.query_pixels,
-                    );
-                    let Some(snap) = snap_config else { return };
-                    let seconds = r.elapsed_seconds - snapshot_seconds;
-                    let due = match snap.every {
-                        SnapshotEvery::Passes(n) => {
-                            r.pass == 0 || r.pass >= last_snapshot.0 + n.max(1)
-                        }
-                        SnapshotEvery::Seconds(s) => r.pass == 0 || seconds >= last_snapshot.1 + s,
+    let mut last_image = None;
+    for (view, camera) in cameras.iter().enumerate() {
+        let mut sum: Option<Image> = None;
+        for sample in 0..spp {
+            trace_eye_paths(
+                gpu,
+                scene,
+                camera,
+                &textures,
+                &tracer,
+                &direct,
+                options,
+                sample,
+                &mut timings,
+                progress,
+            )?;
+            let image = match (&options.global, &map, &estimate) {
+                (Some(gi), Some(map), Some(estimate)) => {
+                    let (k, max_radius) = (scene.photon_map.k, scene.photon_map.max_radius);
+                    let mut snapshot_seconds = 0.0;
+                    let mut last_snapshot = (0u32, 0.0f64);
+                    let mut snapshot_error = None;
+                    let estimate_options = EstimateOptions {
+                        float_addressing: gi.faithful,
+                        ..gi.estimate.clone()
                     };
-                    if !due || snapshot_error.is_some() {
-                        return;
+                    let snap_config = if sample == 0 && view == 0 {
+                        gi.snapshots.as_ref()
+                    } else {
+                        None
+                    };
+                    let s =
+                        estimate.run(map, &direct, k, max_radius, &estimate_options, &mut |r| {
+                            progress(
+                                "radiance estimate",
+                                r.query_pixels - r.searching,
+                                r.query_pixels,
+                            );
+                            let Some(snap) = snap_config else { return };
+                            let seconds = r.elapsed_seconds - snapshot_seconds;
+                            let due = match snap.every {
+                                SnapshotEvery::Passes(n) => {
+                                    r.pass == 0 || r.pass >= last_snapshot.0 + n.max(1)
+                                }
+                                SnapshotEvery::Seconds(s) => {
+                                    r.pass == 0 || seconds >= last_snapshot.1 + s
+                                }
+                            };
+                            if !due || snapshot_error.is_some() {
+                                return;
+                            }
+                            let t0 = std::time::Instant::now();
+                            let img = r
+                                .estimate
+                                .compose(&textures, &direct, k, max_radius, true, true);
+                            let file = format!("snapshot_{:04}.png", snapshots.len());
+                            match img
+                                .png_bytes()
+                                .and_then(|b| image::write_atomically(&snap.dir.join(&file), &b))
+                            {
+                                Ok(()) => snapshots.push(SnapshotRecord {
+                                    file,
+                                    pass: r.pass,
+                                    seconds,
+                                    searching_pixels: r.searching,
+                                }),
+                                Err(e) => snapshot_error = Some(e),
+                            }
+                            last_snapshot = (r.pass, seconds);
+                            snapshot_seconds += t0.elapsed().as_secs_f64();
+                        })?;
+                    if let Some(e) = snapshot_error {
+                        return Err(GpuError::Gl(format!("writing a snapshot: {e}")));
                     }
-                    let t0 = std::time::Instant::now();
-                    let img = r
-                        .estimate
-                        .compose(&textures, &direct, k, max_radius, true, true);
-                    let file = format!("snapshot_{:04}.png", snapshots.len());
-                    match img
-                        .png_bytes()
-                        .and_then(|b| image::write_atomically(&snap.dir.join(&file), &b))
-                    {
-                        Ok(()) => snapshots.push(SnapshotRecord {
-                            file,
-                            pass: r.pass,
-                            seconds,
-                            searching_pixels: r.searching,
-                        }),
-                        Err(e) => snapshot_error = Some(e),
+                    timings.add_both(
+                        "radiance estimate",
+                        s.gpu_seconds,
+                        s.wall_seconds - snapshot_seconds,
+                        s.passes as usize,
+                    );
+                    let image = estimate.compose(&textures, &direct, k, max_radius, true, true);
+                    if let Some(snap) = snap_config {
+                        let final_file = format!("snapshot_{:04}.png", snapshots.len());
+                        image
+                            .png_bytes()
+                            .and_then(|b| image::write_atomically(&snap.dir.join(&final_file), &b))
+                            .map_err(GpuError::Gl)?;
+                        snapshots.push(SnapshotRecord {
+                            file: final_file,
+                            pass: s.passes,
+                            seconds: s.wall_seconds - snapshot_seconds,
+                            searching_pixels: 0,
+                        });
+                        let index = serde_json::to_string_pretty(&snapshots).unwrap_or_default();
+                        image::write_atomically(&snap.dir.join("snapshots.json"), index.as_bytes())
+                            .map_err(GpuError::Gl)?;
                     }
-                    last_snapshot = (r.pass, seconds);
-                    snapshot_seconds += t0.elapsed().as_secs_f64();
-                })?;
-                if let Some(e) = snapshot_error {
-                    return Err(GpuError::Gl(format!("writing a snapshot: {e}")));
-                }
-                timings.add_both(
-                    "radiance estimate",
-                    s.gpu_seconds,
-                    s.wall_seconds - snapshot_seconds,
-                    s.passes as usize,
-                );
-                let image = estimate.compose(&textures, &direct, k, max_radius, true, true);
-                if let Some(snap) = snap_config {
-                    let final_file = format!("snapshot_{:04}.png", snapshots.len());
-                    image
-                        .png_bytes()
-                        .and_then(|b| image::write_atomically(&snap.dir.join(&final_file), &b))
-                        .map_err(GpuError::Gl)?;
-                    snapshots.push(SnapshotRecord {
-                        file: final_file,
-                        pass: s.passes,
-                        seconds: s.wall_seconds - snapshot_seconds,
-                        searching_pixels: 0,
+                    explain.push(ExplainLine {
+                        stage: "radiance estimate".into(),
+                        passes: s.passes as usize,
+                        ran: true,
+                        why: format!(
+                            "kNN-grid, k = {k}, max radius {max_radius}, {} steps per pixel per pass, {:?}; {} of {} pixels have a diffuse hit, {} tile draws{}",
+                            gi.estimate.budget,
+                            gi.estimate.mode,
+                            s.query_pixels,
+                            options.width as u64 * options.height as u64,
+                            s.tile_draws,
+                            if spp > 1 { format!(" (sample {})", sample + 1) } else { String::new() }
+                        ),
                     });
-                    let index = serde_json::to_string_pretty(&snapshots).unwrap_or_default();
-                    image::write_atomically(&snap.dir.join("snapshots.json"), index.as_bytes())
-                        .map_err(GpuError::Gl)?;
+                    stats = Some(s);
+                    image
                 }
-                explain.push(ExplainLine {
-                    stage: "radiance estimate".into(),
-                    passes: s.passes as usize,
-                    ran: true,
-                    why: format!(
-                        "kNN-grid, k = {k}, max radius {max_radius}, {} steps per pixel per pass, {:?}; {} of {} pixels have a diffuse hit, {} tile draws{}",
-                        gi.estimate.budget,
-                        gi.estimate.mode,
-                        s.query_pixels,
-                        options.width as u64 * options.height as u64,
-                        s.tile_draws,
-                        if spp > 1 { format!(" (sample {})", sample + 1) } else { String::new() }
-                    ),
-                });
-                stats = Some(s);
-                image
-            }
-            _ => direct.read_radiance(),
-        };
-        sum = Some(match sum {
-            None => image,
-            Some(mut acc) => {
-                for (a, p) in acc.pixels.iter_mut().zip(&image.pixels) {
-                    for c in 0..3 {
-                        a[c] += p[c];
+                _ => direct.read_radiance(),
+            };
+            sum = Some(match sum {
+                None => image,
+                Some(mut acc) => {
+                    for (a, p) in acc.pixels.iter_mut().zip(&image.pixels) {
+                        for c in 0..3 {
+                            a[c] += p[c];
+                        }
                     }
+                    acc
                 }
-                acc
-            }
-        });
-    }
-    let mut image = sum.expect("at least one sample");
-    if spp > 1 {
-        for p in &mut image.pixels {
-            for c in p.iter_mut() {
-                *c /= spp as f32;
+            });
+        }
+        let mut image = sum.expect("at least one sample");
+        if spp > 1 {
+            for p in &mut image.pixels {
+                for c in p.iter_mut() {
+                    *c /= spp as f32;
+                }
             }
         }
+        on_frame(view, &image).map_err(GpuError::Gl)?;
+        last_image = Some(image);
     }
+    let image = last_image.expect("at least one camera");
     timings.wall_seconds = wall.elapsed().as_secs_f64();
     let passes = timings.stages.iter().map(|s| s.passes).sum();
     let state = RenderState {

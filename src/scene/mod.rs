@@ -1,6 +1,7 @@
 //! The scene: a plain-Rust model of camera, shapes, materials, lights and the
 //! paper's per-scene parameters, loaded from TOML (+ OBJ) and validated.
 
+pub mod camera_path;
 pub mod load;
 pub mod pack;
 
