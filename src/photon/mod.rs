@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod bitonic;
+pub mod fit;
 pub mod stencil_routing;
 pub mod trace;
 

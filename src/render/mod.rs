@@ -397,7 +397,35 @@ pub fn render_views(
                     report.stored
                 ),
             });
-            let grid = Grid::for_scene(scene);
+            // The scene's grid bounds, or (when it fixes none) the box of the photons.
+            let grid = match scene.photon_map.grid_bounds {
+                Some(_) => Grid::for_scene(scene),
+                None => match crate::photon::fit::photon_bounds(gpu, &frames)? {
+                    Some(b) => crate::photon::fit::fitted_grid(
+                        b,
+                        scene.size(),
+                        scene.photon_map.grid_resolution,
+                        scene.photon_map.max_radius,
+                    ),
+                    None => Grid::for_scene(scene),
+                },
+            };
+            explain.push(ExplainLine {
+                stage: "grid bounds".into(),
+                passes: 0,
+                ran: true,
+                why: format!(
+                    "{:?} cells over {:?}..{:?}, {}",
+                    grid.resolution,
+                    grid.min.to_array(),
+                    grid.max.to_array(),
+                    if scene.photon_map.grid_bounds.is_some() {
+                        "as the scene fixes them"
+                    } else {
+                        "fitted to the stored photons"
+                    }
+                ),
+            });
             let mut build_timings = Timings::default();
             let feed = if gi.faithful {
                 VertexFeed::Readback
