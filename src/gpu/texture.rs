@@ -170,10 +170,10 @@ impl Texture {
         }
     }
 
-    /// Reads a mip level of an integer texture (row 0 first).
-    pub fn read_i32_texel(&self, level: u32) -> Vec<i32> {
+    /// Reads mip level `level` back (row 0 first) into T, `channels` values a texel.
+    fn read_level<T: Copy + Default>(&self, level: u32) -> Vec<T> {
         let (w, h) = ((self.width >> level).max(1), (self.height >> level).max(1));
-        let mut out = vec![0i32; (w * h) as usize * self.format.channels()];
+        let mut out = vec![T::default(); (w * h) as usize * self.format.channels()];
         let (_, fmt, ty) = self.format.gl();
         unsafe {
             let gl = self.gpu.gl();
@@ -188,6 +188,24 @@ impl Texture {
             );
         }
         out
+    }
+
+    /// Reads the whole texture back (row 0 first) as floats.
+    pub fn read_f32(&self) -> Vec<f32> {
+        assert!(!self.is_integer(), "read_f32 on an integer texture");
+        self.read_level(0)
+    }
+
+    /// Reads an integer texture back (row 0 first), `channels` ints a texel.
+    pub fn read_i32(&self) -> Vec<i32> {
+        assert!(self.is_integer(), "read_i32 on a float texture");
+        self.read_level(0)
+    }
+
+    /// Reads a mip level of an integer texture (row 0 first).
+    pub fn read_i32_texel(&self, level: u32) -> Vec<i32> {
+        assert!(self.is_integer(), "read_i32_texel on a float texture");
+        self.read_level(level)
     }
 
     pub fn is_integer(&self) -> bool {
@@ -223,45 +241,6 @@ impl Texture {
             );
         }
         self.gpu.check("uploading a float texture")
-    }
-
-    /// Reads the whole texture back (row 0 first) as floats.
-    pub fn read_f32(&self) -> Vec<f32> {
-        assert!(!self.is_integer(), "read_f32 on an integer texture");
-        let mut out = vec![0f32; self.texel_count() * self.format.channels()];
-        let (_, fmt, ty) = self.format.gl();
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
-            gl.get_tex_image(
-                glow::TEXTURE_2D,
-                0,
-                fmt,
-                ty,
-                glow::PixelPackData::Slice(Some(bytes_of_mut(&mut out))),
-            );
-        }
-        out
-    }
-
-    pub fn read_i32(&self) -> Vec<i32> {
-        assert!(self.is_integer(), "read_i32 on a float texture");
-        let mut out = vec![0i32; self.texel_count() * self.format.channels()];
-        let (_, fmt, ty) = self.format.gl();
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
-            gl.get_tex_image(
-                glow::TEXTURE_2D,
-                0,
-                fmt,
-                ty,
-                glow::PixelPackData::Slice(Some(bytes_of_mut(&mut out))),
-            );
-        }
-        out
     }
 }
 
