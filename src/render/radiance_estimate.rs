@@ -79,6 +79,10 @@ pub struct RadianceEstimate {
     init: Program,
     mask: Program,
     compose: Program,
+    /// Search programs by (routed map, tiles, float addressing), compiled on
+    /// first use: a render with several eye samples or camera views runs the
+    /// search many times and must not compile it each time.
+    search: std::cell::RefCell<std::collections::HashMap<(bool, bool, bool), std::rc::Rc<Program>>>,
     width: u32,
     height: u32,
 }
@@ -125,6 +129,7 @@ impl RadianceEstimate {
             init: Program::fullscreen(gpu, "render/knn_init.frag")?,
             mask: Program::fullscreen(gpu, "render/knn_mask.frag")?,
             compose: Program::fullscreen(gpu, "render/compose.frag")?,
+            search: Default::default(),
             width,
             height,
         })
@@ -145,7 +150,21 @@ impl RadianceEstimate {
         let wall = std::time::Instant::now();
         let routed = matches!(map, PhotonMap::Routed(_));
         let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
-        let search = search_program(&self.gpu, routed, tiled, options.float_addressing)?;
+        let key = (routed, tiled, options.float_addressing);
+        let cached = self.search.borrow().get(&key).cloned();
+        let search = match cached {
+            Some(p) => p,
+            None => {
+                let p = std::rc::Rc::new(search_program(
+                    &self.gpu,
+                    routed,
+                    tiled,
+                    options.float_addressing,
+                )?);
+                self.search.borrow_mut().insert(key, p.clone());
+                p
+            }
+        };
         let timer = TimerQuery::new(&self.gpu)?;
         let mut stats = EstimateStats::default();
 
