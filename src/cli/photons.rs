@@ -5,8 +5,7 @@ use anyhow::Result;
 
 use photonmap::gpu::Gpu;
 use photonmap::photon::{
-    BitonicBuild, BuildMethod, Grid, PhotonTracer, RandomSource, StencilRouting, TraceReport,
-    VertexFeed,
+    BitonicBuild, BuildMethod, PhotonTracer, RandomSource, StencilRouting, TraceReport, VertexFeed,
 };
 use photonmap::render::Timings;
 use photonmap::scene::pack::SceneTextures;
@@ -57,7 +56,7 @@ pub fn trace_and_build(gpu: &Gpu, scene: &Scene, o: &PhotonOptions) -> Result<Ph
     let (frames, trace) = tracer.trace_to_stored(scene, &textures, o.seed)?;
     // The kept trace; earlier attempts (choosing the emitted count) are in `trace`.
     timings.add("trace photons", trace.gpu_seconds, frames.frames as usize);
-    let grid = Grid::for_scene(scene);
+    let grid = photonmap::photon::fit::grid_for(gpu, scene, &frames)?;
     let feed = if o.faithful {
         VertexFeed::Readback
     } else {

@@ -8,6 +8,28 @@ use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture};
 
 use super::{Grid, PhotonFrames};
 
+/// The grid a scene's photon map uses: the bounds the scene fixes, else the
+/// box of the stored photons (`fitted_grid`), else the scene's own box. Every
+/// build (render, `photonmap photons`) takes its grid from here.
+pub fn grid_for(
+    gpu: &Gpu,
+    scene: &crate::scene::Scene,
+    frames: &PhotonFrames,
+) -> Result<Grid, GpuError> {
+    if scene.photon_map.grid_bounds.is_some() {
+        return Ok(Grid::for_scene(scene));
+    }
+    Ok(match photon_bounds(gpu, frames)? {
+        Some(b) => fitted_grid(
+            b,
+            scene.size(),
+            scene.photon_map.grid_resolution,
+            scene.photon_map.max_radius,
+        ),
+        None => Grid::for_scene(scene),
+    })
+}
+
 /// The box of the stored photons in use, or None if there are none.
 pub fn photon_bounds(gpu: &Gpu, frames: &PhotonFrames) -> Result<Option<(Vec3, Vec3)>, GpuError> {
     let base = Program::fullscreen(gpu, "photon/bounds_base.frag")?;

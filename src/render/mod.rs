@@ -9,8 +9,7 @@ pub mod timing;
 
 use crate::gpu::{Gpu, GpuError, TimerQuery};
 use crate::photon::{
-    BitonicBuild, BuildMethod, Grid, PhotonMap, PhotonTracer, RandomSource, StencilRouting,
-    VertexFeed,
+    BitonicBuild, BuildMethod, PhotonMap, PhotonTracer, RandomSource, StencilRouting, VertexFeed,
 };
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
@@ -139,6 +138,44 @@ pub struct RenderState {
 /// Something that wants to hear about progress: (stage, done, total).
 pub type Progress<'a> = &'a dyn Fn(&str, u64, u64);
 
+/// The ray tracer's passes for a scene, derived once from it and the options.
+struct PassPlan {
+    specular: bool,
+    has_area: bool,
+    /// Intersect passes per eye sample: one per specular depth.
+    depths: u32,
+    /// Shadow-ray passes per depth: batches of area-light samples, or one.
+    direct_passes: u32,
+}
+
+impl PassPlan {
+    fn new(scene: &Scene, options: &RenderOptions) -> Self {
+        let specular = scene.has_specular();
+        let has_area = scene
+            .lights
+            .iter()
+            .any(|l| matches!(l, crate::scene::Light::Area { .. }));
+        Self {
+            specular,
+            has_area,
+            // With nothing specular, an eye path ends at its first hit.
+            depths: if specular {
+                scene.render.max_specular_depth + 1
+            } else {
+                1
+            },
+            direct_passes: if has_area {
+                scene
+                    .render
+                    .shadow_rays
+                    .div_ceil(options.shadow_batch.max(1))
+            } else {
+                1
+            },
+        }
+    }
+}
+
 /// The seed of eye sample `sample`: the render's own for sample 0 (so one
 /// sample per pixel is exactly the paper's render), a hash of it for the rest.
 pub fn sample_seed(seed: u32, sample: u32) -> u32 {
@@ -166,23 +203,11 @@ fn trace_eye_paths(
     progress: Progress<'_>,
 ) -> Result<(), GpuError> {
     let seed = sample_seed(options.seed, sample);
-    let depths = if scene.has_specular() {
-        scene.render.max_specular_depth + 1
-    } else {
-        1
-    };
-    let has_area = scene
-        .lights
-        .iter()
-        .any(|l| matches!(l, crate::scene::Light::Area { .. }));
-    let direct_passes = if has_area {
-        scene
-            .render
-            .shadow_rays
-            .div_ceil(options.shadow_batch.max(1))
-    } else {
-        1
-    };
+    let PassPlan {
+        depths,
+        direct_passes,
+        ..
+    } = PassPlan::new(scene, options);
     let total = (1 + depths as usize * (1 + direct_passes as usize) + (depths as usize - 1)) as u64;
     let query = TimerQuery::new(gpu)?;
     let mut done = 0u64;
@@ -280,24 +305,12 @@ pub fn render_views(
     let mut timings = Timings::default();
     let wall = std::time::Instant::now();
 
-    let specular = scene.has_specular();
-    let depths = if specular {
-        scene.render.max_specular_depth + 1
-    } else {
-        1
-    };
-    let has_area = scene
-        .lights
-        .iter()
-        .any(|l| matches!(l, crate::scene::Light::Area { .. }));
-    let direct_passes = if has_area {
-        scene
-            .render
-            .shadow_rays
-            .div_ceil(options.shadow_batch.max(1))
-    } else {
-        1
-    };
+    let PassPlan {
+        specular,
+        has_area,
+        depths,
+        direct_passes,
+    } = PassPlan::new(scene, options);
     let mut explain = vec![
         ExplainLine {
             stage: "eye rays".into(),
@@ -398,18 +411,7 @@ pub fn render_views(
                 ),
             });
             // The scene's grid bounds, or (when it fixes none) the box of the photons.
-            let grid = match scene.photon_map.grid_bounds {
-                Some(_) => Grid::for_scene(scene),
-                None => match crate::photon::fit::photon_bounds(gpu, &frames)? {
-                    Some(b) => crate::photon::fit::fitted_grid(
-                        b,
-                        scene.size(),
-                        scene.photon_map.grid_resolution,
-                        scene.photon_map.max_radius,
-                    ),
-                    None => Grid::for_scene(scene),
-                },
-            };
+            let grid = crate::photon::fit::grid_for(gpu, scene, &frames)?;
             explain.push(ExplainLine {
                 stage: "grid bounds".into(),
                 passes: 0,
