@@ -23,6 +23,9 @@ impl Rng {
     }
 }
 
+/// A scene whose one shape is the mesh `fuzz.obj` beside it.
+const MESH_SCENE: &str = "[camera]\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"fuzz.obj\"\nmaterial = \"m\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
+
 const SPECIAL: [&str; 14] = [
     "nan",
     "inf",
@@ -261,8 +264,7 @@ fn mutated_obj_files_never_panic_and_accepted_ones_are_finite() {
     assert!(seeds.len() >= 2);
     let dir = std::env::temp_dir().join(format!("photonmap-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let scene_text = "[camera]\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"fuzz.obj\"\nmaterial = \"m\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
-    std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
+    std::fs::write(dir.join("scene.toml"), MESH_SCENE).unwrap();
     let mut rng = Rng(seed(0x0b1_f00d));
     let (mut accepted, mut refused) = (0, 0);
     for _ in 0..iterations() {
@@ -311,8 +313,7 @@ fn the_cargo_fuzz_corpus_loads_without_panics() {
     }
     let dir = std::env::temp_dir().join(format!("photonmap-corpus-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let scene_text = "[camera]\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"fuzz.obj\"\nmaterial = \"m\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
-    std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
+    std::fs::write(dir.join("scene.toml"), MESH_SCENE).unwrap();
     for entry in std::fs::read_dir(root.join("obj_mesh")).unwrap().flatten() {
         std::fs::copy(entry.path(), dir.join("fuzz.obj")).unwrap();
         match catch_unwind(AssertUnwindSafe(|| load_scene(&dir.join("scene.toml")))) {
