@@ -106,6 +106,10 @@ enum Command {
         /// Trace all max_bounces photon bounces even when none is left alive.
         #[arg(long)]
         all_bounces: bool,
+        /// Scenes that store caustics only: emit photons in every direction
+        /// instead of aiming them by projection maps (to compare).
+        #[arg(long)]
+        no_projection_map: bool,
         /// Also write the software reference (the paper's figure 7c: the same eye
         /// paths and photons, the estimate on the CPU) to this PNG.
         #[arg(long, value_name = "PNG")]
@@ -129,6 +133,10 @@ enum Command {
         /// The paper's 2003 constraints: a texture of random numbers, read-back before routing.
         #[arg(long)]
         faithful: bool,
+        /// Scenes that store caustics only: emit photons in every direction
+        /// instead of aiming them by projection maps (to compare).
+        #[arg(long)]
+        no_projection_map: bool,
         #[arg(long, default_value_t = 1)]
         seed: u32,
         /// As JSON on stdout.
@@ -305,6 +313,7 @@ fn run(cli: Cli) -> Result<()> {
             stencil_m,
             feed,
             faithful,
+            no_projection_map,
             seed,
             json,
         } => {
@@ -316,6 +325,7 @@ fn run(cli: Cli) -> Result<()> {
                 faithful,
                 feed,
                 stencil_block: stencil_m,
+                projection_maps: !no_projection_map,
             };
             let report = cli::photons::trace_and_build(&gpu, &scene, &options)?;
             if json {
@@ -651,6 +661,7 @@ fn run(cli: Cli) -> Result<()> {
             every,
             explain,
             all_bounces,
+            no_projection_map,
             camera_path,
             out,
             reference_software,
@@ -736,6 +747,7 @@ fn run(cli: Cli) -> Result<()> {
                 },
                 snapshots: snapshots.map(|dir| Snapshots { dir, every }),
                 all_bounces,
+                projection_maps: !no_projection_map,
             });
             let gpu = Gpu::new(cli.egl)?;
             let bar = if quiet {

@@ -41,7 +41,14 @@ fn compare(scene: &Scene, seed: u32, emitted: u32) -> (usize, usize, usize) {
     let tracer = PhotonTracer::new(&gpu).unwrap();
     let frames = tracer.trace(scene, &textures, seed, emitted).unwrap();
     let gpu_records = records(&frames);
-    let cpu_records = trace_photons(scene, seed, emitted, frames.width, frames.frame_height);
+    let cpu_records = trace_photons(
+        scene,
+        frames.projection.as_ref(),
+        seed,
+        emitted,
+        frames.width,
+        frames.frame_height,
+    );
     assert_eq!(gpu_records.len(), cpu_records.len());
     let per_frame = (frames.width * frames.frame_height) as usize;
     let size = scene.size();
@@ -77,14 +84,18 @@ fn compare(scene: &Scene, seed: u32, emitted: u32) -> (usize, usize, usize) {
 
 #[test]
 fn gpu_photons_equal_the_cpu_tracer_photon_by_photon() {
-    for (name, emitted) in [
-        ("cornell_box", 20_000),
-        ("glass_ball", 20_000),
-        ("ring", 20_000),
+    // Caustics only: emission through projection maps, photons ending at diffuse hits.
+    for (name, emitted, caustics_only) in [
+        ("cornell_box", 20_000, false),
+        ("glass_ball", 20_000, false),
+        ("ring", 20_000, false),
+        ("cornell_box", 10_000, true),
+        ("ring", 10_000, true),
     ] {
-        let scene = common::paper_scene(name);
+        let mut scene = common::paper_scene(name);
+        scene.photon_map.caustics_only = caustics_only;
         let (photons, diverged, matched) = compare(&scene, 11, emitted);
-        eprintln!("{name}: {photons} photons, {matched} records equal within 1e-4, {diverged} photons diverged");
+        eprintln!("{name} (caustics only: {caustics_only}): {photons} photons, {matched} records equal within 1e-4, {diverged} photons diverged");
         // Rounding flips a decision for a handful of photons in tens of thousands:
         // more than 0.5% would mean a real difference between the twins.
         assert!(
@@ -234,4 +245,158 @@ fn bounces_stop_when_no_photon_is_left_and_the_image_does_not_change() {
     };
     assert_eq!(frames(&full), 65);
     assert!(frames(&stopped) < 40, "{} frames traced", frames(&stopped));
+}
+
+/// Projection maps are conservative: every direction from every point of a
+/// light that meets a mirror or glass shape lies in a kept cell. Checked by
+/// brute force over random light points and directions, with the emission's
+/// own mapping, against the exact intersection of each specular shape.
+#[test]
+fn projection_maps_keep_every_direction_that_reaches_a_specular_shape() {
+    use photonmap::photon::projection::emission_direction;
+    use photonmap::photon::ProjectionMaps;
+    use photonmap::reference::intersect::intersect_geometry;
+    use photonmap::reference::random::{rng_init, rng_next};
+    use photonmap::scene::Light;
+    for name in ["glass_ball", "ring", "cornell_box"] {
+        let mut scene = common::paper_scene(name);
+        scene.photon_map.caustics_only = true;
+        let maps = ProjectionMaps::for_scene(&scene);
+        let specular: Vec<_> = scene
+            .shapes
+            .iter()
+            .filter(|s| scene.materials[s.material].is_specular())
+            .collect();
+        let (mut hits, samples) = (0u32, 400_000u32);
+        for (light, map) in scene.lights.iter().zip(&maps.maps) {
+            let mut rng = rng_init(7, [0, 0], 0);
+            for _ in 0..samples {
+                let (a, b) = (rng_next(&mut rng), rng_next(&mut rng));
+                let (u, v) = (rng_next(&mut rng), rng_next(&mut rng));
+                let origin = match *light {
+                    Light::Point { position, .. } => position,
+                    Light::Area {
+                        corner,
+                        edge1,
+                        edge2,
+                        ..
+                    } => corner + a * edge1 + b * edge2,
+                };
+                let d = emission_direction(light, u, v);
+                if specular
+                    .iter()
+                    .any(|s| intersect_geometry(&s.geometry, origin, d).is_some())
+                {
+                    hits += 1;
+                    assert!(
+                        map.keeps(u, v),
+                        "{name}: direction {d} from {origin} reaches a specular shape but its cell {} is not kept",
+                        map.cell_of(u, v)
+                    );
+                }
+            }
+        }
+        let reaching = hits as f64 / samples as f64;
+        let kept = maps.kept_power_fraction(&scene);
+        eprintln!(
+            "{name}: {:.2}% of sampled directions reach a specular shape; {:.2}% of the power kept",
+            100.0 * reaching,
+            100.0 * kept
+        );
+        assert!(
+            hits > 1000,
+            "{name}: too few directions reach a specular shape ({hits}) to test the map"
+        );
+        assert!(kept < 1.0, "{name}: every cell kept: the map aims nothing");
+    }
+}
+
+/// RING stores caustics only (scenes/ring.toml says so) because that loses
+/// nothing: its only diffuse surface is a plane, and a vertical mirror keeps a
+/// photon's vertical direction, so light that left the floor never returns to
+/// it. Traced with the same random numbers, with and without the declaration
+/// (and without projection maps, which draw other numbers), the stored
+/// photons are the same records.
+#[test]
+fn ring_loses_no_stored_photon_by_storing_caustics_only() {
+    let gpu = common::gpu();
+    let mut all_paths = common::paper_scene("ring");
+    all_paths.photon_map.caustics_only = false;
+    let mut caustics = all_paths.clone();
+    caustics.photon_map.caustics_only = true;
+    let textures = SceneTextures::new(&gpu, &all_paths).unwrap();
+    let mut tracer = PhotonTracer::new(&gpu).unwrap();
+    tracer.projection_maps = false;
+    let stored = |scene: &Scene| -> Vec<PhotonRecord> {
+        let frames = tracer.trace(scene, &textures, 5, 200_000).unwrap();
+        records(&frames)
+            .into_iter()
+            .filter(|r| r.power.w != 0.0)
+            .collect()
+    };
+    let (a, b) = (stored(&all_paths), stored(&caustics));
+    eprintln!(
+        "ring: {} stored with all paths, {} caustics only",
+        a.len(),
+        b.len()
+    );
+    assert!(
+        a.len() > 1000,
+        "too few stored photons ({}) to compare",
+        a.len()
+    );
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!((x.position, x.power), (y.position, y.power));
+    }
+}
+
+/// Projection maps change where photons go, not the light they carry: the
+/// caustic flux stored with them equals the flux stored by photons emitted in
+/// every direction, within 4 standard errors of the difference (each photon's
+/// stored power is one sample; the error is the sample deviation / sqrt(N)).
+#[test]
+fn projection_maps_keep_the_stored_caustic_flux() {
+    let gpu = common::gpu();
+    for name in ["glass_ball", "cornell_box", "ring"] {
+        let mut scene = common::paper_scene(name);
+        scene.photon_map.caustics_only = true;
+        let textures = SceneTextures::new(&gpu, &scene).unwrap();
+        let flux = |aimed: bool, emitted: u32| -> (f64, f64) {
+            let mut tracer = PhotonTracer::new(&gpu).unwrap();
+            tracer.projection_maps = aimed;
+            let frames = tracer.trace(&scene, &textures, 3, emitted).unwrap();
+            assert_eq!(frames.projection.is_some(), aimed);
+            let per_frame = (frames.width * frames.frame_height) as usize;
+            let mut per_photon = vec![0f64; emitted as usize];
+            for (texel, r) in records(&frames).iter().enumerate() {
+                let photon = texel % per_frame;
+                if r.power.w != 0.0 && photon < per_photon.len() {
+                    per_photon[photon] += r.power.truncate().element_sum() as f64;
+                }
+            }
+            let n = per_photon.len() as f64;
+            let total: f64 = per_photon.iter().sum();
+            let mean = total / n;
+            let var = per_photon.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            (total, var * n) // the total and its variance
+        };
+        let (everywhere, v1) = flux(false, 400_000);
+        let (aimed, v2) = flux(true, 100_000);
+        let z = (aimed - everywhere) / (v1 + v2).sqrt();
+        eprintln!(
+            "{name}: stored caustic flux {everywhere:.4} +- {:.4} emitting everywhere, {aimed:.4} +- {:.4} aimed (z = {z:.2})",
+            v1.sqrt(),
+            v2.sqrt()
+        );
+        assert!(z.abs() < 4.0, "{name}: aimed photons store {aimed}, photons emitted everywhere {everywhere} (z = {z})");
+        // Aiming must also pay: per photon emitted, the flux varies less (each
+        // photon carries 1/N of the power, so the total's variance is c / N).
+        let per_photon = (v2 * 100_000.0) / (v1 * 400_000.0);
+        eprintln!("{name}: variance per photon aimed / everywhere = {per_photon:.3}");
+        assert!(
+            per_photon < 1.0,
+            "{name}: aiming did not lower the flux's variance per photon ({per_photon})"
+        );
+    }
 }

@@ -3,7 +3,9 @@
 // textures and writes frame b, a non-overlapping band of the same textures
 // (a texture barrier between passes makes the previous frame visible).
 // Diffuse hits store the photon, except its first hit (direct light is the
-// shadow rays' job), and continue by Russian roulette; mirrors reflect; glass
+// shadow rays' job), and continue by Russian roulette (or end, when the scene
+// stores caustics only: every photon alive at a diffuse hit then came by
+// specular bounces alone); mirrors reflect; glass
 // reflects or refracts by exact Fresnel. Lost or absorbed photons are marked
 // dead, never compacted.
 #include "common/scene.glsl"
@@ -19,6 +21,7 @@ uniform uint u_seed;
 uniform int u_bounce;        // this frame, 1..
 uniform int u_frame_height;
 uniform int u_store_direct;  // 1: store first hits too (tests of the flux)
+uniform int u_caustics_only; // 1: a diffuse hit ends the photon (stored if not its first)
 
 layout(location = 0) out vec4 o_position;
 layout(location = 1) out vec4 o_power;
@@ -83,7 +86,7 @@ void main() {
     if (kind == MAT_DIFFUSE) {
         stored = u_bounce >= 2 || u_store_direct != 0;
         vec3 albedo = material_texel(mat, 1).rgb;
-        alive = u0 < max(albedo.r, max(albedo.g, albedo.b));
+        alive = u_caustics_only == 0 && u0 < max(albedo.r, max(albedo.g, albedo.b));
         next = sample_cosine(nf, u1, u2);
     } else if (kind == MAT_MIRROR) {
         next = reflect(d, nf);

@@ -41,6 +41,8 @@ pub struct PhotonOptions {
     pub faithful: bool,
     pub feed: VertexFeed,
     pub stencil_block: u32,
+    /// Aim photons by projection maps when the scene stores caustics only.
+    pub projection_maps: bool,
 }
 
 pub fn trace_and_build(gpu: &Gpu, scene: &Scene, o: &PhotonOptions) -> Result<PhotonReport> {
@@ -50,7 +52,8 @@ pub fn trace_and_build(gpu: &Gpu, scene: &Scene, o: &PhotonOptions) -> Result<Ph
     } else {
         RandomSource::Hash
     };
-    let tracer = PhotonTracer::with_random(gpu, random)?;
+    let mut tracer = PhotonTracer::with_random(gpu, random)?;
+    tracer.projection_maps = o.projection_maps;
     let mut timings = Timings::default();
     let wall = std::time::Instant::now();
     let (frames, trace) = tracer.trace_to_stored(scene, &textures, o.seed)?;
@@ -151,6 +154,16 @@ pub fn print_report(r: &PhotonReport) {
         "  grid {:?} over {:?}..{:?}: {} in the grid, {} in the map, {} of {} cells used, at most {} in a cell",
         r.grid_resolution, r.grid_min, r.grid_max, r.photons_in_grid, r.photons_in_map, r.cells_with_photons, r.cells, r.max_photons_in_a_cell
     );
+    if let Some(p) = &r.trace.projection {
+        println!(
+            "  caustics only, aimed by projection maps: {} of {} cells kept ({}x{} a light), {:.2}% of the lights' power",
+            p.kept_cells,
+            p.cells,
+            p.resolution,
+            p.resolution,
+            100.0 * p.kept_power_fraction
+        );
+    }
     if let (Some(over), Some(m)) = (r.cells_over_capacity, r.stencil_block) {
         println!("  stencil routing m = {m} ({} slots a cell): {over} cells over capacity, their power redistributed", m * m);
     }

@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod bitonic;
 pub mod fit;
+pub mod projection;
 pub mod stencil_routing;
 pub mod trace;
 
@@ -14,6 +15,7 @@ use crate::gpu::Bindings;
 use crate::scene::Scene;
 
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
+pub use projection::ProjectionMaps;
 pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
 pub use trace::{PhotonFrames, PhotonTracer, RandomSource, TraceReport};
 

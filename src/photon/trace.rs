@@ -6,6 +6,8 @@ use crate::gpu::{max_texture_size, Gpu, GpuError, Program, Target, TexFormat, Te
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
+use super::projection::ProjectionMaps;
+
 /// The photon textures after tracing.
 pub struct PhotonFrames {
     /// xyz, w = material of the hit (-1: on the light)
@@ -28,6 +30,8 @@ pub struct PhotonFrames {
     pub power_scale: f32,
     /// GPU time of the emission and bounce passes (timer query).
     pub gpu_seconds: f64,
+    /// The projection maps photons were aimed by (scenes that store caustics only).
+    pub projection: Option<ProjectionMaps>,
 }
 
 impl PhotonFrames {
@@ -89,6 +93,28 @@ pub struct TraceReport {
     /// GPU time of the last (kept) trace, and of all attempts together.
     pub gpu_seconds: f64,
     pub gpu_seconds_all_attempts: f64,
+    /// With projection maps: kept cells of all lights, cells in all, and the
+    /// share of the lights' power that leaves through kept cells.
+    pub projection: Option<ProjectionSummary>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ProjectionSummary {
+    pub resolution: u32,
+    pub kept_cells: usize,
+    pub cells: usize,
+    pub kept_power_fraction: f64,
+}
+
+impl ProjectionSummary {
+    pub fn new(maps: &ProjectionMaps, scene: &Scene) -> Self {
+        Self {
+            resolution: maps.resolution,
+            kept_cells: maps.maps.iter().map(|m| m.cells.len()).sum(),
+            cells: maps.maps.len() * (maps.resolution as usize).pow(2),
+            kept_power_fraction: maps.kept_power_fraction(scene),
+        }
+    }
 }
 
 /// Where photon tracing takes its random numbers.
@@ -111,6 +137,12 @@ pub struct PhotonTracer {
     /// Stop bouncing once an occlusion query finds no live photon (issue 8's
     /// skip; the frames not traced are left out of every build).
     pub stop_when_dead: bool,
+    /// Aim photons by projection maps when the scene stores caustics only
+    /// (off: emit everywhere and keep only the caustic paths, to compare).
+    pub projection_maps: bool,
+    /// Emission through projection maps, compiled on first use.
+    emit_projected: std::cell::OnceCell<Program>,
+    defines: Vec<(&'static str, String)>,
     random: RandomSource,
 }
 
@@ -123,7 +155,7 @@ impl PhotonTracer {
     }
 
     pub fn with_random(gpu: &Gpu, random: RandomSource) -> Result<Self, GpuError> {
-        let defines: Vec<(&str, String)> = match random {
+        let defines: Vec<(&'static str, String)> = match random {
             RandomSource::Hash => vec![],
             RandomSource::Texture => vec![("RANDOM_TEXTURE", "1".into())],
         };
@@ -134,6 +166,9 @@ impl PhotonTracer {
             count: Program::fullscreen(gpu, "photon/stored_count.frag")?,
             probe: Program::fullscreen(gpu, "photon/alive_probe.frag")?,
             stop_when_dead: true,
+            projection_maps: true,
+            emit_projected: std::cell::OnceCell::new(),
+            defines,
             random,
         })
     }
@@ -193,6 +228,24 @@ impl PhotonTracer {
                 Some(self.random_texture(seed, width, frame_height, frames)?)
             }
         };
+        let projection = self.projection_for(scene)?;
+        let projection_texture = match &projection {
+            None => None,
+            Some(maps) => {
+                let t = maps.texels(scene);
+                Some(Texture::from_f32(
+                    &self.gpu,
+                    t.width,
+                    t.height,
+                    TexFormat::Rgba32F,
+                    &t.data,
+                )?)
+            }
+        };
+        let emit = match &projection_texture {
+            None => &self.emit,
+            Some(_) => self.emit_projected()?,
+        };
         let alive_query = crate::gpu::OcclusionQuery::new(&self.gpu)?;
         let mut probe_target: Option<Result<(Texture, Target), GpuError>> = None;
         let mut frames_used = frames;
@@ -203,10 +256,16 @@ impl PhotonTracer {
         let wall = std::time::Instant::now();
         query.begin();
         {
-            let mut b = self.emit.bind();
+            let mut b = emit.bind();
             textures.bind(&mut b);
             if let Some(r) = &random {
                 b.texture("u_random_numbers", r);
+            }
+            if let Some(p) = &projection_texture {
+                b.texture("u_projection", p).int(
+                    "u_projection_resolution",
+                    scene.photon_map.projection_resolution as i32,
+                );
             }
             b.uint("u_seed", seed)
                 .int("u_emitted", emitted as i32)
@@ -230,7 +289,8 @@ impl PhotonTracer {
                 .uint("u_seed", seed)
                 .int("u_bounce", bounce)
                 .int("u_frame_height", fh)
-                .int("u_store_direct", scene.photon_map.store_direct as i32);
+                .int("u_store_direct", scene.photon_map.store_direct as i32)
+                .int("u_caustics_only", scene.photon_map.caustics_only as i32);
             query.begin();
             self.gpu.draw_region(&target, 0, bounce * fh, w, fh);
             query.end();
@@ -284,7 +344,33 @@ impl PhotonTracer {
             photons_used: emitted,
             power_scale: 1.0,
             gpu_seconds,
+            projection,
         })
+    }
+
+    /// The projection maps this scene's photons are aimed by, if any: the
+    /// scene stores caustics only and they are not switched off.
+    pub fn projection_for(&self, scene: &Scene) -> Result<Option<ProjectionMaps>, GpuError> {
+        if !(scene.photon_map.caustics_only && self.projection_maps) {
+            return Ok(None);
+        }
+        let maps = ProjectionMaps::for_scene(scene);
+        if maps.kept_power_fraction(scene) <= 0.0 {
+            return Err(GpuError::Gl(
+                "the scene stores caustics only, but no light can send a photon towards a mirror or glass shape".into(),
+            ));
+        }
+        Ok(Some(maps))
+    }
+
+    fn emit_projected(&self) -> Result<&Program, GpuError> {
+        if let Some(p) = self.emit_projected.get() {
+            return Ok(p);
+        }
+        let mut defines = self.defines.clone();
+        defines.push(("PROJECTION_MAPS", "1".into()));
+        let p = Program::fullscreen_with(&self.gpu, "photon/emit.frag", &defines)?;
+        Ok(self.emit_projected.get_or_init(|| p))
     }
 
     /// Stored records per photon index, counted on the GPU (one float per
@@ -360,6 +446,10 @@ impl PhotonTracer {
                     target,
                     gpu_seconds: frames.gpu_seconds,
                     gpu_seconds_all_attempts: all_seconds,
+                    projection: frames
+                        .projection
+                        .as_ref()
+                        .map(|m| ProjectionSummary::new(m, scene)),
                 };
                 return Ok((frames, report));
             }
@@ -419,6 +509,7 @@ impl PhotonFrames {
             photons_used,
             power_scale: 1.0,
             gpu_seconds: 0.0,
+            projection: None,
         })
     }
 }

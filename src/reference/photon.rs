@@ -4,6 +4,7 @@
 
 use glam::{Vec3, Vec4};
 
+use crate::photon::projection::{ProjectionMaps, ProjectionTexels};
 use crate::scene::pack::PackedScene;
 use crate::scene::{Material, Scene};
 
@@ -81,9 +82,11 @@ const DEAD: PhotonRecord = PhotonRecord {
     outgoing: Vec4::new(0.0, 0.0, 0.0, -1.0),
 };
 
-/// glsl/photon/emit.frag for the photon at frame texel (x, y).
+/// glsl/photon/emit.frag for the photon at frame texel (x, y); `projection`
+/// (texels and resolution) is its PROJECTION_MAPS variant.
 pub fn emit(
     packed: &PackedScene,
+    projection: Option<(&ProjectionTexels, u32)>,
     seed: u32,
     emitted: u32,
     width: u32,
@@ -97,19 +100,42 @@ pub fn emit(
     let pick = rng_next(&mut rng);
     let light_row = |l: usize, i: usize| Vec4::from(packed.lights[l * 6 + i]);
     let mut l = 0;
-    while l + 1 < packed.light_count && pick >= light_row(l, 5).x {
+    let cdf = |l: usize| match projection {
+        Some((t, _)) => t.texel(l, 0).x,
+        None => light_row(l, 5).x,
+    };
+    while l + 1 < packed.light_count && pick >= cdf(l) {
         l += 1;
     }
     let choice = light_row(l, 5);
     let head = light_row(l, 0);
     let a = light_row(l, 1).truncate();
-    let emitted_radiance = light_row(l, 4).truncate();
-    let (u1, u2, u3, u4) = (
+    let mut emitted_radiance = light_row(l, 4).truncate();
+    let (mut u1, mut u2, mut u3, mut u4) = (
         rng_next(&mut rng),
         rng_next(&mut rng),
         rng_next(&mut rng),
         rng_next(&mut rng),
     );
+    let mut probability = choice.y;
+    if let Some((t, resolution)) = projection {
+        let kept = t.texel(l, 0);
+        probability = kept.y;
+        let count = kept.w as i32;
+        let c = ((rng_next(&mut rng) * count as f32) as i32).min(count - 1) as usize;
+        let cell = t.texel(l, 1 + c / 4)[c % 4];
+        let n = resolution as f32;
+        let row = (cell / n).floor();
+        let column = cell - row * n;
+        if head.x as i32 == 1 {
+            u1 = (column + u1) / n;
+            u2 = (row + u2) / n;
+        } else {
+            u3 = (column + u3) / n;
+            u4 = (row + u4) / n;
+        }
+        emitted_radiance *= kept.z;
+    }
     let (p, d, power) = if head.x as i32 == 1 {
         (a, sample_sphere(u1, u2), 4.0 * PI * emitted_radiance)
     } else {
@@ -122,7 +148,7 @@ pub fn emit(
     };
     PhotonRecord {
         position: p.extend(-1.0),
-        power: (power / (emitted as f32 * choice.y)).extend(0.0),
+        power: (power / (emitted as f32 * probability)).extend(0.0),
         incoming: Vec4::new(0.0, 0.0, 0.0, 1.0),
         outgoing: d.extend(choice.z),
     }
@@ -165,7 +191,7 @@ pub fn bounce(
     let next = match material {
         Material::Diffuse { albedo } => {
             stored = bounce >= 2 || scene.photon_map.store_direct;
-            alive = u0 < albedo.max_element();
+            alive = !scene.photon_map.caustics_only && u0 < albedo.max_element();
             sample_cosine(nf, u1, u2)
         }
         Material::Mirror { .. } => reflect(d, nf),
@@ -190,22 +216,27 @@ pub fn bounce(
     }
 }
 
-/// Every record of every frame, row 0 of frame 0 first (the GPU texture layout).
+/// Every record of every frame, row 0 of frame 0 first (the GPU texture
+/// layout), aimed by `projection` when given (as the GPU tracer is when the
+/// scene stores caustics only).
 pub fn trace_photons(
     scene: &Scene,
+    projection: Option<&ProjectionMaps>,
     seed: u32,
     emitted: u32,
     width: u32,
     frame_height: u32,
 ) -> Vec<PhotonRecord> {
     let packed = PackedScene::new(scene);
+    let texels = projection.map(|p| (p.texels(scene), p.resolution));
+    let projection = texels.as_ref().map(|(t, r)| (t, *r));
     let frames = scene.photon_map.max_bounces + 1;
     let per_frame = (width * frame_height) as usize;
     let mut out = vec![DEAD; per_frame * frames as usize];
     for y in 0..frame_height {
         for x in 0..width {
             let i = (y * width + x) as usize;
-            out[i] = emit(&packed, seed, emitted, width, x, y);
+            out[i] = emit(&packed, projection, seed, emitted, width, x, y);
             for b in 1..frames {
                 let last = out[(b as usize - 1) * per_frame + i];
                 out[b as usize * per_frame + i] = bounce(scene, seed, b, x, y, &last);

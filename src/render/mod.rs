@@ -47,6 +47,8 @@ pub struct GlobalIllumination {
     pub snapshots: Option<Snapshots>,
     /// Trace every bounce up to max_bounces even when no photon is left alive.
     pub all_bounces: bool,
+    /// Aim photons by projection maps when the scene stores caustics only.
+    pub projection_maps: bool,
 }
 
 impl Default for GlobalIllumination {
@@ -59,6 +61,7 @@ impl Default for GlobalIllumination {
             estimate: EstimateOptions::default(),
             snapshots: None,
             all_bounces: false,
+            projection_maps: true,
         }
     }
 }
@@ -380,6 +383,7 @@ pub fn render_views(
             };
             let mut photon_tracer = PhotonTracer::with_random(gpu, random)?;
             photon_tracer.stop_when_dead = !gi.all_bounces;
+            photon_tracer.projection_maps = gi.projection_maps;
             progress("photons", 0, 1);
             gpu.finish();
             let t0 = std::time::Instant::now();
@@ -409,6 +413,23 @@ pub fn render_views(
                     report.photons_used,
                     report.stored
                 ),
+            });
+            explain.push(ExplainLine {
+                stage: "projection maps".into(),
+                passes: 0,
+                ran: report.projection.is_some(),
+                why: match (&report.projection, scene.photon_map.caustics_only) {
+                    (Some(p), _) => format!(
+                        "caustics only: photons leave through {} of {} emission cells ({}x{} a light) that can reach a mirror or glass shape, {:.2}% of the lights' power",
+                        p.kept_cells,
+                        p.cells,
+                        p.resolution,
+                        p.resolution,
+                        100.0 * p.kept_power_fraction
+                    ),
+                    (None, true) => "skipped: switched off (--no-projection-map); photons leave in every direction and only caustic paths are stored".into(),
+                    (None, false) => "skipped: the map stores indirect diffuse light too, which any emitted direction may carry (caustics_only = true aims photons at specular shapes)".into(),
+                },
             });
             // The scene's grid bounds, or (when it fixes none) the box of the photons.
             let grid = crate::photon::fit::grid_for(gpu, scene, &frames)?;

@@ -67,6 +67,8 @@ struct PhotonMapDef {
     max_radius: Option<f32>,
     max_bounces: Option<i64>,
     store_direct: Option<bool>,
+    caustics_only: Option<bool>,
+    projection_resolution: Option<i64>,
 }
 
 #[derive(Deserialize)]
@@ -537,6 +539,22 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ))
             }
         };
+        let store_direct = p.and_then(|p| p.store_direct).unwrap_or(false);
+        let caustics_only = p.and_then(|p| p.caustics_only).unwrap_or(false);
+        if store_direct && caustics_only {
+            return Err(cx.err(
+                s,
+                "photon_map.caustics_only",
+                "caustics_only and store_direct exclude each other: a caustic photon is never stored at its first hit".into(),
+            ));
+        }
+        if caustics_only && !shapes.iter().any(|x| materials[x.material].is_specular()) {
+            return Err(cx.err(
+                s,
+                "photon_map.caustics_only",
+                "no shape is mirror or glass, so the scene has no caustics to store".into(),
+            ));
+        }
         let max_radius = cx.positive(
             s.clone(),
             "photon_map.max_radius",
@@ -562,13 +580,22 @@ pub fn load_scene_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
             )? as u32,
             max_radius,
             max_bounces: cx.int_range(
-                s,
+                s.clone(),
                 "photon_map.max_bounces",
                 p.and_then(|p| p.max_bounces).unwrap_or(8),
                 1,
                 64,
             )? as u32,
-            store_direct: p.and_then(|p| p.store_direct).unwrap_or(false),
+            store_direct,
+            caustics_only,
+            projection_resolution: cx.int_range(
+                s,
+                "photon_map.projection_resolution",
+                p.and_then(|p| p.projection_resolution)
+                    .unwrap_or(crate::photon::projection::DEFAULT_RESOLUTION as i64),
+                crate::photon::projection::MIN_RESOLUTION as i64,
+                crate::photon::projection::MAX_RESOLUTION as i64,
+            )? as u32,
         }
     };
 

@@ -133,6 +133,13 @@ pub struct PhotonMapParams {
     /// Store photons at their first diffuse hit too (off in the paper's split,
     /// where shadow rays count direct light; on for tests of the photon flux).
     pub store_direct: bool,
+    /// Store caustic photons only (light, one or more specular bounces, then
+    /// the first diffuse hit, where the photon ends). Photons then leave each
+    /// light only through the cells of its projection map that can reach a
+    /// specular object (Jensen's projection maps).
+    pub caustics_only: bool,
+    /// Cells per side of each light's projection map (caustics only).
+    pub projection_resolution: u32,
 }
 
 #[derive(Clone, Debug)]
@@ -175,6 +182,8 @@ impl Scene {
                 max_radius: 1.0,
                 max_bounces: 1,
                 store_direct: false,
+                caustics_only: false,
+                projection_resolution: crate::photon::projection::DEFAULT_RESOLUTION,
             },
         }
     }
