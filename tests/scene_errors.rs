@@ -343,3 +343,36 @@ fn tempdir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+#[test]
+fn caustics_only_without_a_specular_shape() {
+    expect(
+        "[materials]",
+        "[photon_map]\ncaustics_only = true\n\n[materials]",
+        10,
+        "photon_map.caustics_only",
+        "no shape is mirror or glass",
+    );
+}
+
+#[test]
+fn caustics_only_with_store_direct() {
+    expect(
+        "[materials]",
+        "[photon_map]\nstore_direct = true\ncaustics_only = true\n\n[materials]",
+        11,
+        "photon_map.caustics_only",
+        "exclude each other",
+    );
+}
+
+#[test]
+fn projection_resolution_out_of_range() {
+    expect(
+        "[materials]",
+        "[photon_map]\nprojection_resolution = 1000\n\n[materials]",
+        10,
+        "photon_map.projection_resolution",
+        "4..=128",
+    );
+}
