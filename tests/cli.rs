@@ -719,3 +719,85 @@ fn a_camera_path_renders_every_frame_on_one_photon_map() {
         .unwrap();
     assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("key[0]"));
 }
+
+/// RING stores caustics only: `photons` and `--explain` say its photons are
+/// aimed by projection maps, and `--no-projection-map` emits everywhere,
+/// needing many more photons for the same stored count.
+#[test]
+fn projection_maps_are_reported_and_can_be_switched_off() {
+    let photons = |extra: &[&str]| -> serde_json::Value {
+        let out = photonmap()
+            .args(["photons", "--json"])
+            .args(extra)
+            .arg(scene("ring"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let aimed = photons(&[]);
+    let everywhere = photons(&["--no-projection-map"]);
+    assert_eq!(aimed["trace"]["target"], 16000);
+    assert_eq!(everywhere["trace"]["target"], 16000);
+    let kept = aimed["trace"]["projection"]["kept_power_fraction"]
+        .as_f64()
+        .unwrap();
+    assert!(kept > 0.0 && kept < 0.1, "{aimed}");
+    assert!(everywhere["trace"]["projection"].is_null(), "{everywhere}");
+    let used = |v: &serde_json::Value| v["trace"]["photons_used"].as_f64().unwrap();
+    // About 1 / kept as many photons emitted everywhere; at least half that.
+    assert!(
+        used(&everywhere) > 0.5 * used(&aimed) / kept,
+        "aimed {}, everywhere {}",
+        used(&aimed),
+        used(&everywhere)
+    );
+
+    let explain = |extra: &[&str]| -> String {
+        let out = photonmap()
+            .args([
+                "render",
+                "--quiet",
+                "--explain",
+                "--width",
+                "32",
+                "--height",
+                "24",
+                "-o",
+            ])
+            .arg(tmp("projection").join("ring.png"))
+            .args(extra)
+            .arg(scene("ring"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    assert!(explain(&[]).contains("run  projection maps"));
+    assert!(explain(&["--no-projection-map"]).contains("skip projection maps"));
+    let glass = photonmap()
+        .args([
+            "render",
+            "--quiet",
+            "--explain",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "-o",
+        ])
+        .arg(tmp("projection-glass").join("glass.png"))
+        .arg(scene("glass_ball"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&glass.stderr);
+    assert!(
+        err.contains("skip projection maps") && err.contains("indirect diffuse"),
+        "{err}"
+    );
+}

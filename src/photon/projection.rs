@@ -422,7 +422,7 @@ mod tests {
         // The sphere's cone is (1 - cos asin 0.1) / 2 = 0.25% of the sphere of
         // directions; the kept cells must hold it, rounded up to whole cells.
         let f = far.maps[0].fraction();
-        assert!(f >= 0.0025 && f < 0.05, "kept fraction {f}");
+        assert!((0.0025..0.05).contains(&f), "kept fraction {f}");
         let inside = ProjectionMaps::for_scene(&point_and_sphere(0.5, 1.0));
         assert_eq!(inside.maps[0].fraction(), 1.0);
     }
