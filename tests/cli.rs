@@ -757,45 +757,22 @@ fn projection_maps_are_reported_and_can_be_switched_off() {
         used(&everywhere)
     );
 
-    let explain = |extra: &[&str]| -> String {
+    let explain = |name: &str, extra: &[&str]| -> String {
         let out = photonmap()
-            .args([
-                "render",
-                "--quiet",
-                "--explain",
-                "--width",
-                "32",
-                "--height",
-                "24",
-                "-o",
-            ])
-            .arg(tmp("projection").join("ring.png"))
+            .args(["render", "--quiet", "--explain", "--width", "32"])
+            .args(["--height", "24", "-o"])
+            .arg(tmp(&format!("projection-{name}")).join("x.png"))
             .args(extra)
-            .arg(scene("ring"))
+            .arg(scene(name))
             .output()
             .unwrap();
         let err = String::from_utf8_lossy(&out.stderr).into_owned();
         assert!(out.status.success(), "{err}");
         err
     };
-    assert!(explain(&[]).contains("run  projection maps"));
-    assert!(explain(&["--no-projection-map"]).contains("skip projection maps"));
-    let glass = photonmap()
-        .args([
-            "render",
-            "--quiet",
-            "--explain",
-            "--width",
-            "32",
-            "--height",
-            "24",
-            "-o",
-        ])
-        .arg(tmp("projection-glass").join("glass.png"))
-        .arg(scene("glass_ball"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&glass.stderr);
+    assert!(explain("ring", &[]).contains("run  projection maps"));
+    assert!(explain("ring", &["--no-projection-map"]).contains("skip projection maps"));
+    let err = explain("glass_ball", &[]);
     assert!(
         err.contains("skip projection maps") && err.contains("indirect diffuse"),
         "{err}"

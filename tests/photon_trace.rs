@@ -400,3 +400,55 @@ fn projection_maps_keep_the_stored_caustic_flux() {
         );
     }
 }
+
+/// A caustics-only scene whose light cannot face its mirror (the mirror sits
+/// behind a one-sided area light) is refused with a reason, not traced forever.
+#[test]
+fn caustics_only_with_no_reachable_mirror_is_refused() {
+    let scene = load_scene_str(
+        r#"
+[camera]
+position = [0.0, 1.0, 5.0]
+look_at = [0.0, 1.0, 0.0]
+vfov = 40.0
+width = 8
+height = 8
+[photon_map]
+caustics_only = true
+[materials]
+floor = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
+mirror = { type = "mirror", reflectance = [0.9, 0.9, 0.9] }
+[[shape]]
+type = "parallelogram"
+corner = [-2.0, 0.0, -2.0]
+edge1 = [0.0, 0.0, 4.0]
+edge2 = [4.0, 0.0, 0.0]
+material = "floor"
+[[shape]]
+type = "sphere"
+center = [0.0, 3.0, 0.0]
+radius = 0.5
+material = "mirror"
+[[light]]
+type = "area"
+corner = [-0.5, 2.0, -0.5]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 1.0]
+normal = [0.0, -1.0, 0.0]
+radiance = [10.0, 10.0, 10.0]
+"#,
+        std::path::Path::new("behind.toml"),
+    )
+    .unwrap();
+    let gpu = common::gpu();
+    let textures = SceneTextures::new(&gpu, &scene).unwrap();
+    let tracer = PhotonTracer::new(&gpu).unwrap();
+    let err = match tracer.trace_to_stored(&scene, &textures, 1) {
+        Ok(_) => panic!("a mirror no photon can reach was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("no light can send a photon towards a mirror or glass shape"),
+        "{err}"
+    );
+}
