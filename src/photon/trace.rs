@@ -146,6 +146,12 @@ pub struct PhotonTracer {
     random: RandomSource,
 }
 
+/// Projection maps ready for emission: the maps and their texture.
+struct Aim {
+    maps: ProjectionMaps,
+    texture: Texture,
+}
+
 /// Random numbers per photon per frame in the texture source.
 const RANDOM_PER_TEXEL_PAIR: usize = 8;
 
@@ -213,6 +219,19 @@ impl PhotonTracer {
         seed: u32,
         emitted: u32,
     ) -> Result<PhotonFrames, GpuError> {
+        let aim = self.aim_for(scene)?;
+        self.trace_aimed(scene, textures, aim.as_ref(), seed, emitted)
+    }
+
+    /// `trace` with the projection maps already made (once per scene, not per attempt).
+    fn trace_aimed(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        aim: Option<&Aim>,
+        seed: u32,
+        emitted: u32,
+    ) -> Result<PhotonFrames, GpuError> {
         let frames = scene.photon_map.max_bounces + 1;
         let (width, frame_height) = frame_layout(emitted, frames, max_texture_size(&self.gpu))?;
         let height = frame_height * frames;
@@ -228,21 +247,7 @@ impl PhotonTracer {
                 Some(self.random_texture(seed, width, frame_height, frames)?)
             }
         };
-        let projection = self.projection_for(scene)?;
-        let projection_texture = match &projection {
-            None => None,
-            Some(maps) => {
-                let t = maps.texels(scene);
-                Some(Texture::from_f32(
-                    &self.gpu,
-                    t.width,
-                    t.height,
-                    TexFormat::Rgba32F,
-                    &t.data,
-                )?)
-            }
-        };
-        let emit = match &projection_texture {
+        let emit = match aim {
             None => &self.emit,
             Some(_) => self.emit_projected()?,
         };
@@ -261,8 +266,8 @@ impl PhotonTracer {
             if let Some(r) = &random {
                 b.texture("u_random_numbers", r);
             }
-            if let Some(p) = &projection_texture {
-                b.texture("u_projection", p).int(
+            if let Some(aim) = aim {
+                b.texture("u_projection", &aim.texture).int(
                     "u_projection_resolution",
                     scene.photon_map.projection_resolution as i32,
                 );
@@ -344,13 +349,14 @@ impl PhotonTracer {
             photons_used: emitted,
             power_scale: 1.0,
             gpu_seconds,
-            projection,
+            projection: aim.map(|a| a.maps.clone()),
         })
     }
 
-    /// The projection maps this scene's photons are aimed by, if any: the
-    /// scene stores caustics only and they are not switched off.
-    pub fn projection_for(&self, scene: &Scene) -> Result<Option<ProjectionMaps>, GpuError> {
+    /// The projection maps this scene's photons are aimed by, and their
+    /// texture, if any: the scene stores caustics only and they are not
+    /// switched off.
+    fn aim_for(&self, scene: &Scene) -> Result<Option<Aim>, GpuError> {
         if !(scene.photon_map.caustics_only && self.projection_maps) {
             return Ok(None);
         }
@@ -360,7 +366,9 @@ impl PhotonTracer {
                 "the scene stores caustics only, but no light can send a photon towards a mirror or glass shape".into(),
             ));
         }
-        Ok(Some(maps))
+        let t = maps.texels(scene);
+        let texture = Texture::from_f32(&self.gpu, t.width, t.height, TexFormat::Rgba32F, &t.data)?;
+        Ok(Some(Aim { maps, texture }))
     }
 
     fn emit_projected(&self) -> Result<&Program, GpuError> {
@@ -417,11 +425,12 @@ impl PhotonTracer {
             // Whole rows per frame of the widest frame.
             ((max / frames as u64) * max).min(u32::MAX as u64 / 2) as u32
         };
+        let aim = self.aim_for(scene)?;
         let mut emitted = target.max(64);
         let mut attempts = Vec::new();
         let mut all_seconds = 0.0;
         loop {
-            let mut frames = self.trace(scene, textures, seed, emitted)?;
+            let mut frames = self.trace_aimed(scene, textures, aim.as_ref(), seed, emitted)?;
             attempts.push(emitted);
             all_seconds += frames.gpu_seconds;
             let counts = self.stored_per_photon(&frames)?;
@@ -446,10 +455,7 @@ impl PhotonTracer {
                     target,
                     gpu_seconds: frames.gpu_seconds,
                     gpu_seconds_all_attempts: all_seconds,
-                    projection: frames
-                        .projection
-                        .as_ref()
-                        .map(|m| ProjectionSummary::new(m, scene)),
+                    projection: aim.as_ref().map(|a| ProjectionSummary::new(&a.maps, scene)),
                 };
                 return Ok((frames, report));
             }
