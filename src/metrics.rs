@@ -18,24 +18,9 @@ pub struct Metrics {
     pub pixels_compared: usize,
 }
 
-/// Compares `a` with the reference `b`; `mask` (same size) keeps pixels where it is true.
-pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics, String> {
-    if (a.width, a.height) != (b.width, b.height) {
-        return Err(format!(
-            "image sizes differ: {} x {} and {} x {}",
-            a.width, a.height, b.width, b.height
-        ));
-    }
-    if let Some(m) = mask {
-        if m.len() != a.pixels.len() {
-            return Err(format!(
-                "the mask has {} pixels, the images {}",
-                m.len(),
-                a.pixels.len()
-            ));
-        }
-    }
-    let keep = |i: usize| mask.is_none_or(|m| m[i]);
+/// Sums over the kept pixels' channels of (a - b)^2 and (a - b)^2 / (b^2 +
+/// 0.01), and the pixels kept.
+fn squared_errors(a: &Image, b: &Image, keep: impl Fn(usize) -> bool) -> (f64, f64, usize) {
     let (mut se, mut rel, mut n) = (0f64, 0f64, 0usize);
     for (i, (p, q)) in a.pixels.iter().zip(&b.pixels).enumerate() {
         if !keep(i) {
@@ -48,6 +33,40 @@ pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics, S
         }
         n += 1;
     }
+    (se, rel, n)
+}
+
+fn same_size(a: &Image, b: &Image) -> Result<(), String> {
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(format!(
+            "image sizes differ: {} x {} and {} x {}",
+            a.width, a.height, b.width, b.height
+        ));
+    }
+    Ok(())
+}
+
+/// RMSE of linear RGB alone (no SSIM): for tests and noise figures.
+pub fn rmse(a: &Image, b: &Image) -> Result<f64, String> {
+    same_size(a, b)?;
+    let (se, _, n) = squared_errors(a, b, |_| true);
+    Ok((se / (n.max(1) * 3) as f64).sqrt())
+}
+
+/// Compares `a` with the reference `b`; `mask` (same size) keeps pixels where it is true.
+pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics, String> {
+    same_size(a, b)?;
+    if let Some(m) = mask {
+        if m.len() != a.pixels.len() {
+            return Err(format!(
+                "the mask has {} pixels, the images {}",
+                m.len(),
+                a.pixels.len()
+            ));
+        }
+    }
+    let keep = |i: usize| mask.is_none_or(|m| m[i]);
+    let (se, rel, n) = squared_errors(a, b, keep);
     if n == 0 {
         return Err("the mask keeps no pixel".into());
     }

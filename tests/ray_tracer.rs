@@ -107,7 +107,7 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
             render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image
         })
         .collect();
-    let mean = common::mean_image(&images);
+    let mean = Image::average(&images);
     // The choice is really random: some pixels vary between seeds.
     assert!(
         images.iter().any(|im| im.pixels != images[0].pixels),

@@ -144,7 +144,7 @@ fn regenerate(gpu: &photonmap::gpu::Gpu, name: &str) {
                 .filter(|(j, _)| *j != i)
                 .map(|(_, im)| im.clone())
                 .collect();
-            let m = common::mean_image(&others);
+            let m = Image::average(&others);
             let mut v = variance(&others, &m);
             driver_var(&mut v);
             failing_fraction(&images[i], &m, &v, SEEDS - 1)
@@ -152,7 +152,7 @@ fn regenerate(gpu: &photonmap::gpu::Gpu, name: &str) {
         .collect();
     let m = loo.iter().sum::<f64>() / loo.len() as f64;
     let sd = (loo.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (loo.len() - 1) as f64).sqrt();
-    let mean = common::mean_image(&images);
+    let mean = Image::average(&images);
     let mut var = variance(&images, &mean);
     driver_var(&mut var);
     let tol = Tolerance {

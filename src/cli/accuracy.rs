@@ -38,18 +38,6 @@ pub struct ReferenceOptions {
     pub spp: u32,
 }
 
-fn mean(images: &[Image]) -> Image {
-    let mut out = Image::new(images[0].width, images[0].height);
-    for img in images {
-        for (o, p) in out.pixels.iter_mut().zip(&img.pixels) {
-            for c in 0..3 {
-                o[c] += p[c] / images.len() as f32;
-            }
-        }
-    }
-    out
-}
-
 /// Renders the converged reference: photons x factor, k x sqrt(factor) (the
 /// radius shrinks as the density grows, so bias falls with the noise), spp
 /// eye samples, `seeds` renders averaged.
@@ -89,11 +77,11 @@ pub fn make_reference(
     }
     let even: Vec<Image> = images.iter().step_by(2).cloned().collect();
     let odd: Vec<Image> = images.iter().skip(1).step_by(2).cloned().collect();
-    let residual = compare(&mean(&even), &mean(&odd), None)
+    let residual = compare(&Image::average(&even), &Image::average(&odd), None)
         .map_err(anyhow::Error::msg)?
         .rmse
         / 2.0;
-    let img = mean(&images);
+    let img = Image::average(&images);
     let info = ReferenceInfo {
         scene: scene.name.clone(),
         width: img.width,

@@ -49,6 +49,19 @@ impl Image {
         self.pixels[(y * self.width + x) as usize]
     }
 
+    /// The per-pixel mean of equally sized images.
+    pub fn average(images: &[Image]) -> Image {
+        let mut out = Image::new(images[0].width, images[0].height);
+        for img in images {
+            for (o, p) in out.pixels.iter_mut().zip(&img.pixels) {
+                for c in 0..3 {
+                    o[c] += p[c] / images.len() as f32;
+                }
+            }
+        }
+        out
+    }
+
     pub fn mean(&self) -> [f64; 3] {
         let mut s = [0f64; 3];
         for p in &self.pixels {
