@@ -8,7 +8,7 @@ use crate::gpu::{Gpu, GpuError, TexFormat, Texture};
 use crate::metrics::compare;
 use crate::photon::{BitonicBuild, BuildMethod, PhotonMap};
 use crate::render::{render, GlobalIllumination, RenderOptions, RenderOutput};
-use crate::scene::{load_scene_str, Geometry, Light, Scene};
+use crate::scene::{load_scene_str, Light, Scene};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -77,37 +77,7 @@ pub fn transformed(scene: &Scene, s: f32, t: Vec3) -> Scene {
     out.camera.position = p(scene.camera.position);
     out.camera.look_at = p(scene.camera.look_at);
     for shape in &mut out.shapes {
-        shape.geometry = match shape.geometry {
-            Geometry::Sphere { center, radius } => Geometry::Sphere {
-                center: p(center),
-                radius: radius * s,
-            },
-            Geometry::Cylinder {
-                base,
-                axis,
-                radius,
-                height,
-            } => Geometry::Cylinder {
-                base: p(base),
-                axis,
-                radius: radius * s,
-                height: height * s,
-            },
-            Geometry::Parallelogram {
-                corner,
-                edge1,
-                edge2,
-            } => Geometry::Parallelogram {
-                corner: p(corner),
-                edge1: edge1 * s,
-                edge2: edge2 * s,
-            },
-            Geometry::Triangle { v0, v1, v2 } => Geometry::Triangle {
-                v0: p(v0),
-                v1: p(v1),
-                v2: p(v2),
-            },
-        };
+        shape.geometry = shape.geometry.scaled(s, p);
     }
     for light in &mut out.lights {
         *light = match *light {

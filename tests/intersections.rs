@@ -264,37 +264,7 @@ fn no_self_intersection_at_any_scale() {
             for (name, g0) in shapes() {
                 let t = |p: Vec3| (p.as_dvec3() * scale + shift).as_vec3();
                 let s = scale as f32;
-                let g = match g0 {
-                    Geometry::Sphere { center, radius } => Geometry::Sphere {
-                        center: t(center),
-                        radius: radius * s,
-                    },
-                    Geometry::Cylinder {
-                        base,
-                        axis,
-                        radius,
-                        height,
-                    } => Geometry::Cylinder {
-                        base: t(base),
-                        axis,
-                        radius: radius * s,
-                        height: height * s,
-                    },
-                    Geometry::Parallelogram {
-                        corner,
-                        edge1,
-                        edge2,
-                    } => Geometry::Parallelogram {
-                        corner: t(corner),
-                        edge1: edge1 * s,
-                        edge2: edge2 * s,
-                    },
-                    Geometry::Triangle { v0, v1, v2 } => Geometry::Triangle {
-                        v0: t(v0),
-                        v1: t(v1),
-                        v2: t(v2),
-                    },
-                };
+                let g = g0.scaled(s, t);
                 let mut rng = Rng(0xfeed ^ name.len() as u64);
                 let (mut pts, mut normals, mut dirs, mut legit) = (vec![], vec![], vec![], vec![]);
                 for _ in 0..3000 {

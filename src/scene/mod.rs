@@ -75,6 +75,45 @@ pub enum Geometry {
     },
 }
 
+impl Geometry {
+    /// The shape scaled by `scale` and moved: `point` maps its points (the
+    /// caller's scaling and move, in whatever precision it likes), and its
+    /// lengths scale by `scale`; directions stay.
+    pub fn scaled(&self, scale: f32, point: impl Fn(Vec3) -> Vec3) -> Geometry {
+        match *self {
+            Geometry::Sphere { center, radius } => Geometry::Sphere {
+                center: point(center),
+                radius: radius * scale,
+            },
+            Geometry::Cylinder {
+                base,
+                axis,
+                radius,
+                height,
+            } => Geometry::Cylinder {
+                base: point(base),
+                axis,
+                radius: radius * scale,
+                height: height * scale,
+            },
+            Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            } => Geometry::Parallelogram {
+                corner: point(corner),
+                edge1: edge1 * scale,
+                edge2: edge2 * scale,
+            },
+            Geometry::Triangle { v0, v1, v2 } => Geometry::Triangle {
+                v0: point(v0),
+                v1: point(v1),
+                v2: point(v2),
+            },
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shape {
     pub geometry: Geometry,
