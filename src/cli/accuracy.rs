@@ -343,20 +343,19 @@ pub fn csv(r: &AccuracyReport) -> String {
     s
 }
 
+/// Each run's log10 seconds and log10 relative MSE (floored above zero): the
+/// points both plots draw.
+fn log_points(r: &AccuracyReport) -> (Vec<f64>, Vec<f64>) {
+    let xs = r.runs.iter().map(|x| x.total_seconds.max(1e-4).log10());
+    let ys = r.runs.iter().map(|x| x.metrics.rel_mse.max(1e-9).log10());
+    (xs.collect(), ys.collect())
+}
+
 /// Relative MSE against seconds, log-log, the Pareto front joined: an SVG
 /// written by hand (plotters' text needs system fonts CI may lack).
 pub fn svg_plot(r: &AccuracyReport) -> String {
     let (w, h, m) = (720.0, 480.0, 70.0);
-    let xs: Vec<f64> = r
-        .runs
-        .iter()
-        .map(|x| x.total_seconds.max(1e-4).log10())
-        .collect();
-    let ys: Vec<f64> = r
-        .runs
-        .iter()
-        .map(|x| x.metrics.rel_mse.max(1e-9).log10())
-        .collect();
+    let (xs, ys) = log_points(r);
     let (x0, x1) = (
         xs.iter().copied().fold(f64::INFINITY, f64::min).floor(),
         xs.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil(),
@@ -418,16 +417,7 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
 pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
     let (w, h, m) = (480u32, 320u32, 30.0f64);
     let mut img = image::RgbImage::from_pixel(w, h, image::Rgb([255, 255, 255]));
-    let xs: Vec<f64> = r
-        .runs
-        .iter()
-        .map(|x| x.total_seconds.max(1e-4).log10())
-        .collect();
-    let ys: Vec<f64> = r
-        .runs
-        .iter()
-        .map(|x| x.metrics.rel_mse.max(1e-9).log10())
-        .collect();
+    let (xs, ys) = log_points(r);
     let (x0, x1) = (
         xs.iter().copied().fold(f64::INFINITY, f64::min) - 0.1,
         xs.iter().copied().fold(f64::NEG_INFINITY, f64::max) + 0.1,
