@@ -426,6 +426,12 @@ impl PhotonTracer {
             ((max / frames as u64) * max).min(u32::MAX as u64 / 2) as u32
         };
         let aim = self.aim_for(scene)?;
+        // store_direct would store more, but caustics-only scenes cannot have it.
+        let remedy = if scene.photon_map.caustics_only {
+            ", or store all paths (caustics_only = false)"
+        } else {
+            ", or set store_direct"
+        };
         let mut emitted = target.max(64);
         let mut attempts = Vec::new();
         let mut all_seconds = 0.0;
@@ -461,12 +467,12 @@ impl PhotonTracer {
             }
             if total == 0 && emitted >= 250_000 {
                 return Err(GpuError::Gl(format!(
-                    "{emitted} photons emitted and none stored: no diffuse surface is reached after a bounce (photon maps store diffuse hits after the first; add a diffuse surface or set store_direct)"
+                    "{emitted} photons emitted and none stored: no diffuse surface is reached after a bounce (photon maps store diffuse hits after the first; add a diffuse surface{remedy})"
                 )));
             }
             if emitted >= max_emitted || attempts.len() >= 8 {
                 return Err(GpuError::Gl(format!(
-                    "{emitted} photons emitted stored only {total} of the {target} asked for: the scene's lights reach too few diffuse surfaces after a bounce (lower photons_stored, or set store_direct)"
+                    "{emitted} photons emitted stored only {total} of the {target} asked for: the scene's lights reach too few diffuse surfaces after a bounce (lower photons_stored{remedy})"
                 )));
             }
             let grow = if total == 0 {
