@@ -159,20 +159,26 @@ fn info_names_the_renderer_and_limits() {
     assert_eq!(v["stencil_bits"], 8);
 }
 
+/// `photonmap photons --json` on a paper scene, which must succeed.
+fn photons_json(name: &str, extra: &[&str]) -> serde_json::Value {
+    let out = photonmap()
+        .args(["photons", "--json"])
+        .args(extra)
+        .arg(scene(name))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 #[test]
 fn photons_reports_the_stored_count_for_both_builds() {
     for build in ["bitonic", "stencil"] {
-        let out = photonmap()
-            .args(["photons", "--json", "--build", build])
-            .arg(scene("glass_ball"))
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let v = photons_json("glass_ball", &["--build", build]);
         assert_eq!(v["trace"]["target"], 5000);
         let stored = v["trace"]["stored"].as_u64().unwrap();
         assert!((5000..=5008).contains(&stored), "{v}");
@@ -194,22 +200,8 @@ fn photons_reports_the_stored_count_for_both_builds() {
 
 #[test]
 fn faithful_photons_match_the_default_ones() {
-    let run = |faithful: bool| {
-        let mut c = photonmap();
-        c.args(["photons", "--json", "--build", "stencil"])
-            .arg(scene("cornell_box"));
-        if faithful {
-            c.arg("--faithful");
-        }
-        let out = c.output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
-    };
-    let (a, b) = (run(false), run(true));
+    let a = photons_json("cornell_box", &["--build", "stencil"]);
+    let b = photons_json("cornell_box", &["--build", "stencil", "--faithful"]);
     // The random texture holds the hash's numbers: the same photons, the same map.
     for field in ["attempts", "emitted", "photons_used", "stored"] {
         assert_eq!(a["trace"][field], b["trace"][field], "{field}");
@@ -725,22 +717,8 @@ fn a_camera_path_renders_every_frame_on_one_photon_map() {
 /// needing many more photons for the same stored count.
 #[test]
 fn projection_maps_are_reported_and_can_be_switched_off() {
-    let photons = |extra: &[&str]| -> serde_json::Value {
-        let out = photonmap()
-            .args(["photons", "--json"])
-            .args(extra)
-            .arg(scene("ring"))
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice(&out.stdout).unwrap()
-    };
-    let aimed = photons(&[]);
-    let everywhere = photons(&["--no-projection-map"]);
+    let aimed = photons_json("ring", &[]);
+    let everywhere = photons_json("ring", &["--no-projection-map"]);
     assert_eq!(aimed["trace"]["target"], 16000);
     assert_eq!(everywhere["trace"]["target"], 16000);
     let kept = aimed["trace"]["projection"]["kept_power_fraction"]
