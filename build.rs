@@ -1,43 +1,58 @@
-//! Embeds every file under glsl/ into the binary as (path, source) pairs, so a
-//! shader added to the folder is compiled into the program and into the test
-//! that compiles every GLSL file, with no list to keep by hand.
+//! Embeds every file under glsl/ (shaders) and every scene under scenes/ into
+//! the binary as (path, source) pairs: a shader or scene added to its folder
+//! is compiled in, and into the tests that check them all, with no list to
+//! keep by hand. The embedded scenes let the installed binary render the paper
+//! scenes by name and run the stress suite from any folder.
 use std::path::{Path, PathBuf};
 
-fn collect(dir: &Path, root: &Path, out: &mut Vec<PathBuf>) {
+fn collect(dir: &Path, root: &Path, extensions: &[&str], out: &mut Vec<PathBuf>) {
     let mut entries: Vec<_> = std::fs::read_dir(dir)
-        .expect("read glsl/")
+        .unwrap_or_else(|e| panic!("read {}: {e}", dir.display()))
         .flatten()
         .collect();
     entries.sort_by_key(|e| e.path());
     for e in entries {
         let p = e.path();
         if p.is_dir() {
-            collect(&p, root, out);
-        } else if matches!(
-            p.extension().and_then(|e| e.to_str()),
-            Some("glsl" | "vert" | "frag")
-        ) {
+            collect(&p, root, extensions, out);
+        } else if p
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| extensions.contains(&e))
+        {
             out.push(p.strip_prefix(root).unwrap().to_path_buf());
         }
     }
 }
 
-fn main() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
-    println!("cargo:rerun-if-changed=glsl");
+fn table(name: &str, folder: &str, extensions: &[&str]) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
+    println!("cargo:rerun-if-changed={folder}");
     let mut files = Vec::new();
-    collect(&root, &root, &mut files);
-    let mut code = String::from("pub static GLSL_SOURCES: &[(&str, &str)] = &[\n");
+    collect(&root, &root, extensions, &mut files);
+    let mut code = format!("pub static {name}: &[(&str, &str)] = &[\n");
     for f in &files {
-        println!("cargo:rerun-if-changed=glsl/{}", f.display());
-        let name = f.to_string_lossy().replace('\\', "/");
+        println!("cargo:rerun-if-changed={folder}/{}", f.display());
+        let path = f.to_string_lossy().replace('\\', "/");
         code += &format!(
             "    ({:?}, include_str!({:?})),\n",
-            name,
+            path,
             root.join(f).to_string_lossy()
         );
     }
-    code += "];\n";
-    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("glsl_sources.rs");
-    std::fs::write(out, code).unwrap();
+    code + "];\n"
+}
+
+fn main() {
+    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    std::fs::write(
+        out.join("glsl_sources.rs"),
+        table("GLSL_SOURCES", "glsl", &["glsl", "vert", "frag"]),
+    )
+    .unwrap();
+    std::fs::write(
+        out.join("scene_sources.rs"),
+        table("SCENE_SOURCES", "scenes", &["toml", "obj", "mtl"]),
+    )
+    .unwrap();
 }

@@ -1,11 +1,25 @@
 //! photonmap-gl: Purcell et al., "Photon Mapping on Programmable Graphics
 //! Hardware" (Graphics Hardware 2003), as OpenGL fragment passes, headless.
 //! ARCHITECTURE.md maps each box of the paper's Figure 1 to a module here.
+//!
+//! Dependencies run one way: render -> photon -> scene -> gpu, and every one
+//! of them may use the leaf modules (error, layout, random, sampling, timing,
+//! image). `stress` sits above render. `reference` holds the plain-Rust twins
+//! of the kernels; only tests import it.
+#![deny(unsafe_code)]
 
+pub mod error;
 pub mod gpu;
+pub mod image;
+pub mod layout;
 pub mod metrics;
 pub mod photon;
+pub mod random;
 pub mod reference;
 pub mod render;
+pub mod sampling;
 pub mod scene;
 pub mod stress;
+pub mod timing;
+
+pub use error::{Error, Result};

@@ -2,8 +2,8 @@
 //! (linear), relative MSE, and SSIM (Wang et al. 2004) on display luminance,
 //! all optionally restricted by a mask.
 
-use crate::render::image::linear_to_srgb;
-use crate::render::Image;
+use crate::error::{Error, Result};
+use crate::image::{linear_to_srgb, Image};
 
 #[derive(Clone, Debug, serde::Serialize, PartialEq)]
 pub struct Metrics {
@@ -36,39 +36,41 @@ fn squared_errors(a: &Image, b: &Image, keep: impl Fn(usize) -> bool) -> (f64, f
     (se, rel, n)
 }
 
-fn same_size(a: &Image, b: &Image) -> Result<(), String> {
+fn same_size(a: &Image, b: &Image) -> Result<()> {
     if (a.width, a.height) != (b.width, b.height) {
-        return Err(format!(
-            "image sizes differ: {} x {} and {} x {}",
-            a.width, a.height, b.width, b.height
-        ));
+        return Err(Error::SizeMismatch {
+            a_width: a.width,
+            a_height: a.height,
+            b_width: b.width,
+            b_height: b.height,
+        });
     }
     Ok(())
 }
 
 /// RMSE of linear RGB alone (no SSIM): for tests and noise figures.
-pub fn rmse(a: &Image, b: &Image) -> Result<f64, String> {
+pub fn rmse(a: &Image, b: &Image) -> Result<f64> {
     same_size(a, b)?;
     let (se, _, n) = squared_errors(a, b, |_| true);
     Ok((se / (n.max(1) * 3) as f64).sqrt())
 }
 
 /// Compares `a` with the reference `b`; `mask` (same size) keeps pixels where it is true.
-pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics, String> {
+pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics> {
     same_size(a, b)?;
     if let Some(m) = mask {
         if m.len() != a.pixels.len() {
-            return Err(format!(
+            return Err(Error::InvalidOption(format!(
                 "the mask has {} pixels, the images {}",
                 m.len(),
                 a.pixels.len()
-            ));
+            )));
         }
     }
     let keep = |i: usize| mask.is_none_or(|m| m[i]);
     let (se, rel, n) = squared_errors(a, b, keep);
     if n == 0 {
-        return Err("the mask keeps no pixel".into());
+        return Err(Error::InvalidOption("the mask keeps no pixel".into()));
     }
     let ssim_map = ssim_map(a, b);
     let ssim: f64 = ssim_map

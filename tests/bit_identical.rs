@@ -78,9 +78,9 @@ fn render_case(gpu: &photonmap::gpu::Gpu, c: &Case) -> Image {
     o.seed = 7;
     o.spp = c.spp;
     let gi = o.global.as_mut().unwrap();
-    gi.build = c.build;
-    gi.faithful = c.faithful;
-    render(gpu, &scene, &o, &|_, _, _| {}).unwrap().image
+    gi.photons.build = c.build;
+    gi.photons.faithful = c.faithful;
+    render(gpu, &scene, &o, &mut ()).unwrap().image
 }
 
 #[test]

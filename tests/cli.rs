@@ -55,7 +55,7 @@ fn render_writes_png_and_exr_the_same_way_up() {
     );
     for (x, y, p) in srgb.enumerate_pixels() {
         let v = linear.get(x, y);
-        let expect = (photonmap::render::image::linear_to_srgb(v[0]) * 255.0 + 0.5) as u8;
+        let expect = (photonmap::image::linear_to_srgb(v[0]) * 255.0 + 0.5) as u8;
         assert_eq!(p[0], expect, "pixel ({x}, {y})");
     }
 }

@@ -4,7 +4,7 @@
 mod common;
 
 use photonmap::gpu::program::glsl_files;
-use photonmap::gpu::{GpuError, PingPong, Program, Target, TexFormat, Texture};
+use photonmap::gpu::{DrawState, Error, PingPong, Program, Target, TexFormat, Texture};
 
 #[test]
 fn a_pass_writes_values_that_read_back_exactly() {
@@ -14,8 +14,11 @@ fn a_pass_writes_values_that_read_back_exactly() {
     let target = Target::new(&gpu, &[&tex]).unwrap();
     let program = Program::fullscreen(&gpu, "test/write_values.frag").unwrap();
     let value = 0.1f32; // not a short binary fraction: must still come back bit for bit
-    program.bind().float("u_value", value);
-    gpu.draw_fullscreen(&target);
+    program
+        .bind()
+        .float("u_value", value)
+        .draw_fullscreen(&target, &DrawState::PLAIN)
+        .unwrap();
     let data = tex.read_f32();
     for y in 0..h {
         for x in 0..w {
@@ -37,8 +40,11 @@ fn ping_pong_swaps_what_is_read_and_written() {
     let program = Program::fullscreen(&gpu, "test/add_one.frag").unwrap();
     let first = pp.current_index();
     for n in 1..=5 {
-        program.bind().texture("u_current", &pp.current()[0]);
-        gpu.draw_fullscreen(pp.next_target());
+        program
+            .bind()
+            .texture("u_current", &pp.current()[0])
+            .draw_fullscreen(pp.next_target(), &DrawState::PLAIN)
+            .unwrap();
         pp.swap();
         assert_eq!(pp.current_index(), (first + n) % 2);
         assert!(
@@ -97,8 +103,11 @@ fn texel_addressing_is_exact_up_to_2_pow_28() {
     let output = Texture::new(&gpu, tex_w, tex_h, TexFormat::Rgba32I).unwrap();
     let target = Target::new(&gpu, &[&output]).unwrap();
     let program = Program::fullscreen(&gpu, "test/addressing.frag").unwrap();
-    program.bind().texture("u_queries", &input);
-    gpu.draw_fullscreen(&target);
+    program
+        .bind()
+        .texture("u_queries", &input)
+        .draw_fullscreen(&target, &DrawState::PLAIN)
+        .unwrap();
     let out = output.read_i32();
     let mut mismatches = 0;
     for k in 0..n {
@@ -140,7 +149,7 @@ fn a_broken_shader_names_its_glsl_file_and_line() {
     )
     .err()
     .expect("the broken shader must not compile");
-    let GpuError::Shader(e) = err else {
+    let Error::Shader(e) = err else {
         panic!("expected a shader error, got {err}")
     };
     assert_eq!(
@@ -160,7 +169,7 @@ fn a_broken_shader_names_its_glsl_file_and_line() {
             other => glsl_files().find(|(n, _)| *n == other).map(|(_, s)| s.to_string()),
         }
     };
-    let GpuError::Shader(e) = Program::from_lookup(
+    let Error::Shader(e) = Program::from_lookup(
         &gpu,
         &lookup2,
         "common/fullscreen.vert",

@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{DVec3, Vec3};
-use photonmap::gpu::{Gpu, Program, Target, TexFormat, Texture};
+use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};
 use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
@@ -82,8 +82,9 @@ fn gpu_hits(
         .texture("u_ray_direction", &td)
         .texture("u_ray_normal", &tn)
         .int("u_primitive", 0)
-        .int("u_mode", normals.is_some() as i32);
-    gpu.draw_fullscreen(&target);
+        .int("u_mode", normals.is_some() as i32)
+        .draw_fullscreen(&target, &DrawState::PLAIN)
+        .unwrap();
     out.read_f32()
         .chunks(4)
         .take(n)

@@ -417,11 +417,11 @@ fn compaction_gives_the_same_map_as_sorting_every_record() {
         .trace_to_stored(&scene, &textures, 2)
         .unwrap();
     let grid = Grid::for_scene(&scene);
-    let mut build = BitonicBuild::new(&gpu).unwrap();
+    let build = BitonicBuild::new(&gpu).unwrap();
     let compacted = build
         .build(&frames, &grid, &mut Timings::default())
         .unwrap();
-    build.compact = false;
+    let build = build.compacting(false);
     let full = build
         .build(&frames, &grid, &mut Timings::default())
         .unwrap();

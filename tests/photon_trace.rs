@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{Vec3, Vec4};
-use photonmap::photon::{PhotonTracer, RandomSource};
+use photonmap::photon::{PhotonTracer, RandomSource, TraceConfig};
 use photonmap::reference::photon::{trace_photons, PhotonRecord};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{load_scene_str, Scene};
@@ -205,8 +205,17 @@ fn the_random_texture_traces_the_same_photons_as_the_hash() {
     let gpu = common::gpu();
     let scene = common::paper_scene("cornell_box");
     let textures = SceneTextures::new(&gpu, &scene).unwrap();
-    let hash = PhotonTracer::with_random(&gpu, RandomSource::Hash).unwrap();
-    let texture = PhotonTracer::with_random(&gpu, RandomSource::Texture).unwrap();
+    let with = |random| {
+        PhotonTracer::with_config(
+            &gpu,
+            TraceConfig {
+                random,
+                ..TraceConfig::default()
+            },
+        )
+        .unwrap()
+    };
+    let (hash, texture) = (with(RandomSource::Hash), with(RandomSource::Texture));
     let a = records(&hash.trace(&scene, &textures, 3, 5000).unwrap());
     let b = records(&texture.trace(&scene, &textures, 3, 5000).unwrap());
     assert_eq!(
@@ -223,21 +232,22 @@ fn bounces_stop_when_no_photon_is_left_and_the_image_does_not_change() {
     let gpu = common::gpu();
     let text = photonmap::stress::FURNACE.replace("max_bounces = 24", "max_bounces = 64");
     let scene = load_scene_str(&text, std::path::Path::new("furnace64.toml")).unwrap();
-    let run = |all: bool| {
+    let options = |all: bool| {
         let mut o = RenderOptions::for_scene(&scene);
         (o.width, o.height) = (32, 32);
         if let Some(gi) = &mut o.global {
-            gi.all_bounces = all;
+            gi.photons.all_bounces = all;
         }
-        render(&gpu, &scene, &o, &|_, _, _| {}).unwrap()
+        o
     };
+    let run = |all: bool| render(&gpu, &scene, &options(all), &mut ()).unwrap();
     let (stopped, full) = (run(false), run(true));
     assert_eq!(
         stopped.image, full.image,
         "stopping early must not change the image"
     );
     let frames = |r: &photonmap::render::RenderOutput| {
-        r.explain
+        r.explain(&scene, &options(false))
             .iter()
             .find(|l| l.stage == "trace photons")
             .unwrap()
@@ -325,8 +335,14 @@ fn ring_loses_no_stored_photon_by_storing_caustics_only() {
     let mut caustics = all_paths.clone();
     caustics.photon_map.caustics_only = true;
     let textures = SceneTextures::new(&gpu, &all_paths).unwrap();
-    let mut tracer = PhotonTracer::new(&gpu).unwrap();
-    tracer.projection_maps = false;
+    let tracer = PhotonTracer::with_config(
+        &gpu,
+        TraceConfig {
+            projection_maps: false,
+            ..TraceConfig::default()
+        },
+    )
+    .unwrap();
     let stored = |scene: &Scene| -> Vec<PhotonRecord> {
         let frames = tracer.trace(scene, &textures, 5, 200_000).unwrap();
         records(&frames)
@@ -363,8 +379,14 @@ fn projection_maps_keep_the_stored_caustic_flux() {
         scene.photon_map.caustics_only = true;
         let textures = SceneTextures::new(&gpu, &scene).unwrap();
         let flux = |aimed: bool, emitted: u32| -> (f64, f64) {
-            let mut tracer = PhotonTracer::new(&gpu).unwrap();
-            tracer.projection_maps = aimed;
+            let tracer = PhotonTracer::with_config(
+                &gpu,
+                TraceConfig {
+                    projection_maps: aimed,
+                    ..TraceConfig::default()
+                },
+            )
+            .unwrap();
             let frames = tracer.trace(&scene, &textures, 3, emitted).unwrap();
             assert_eq!(frames.projection.is_some(), aimed);
             let per_frame = (frames.width * frames.frame_height) as usize;

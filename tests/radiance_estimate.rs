@@ -4,7 +4,7 @@
 mod common;
 
 use glam::Vec3;
-use photonmap::photon::{BuildMethod, Grid, PhotonFrames, PhotonMap};
+use photonmap::photon::{BuildMethod, Grid, PhotonConfig, PhotonFrames, PhotonMap};
 use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
 use photonmap::render::{render, EstimateMode, GlobalIllumination, RenderOptions, RenderOutput};
 use photonmap::scene::Scene;
@@ -20,13 +20,16 @@ fn render_gi(
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (width, height, 3);
     let mut gi = GlobalIllumination {
-        build,
+        photons: PhotonConfig {
+            build,
+            ..PhotonConfig::default()
+        },
         ..GlobalIllumination::default()
     };
     gi.estimate.mode = mode;
     gi.estimate.budget = 48;
     o.global = Some(gi);
-    render(&gpu, scene, &o, &|_, _, _| {}).unwrap()
+    render(&gpu, scene, &o, &mut ()).unwrap()
 }
 
 /// Per query pixel: (position, GPU flux, GPU r^2, GPU accepted).
@@ -232,7 +235,7 @@ intensity = [0.0, 0.0, 0.0]
     let scene = photonmap::scene::load_scene_str(text, std::path::Path::new("plane.toml")).unwrap();
     let gpu = common::gpu();
     let o = RenderOptions::for_scene(&scene).direct_only();
-    let out = render(&gpu, &scene, &o, &|_, _, _| {}).unwrap();
+    let out = render(&gpu, &scene, &o, &mut ()).unwrap();
     let n = 40_000usize;
     let total_power = 8.0f32;
     let mut state = 12345u32;
@@ -271,14 +274,16 @@ intensity = [0.0, 0.0, 0.0]
         &mut |_| {},
     )
     .unwrap();
-    let img = est.compose(
-        &out.state.textures,
-        &out.state.direct,
-        k,
-        max_r,
-        false,
-        true,
-    );
+    let img = est
+        .compose(
+            &out.state.textures,
+            &out.state.direct,
+            k,
+            max_r,
+            false,
+            true,
+        )
+        .unwrap();
     // Pixels seeing the middle of the floor (the estimate's disc stays on it).
     let mut sum = 0f64;
     let mut count = 0;
@@ -354,11 +359,14 @@ fn faithful_mode_renders_the_same_image() {
             let mut o = RenderOptions::for_scene(&scene);
             (o.width, o.height) = (64, 48);
             o.global = Some(GlobalIllumination {
-                build,
-                faithful,
+                photons: PhotonConfig {
+                    build,
+                    faithful,
+                    ..PhotonConfig::default()
+                },
                 ..GlobalIllumination::default()
             });
-            images.push(render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image);
+            images.push(render(&gpu, &scene, &o, &mut ()).unwrap().image);
         }
         assert_eq!(
             images[0], images[1],

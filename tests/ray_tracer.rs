@@ -104,7 +104,7 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
         .map(|seed| {
             let mut o = RenderOptions::for_scene(&scene).direct_only();
             o.seed = seed + 1;
-            render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image
+            render(&gpu, &scene, &o, &mut ()).unwrap().image
         })
         .collect();
     let mean = Image::average(&images);
@@ -149,7 +149,7 @@ fn an_emitter_seen_directly_shows_its_radiance() {
     let scene = common::paper_scene("cornell_box");
     let mut o = RenderOptions::for_scene(&scene).direct_only();
     (o.width, o.height) = (64, 64);
-    let img = render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image;
+    let img = render(&gpu, &scene, &o, &mut ()).unwrap().image;
     let at_light = img
         .pixels
         .iter()
@@ -190,7 +190,7 @@ intensity = [8.0, 8.0, 8.0]
         &gpu,
         &scene,
         &RenderOptions::for_scene(&scene).direct_only(),
-        &|_, _, _| {},
+        &mut (),
     )
     .unwrap()
     .image;
@@ -208,7 +208,7 @@ fn samples_per_pixel_cut_noise_and_antialias_edges() {
     let run = |scene: &Scene, spp: u32, seed: u32| {
         let mut o = RenderOptions::for_scene(scene).direct_only();
         (o.width, o.height, o.spp, o.seed) = (64, 48, spp, seed);
-        render(&gpu, scene, &o, &|_, _, _| {}).unwrap().image
+        render(&gpu, scene, &o, &mut ()).unwrap().image
     };
     // Seed-to-seed difference (soft shadows, the glass choice) falls roughly as 1/sqrt(spp).
     let glass = common::paper_scene("glass_ball");

@@ -51,7 +51,7 @@ fn reduced(scene: &Scene) -> RenderOptions {
 fn render_seed(gpu: &photonmap::gpu::Gpu, scene: &Scene, seed: u32) -> Image {
     let mut o = reduced(scene);
     o.seed = seed;
-    render(gpu, scene, &o, &|_, _, _| {}).unwrap().image
+    render(gpu, scene, &o, &mut ()).unwrap().image
 }
 
 fn paths(name: &str) -> (PathBuf, PathBuf, PathBuf) {
@@ -305,7 +305,7 @@ fn the_comparison_catches_defects() {
             let scene = common::paper_scene(name);
             let mut o = reduced(&scene).direct_only();
             o.seed = TEST_SEED;
-            let img = render(&gpu, &scene, &o, &|_, _, _| {}).unwrap().image;
+            let img = render(&gpu, &scene, &o, &mut ()).unwrap().image;
             let f = score(&format!("{name}.no_caustic"), &img, &r);
             eprintln!(
                 "{name}: missing caustic fails {:.3}% (tolerance {:.3}%)",

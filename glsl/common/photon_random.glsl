@@ -1,6 +1,6 @@
 // Random numbers for photon tracing: the per-photon hash by default, or (with
 // RANDOM_TEXTURE, the paper's way, `--faithful`) a texture of random numbers,
-// 8 per photon per frame in two RGBA texels side by side. The texture is filled
+// RANDOM_PER_PHOTON_FRAME (8) per photon per frame in two RGBA texels side by side. The texture is filled
 // on the CPU with this very hash's values (src/photon/trace.rs), so both
 // sources give the same photons.
 #include "common/random.glsl"

@@ -2,24 +2,14 @@
 // shadow queries over all of it: a loop over every primitive, as in the paper.
 #include "common/intersect.glsl"
 
-uniform sampler2D u_primitives; // 4 texels a primitive, one row each
-uniform sampler2D u_materials;  // 3 texels a material
-uniform sampler2D u_lights;     // 5 texels a light
+uniform sampler2D u_primitives; // PRIMITIVE_TEXELS a primitive, one row each
+uniform sampler2D u_materials;  // MATERIAL_TEXELS a material
+uniform sampler2D u_lights;     // LIGHT_TEXELS a light
 uniform int u_primitive_count;
 uniform int u_light_count;
 
-const int PRIM_SPHERE = 0;
-const int PRIM_CYLINDER = 1;
-const int PRIM_PARALLELOGRAM = 2;
-const int PRIM_TRIANGLE = 3;
-
-const int MAT_DIFFUSE = 0;
-const int MAT_MIRROR = 1;
-const int MAT_GLASS = 2;
-const int MAT_EMITTER = 3;
-
-const int LIGHT_AREA = 0;
-const int LIGHT_POINT = 1;
+// PRIM_*, MAT_*, LIGHT_* kind codes and the *_TEXELS row lengths are
+// #defines from src/layout.rs, injected into every program.
 
 vec4 primitive_texel(int prim, int i) { return texelFetch(u_primitives, ivec2(i, prim), 0); }
 

@@ -16,7 +16,6 @@ uniform int u_count;              // stored records in all
 
 layout(location = 0) out ivec4 o_pair;
 
-const int INVALID_KEY = 0x7fffffff;
 
 int count_at(int level, ivec2 t) {
     ivec2 size = textureSize(u_pyramid, level);

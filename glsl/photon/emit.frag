@@ -74,13 +74,13 @@ void main() {
     if (int(head.x) == LIGHT_POINT) {
         p = a;
         d = sample_sphere(u1, u2);
-        power = 4.0 * SAMPLING_PI * emitted;
+        power = 4.0 * PI * emitted;
     } else {
         vec3 e1 = light_texel(l, 2).xyz;
         vec3 e2 = light_texel(l, 3).xyz;
         p = a + u1 * e1 + u2 * e2;
         d = sample_cosine(head.yzw, u3, u4);
-        power = SAMPLING_PI * length(cross(e1, e2)) * emitted;
+        power = PI * length(cross(e1, e2)) * emitted;
     }
     o_position = vec4(p, -1.0);
     o_power = vec4(power / (float(u_emitted) * probability), 0.0);

@@ -15,7 +15,6 @@ layout(location = 0) out vec4 o_position; // xyz, w = 1 valid
 layout(location = 1) out vec4 o_power;    // rgb
 layout(location = 2) out vec4 o_incoming; // direction of arrival
 
-const int INVALID_KEY = 0x7fffffff;
 
 void main() {
     ivec4 pair = texelFetch(u_sorted, ivec2(gl_FragCoord.xy), 0);

@@ -16,7 +16,6 @@ uniform int u_photons_used;   // photons with index >= this are dropped
 
 layout(location = 0) out ivec4 o_key; // (cell, record, 0, 0)
 
-const int INVALID_KEY = 0x7fffffff;
 
 void main() {
     int i = index_of_texel(ivec2(gl_FragCoord.xy), u_sort_width);

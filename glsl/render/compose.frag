@@ -18,7 +18,6 @@ uniform int u_include_indirect;
 
 layout(location = 0) out vec4 o_radiance;
 
-const float PI = 3.14159265358979;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);

@@ -24,7 +24,6 @@ layout(location = 1) out vec4 o_diffuse_position;   // xyz, w = 1 where recorded
 layout(location = 2) out vec4 o_diffuse_normal;     // facing the viewer, w = material + 1
 layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the hit
 
-const float PI = 3.14159265358979;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);

@@ -5,14 +5,154 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use clap::Args;
 use serde::{Deserialize, Serialize};
 
-use photonmap::gpu::Gpu;
+use photonmap::gpu::{Gpu, Platform};
+use photonmap::image::write_atomically;
 use photonmap::metrics::{compare, Metrics};
-use photonmap::photon::BuildMethod;
-use photonmap::render::image::write_atomically;
+use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::render::{render, EstimateMode, GlobalIllumination, Image, RenderOptions};
-use photonmap::scene::Scene;
+use photonmap::scene::{embedded, Scene};
+
+/// Render a converged reference of a scene (more photons, larger k, several
+/// eye samples, many seeds averaged) as EXR, with its command and residual noise.
+#[derive(Args)]
+pub struct ReferenceArgs {
+    /// Scene file, or the name of an embedded scene.
+    pub scene: PathBuf,
+    /// Output EXR (default: reference_images/<scene>.converged.exr under the
+    /// current folder; a .json goes beside it).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Render at 1/scale of the scene's resolution (1..=16).
+    #[arg(long, default_value_t = 2, value_parser = super::args::in_range(1, 16))]
+    pub scale: u32,
+    /// Photons stored x this; k x its square root (1..=64).
+    #[arg(long, default_value_t = 8, value_parser = super::args::in_range(1, 64))]
+    pub photons_factor: u32,
+    /// Renders averaged (2..=256).
+    #[arg(long, default_value_t = 8, value_parser = super::args::in_range(2, 256))]
+    pub seeds: u32,
+    /// Eye samples per pixel of each (1..=256).
+    #[arg(long, default_value_t = 4, value_parser = super::args::in_range(1, 256))]
+    pub spp: u32,
+}
+
+pub fn run_reference(a: &ReferenceArgs, platform: Platform) -> Result<()> {
+    let scene = embedded::load_path_or_name(&a.scene)?;
+    let out = a.out.clone().unwrap_or_else(|| default_reference(&a.scene));
+    super::check_output(&out, "exr", "--out")?;
+    let gpu = super::gpu(platform)?;
+    let command = format!(
+        "photonmap reference {} --scale {} --photons-factor {} --seeds {} --spp {}",
+        a.scene.display(),
+        a.scale,
+        a.photons_factor,
+        a.seeds,
+        a.spp
+    );
+    let options = ReferenceOptions {
+        scale: a.scale,
+        photons_factor: a.photons_factor,
+        seeds: a.seeds,
+        spp: a.spp,
+    };
+    let (img, info) = make_reference(&gpu, &scene, &options, command, &|m: &str| eprintln!("{m}"))?;
+    write_reference(&img, &info, &out)?;
+    eprintln!(
+        "wrote {} (residual RMSE {:.6})",
+        out.display(),
+        info.residual_rmse
+    );
+    Ok(())
+}
+
+/// `bench accuracy`'s options.
+#[derive(Args)]
+pub struct AccuracyArgs {
+    /// Scene file, or the name of an embedded scene.
+    #[arg(long)]
+    pub scene: PathBuf,
+    /// The converged reference (default: reference_images/<scene>.converged.exr
+    /// under the current folder).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Output folder (default: results/<renderer>/accuracy/<scene>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// A small sweep.
+    #[arg(long)]
+    pub quick: bool,
+    #[arg(long)]
+    pub json: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
+    let scene = embedded::load_path_or_name(&a.scene)?;
+    let reference = a
+        .reference
+        .clone()
+        .unwrap_or_else(|| default_reference(&a.scene));
+    if !reference.is_file() {
+        bail!(
+            "no converged reference at {}: make one with `photonmap reference {}`",
+            reference.display(),
+            a.scene.display()
+        );
+    }
+    let gpu = super::gpu(platform)?;
+    let report = bench_accuracy(
+        &gpu,
+        &scene,
+        &reference,
+        a.quick,
+        &super::progress_lines(a.quiet),
+    )?;
+    let dir = a.out.clone().unwrap_or_else(|| {
+        super::tables::default_out(&report.renderer)
+            .join("accuracy")
+            .join(stem(&a.scene))
+    });
+    std::fs::create_dir_all(&dir)?;
+    let write = |name: &str, bytes: &[u8]| write_atomically(&dir.join(name), bytes);
+    write("accuracy.csv", csv(&report).as_bytes())?;
+    write(
+        "accuracy.json",
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )?;
+    write("accuracy.svg", svg_plot(&report).as_bytes())?;
+    write("accuracy.png", &png_plot(&report))?;
+    if a.json {
+        return super::print_json(&report);
+    }
+    println!(
+        "{:<18} {:>9} {:>11} {:>8} {:>7}",
+        "run", "seconds", "rel. MSE", "SSIM", "front"
+    );
+    for r in &report.runs {
+        println!(
+            "{:<18} {:>9.3} {:>11.5} {:>8.4} {:>7}",
+            r.label,
+            r.total_seconds,
+            r.metrics.rel_mse,
+            r.metrics.ssim,
+            if r.on_pareto_front { "*" } else { "" }
+        );
+    }
+    println!("recommended: {}", report.recommended);
+    eprintln!("wrote {}", dir.display());
+    Ok(())
+}
+
+fn stem(scene: &Path) -> String {
+    scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
 
 #[derive(Serialize, Deserialize, Debug, Clone)]
 pub struct ReferenceInfo {
@@ -48,13 +188,6 @@ pub fn make_reference(
     command: String,
     progress: &dyn Fn(&str),
 ) -> Result<(Image, ReferenceInfo)> {
-    if !(1..=16).contains(&o.scale)
-        || !(1..=64).contains(&o.photons_factor)
-        || !(2..=256).contains(&o.seeds)
-        || !(1..=256).contains(&o.spp)
-    {
-        bail!("--scale 1..=16, --photons-factor 1..=64, --seeds 2..=256, --spp 1..=256 are the allowed ranges");
-    }
     let mut s = scene.clone();
     s.photon_map.photons_stored = scene
         .photon_map
@@ -73,14 +206,11 @@ pub fn make_reference(
         opts.height = (scene.camera.height / o.scale).max(1);
         opts.spp = o.spp;
         opts.seed = 1000 + seed;
-        images.push(render(gpu, &s, &opts, &|_, _, _| {})?.image);
+        images.push(render(gpu, &s, &opts, &mut ())?.image);
     }
     let even: Vec<Image> = images.iter().step_by(2).cloned().collect();
     let odd: Vec<Image> = images.iter().skip(1).step_by(2).cloned().collect();
-    let residual = compare(&Image::average(&even), &Image::average(&odd), None)
-        .map_err(anyhow::Error::msg)?
-        .rmse
-        / 2.0;
+    let residual = compare(&Image::average(&even), &Image::average(&odd), None)?.rmse / 2.0;
     let img = Image::average(&images);
     let info = ReferenceInfo {
         scene: scene.name.clone(),
@@ -99,13 +229,12 @@ pub fn make_reference(
 }
 
 pub fn write_reference(img: &Image, info: &ReferenceInfo, exr: &Path) -> Result<()> {
-    write_atomically(exr, &img.exr_bytes().map_err(anyhow::Error::msg)?)
-        .map_err(anyhow::Error::msg)?;
+    write_atomically(exr, &img.exr_bytes()?)?;
     write_atomically(
         &exr.with_extension("json"),
         (serde_json::to_string_pretty(info)? + "\n").as_bytes(),
-    )
-    .map_err(anyhow::Error::msg)
+    )?;
+    Ok(())
 }
 
 #[derive(Serialize, Clone, Debug)]
@@ -225,7 +354,7 @@ pub fn bench_accuracy(
     quick: bool,
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
-    let reference_img = Image::read_exr(reference).map_err(anyhow::Error::msg)?;
+    let reference_img = Image::read_exr(reference)?;
     let info: ReferenceInfo = serde_json::from_str(
         &std::fs::read_to_string(reference.with_extension("json"))
             .with_context(|| format!("reading {}", reference.with_extension("json").display()))?,
@@ -243,7 +372,10 @@ pub fn bench_accuracy(
         let mut o = RenderOptions::for_scene(&s);
         (o.width, o.height, o.spp, o.seed) = (reference_img.width, reference_img.height, c.spp, 7);
         let mut gi = GlobalIllumination {
-            build: c.build,
+            photons: PhotonConfig {
+                build: c.build,
+                ..PhotonConfig::default()
+            },
             ..GlobalIllumination::default()
         };
         gi.estimate.mode = if c.tile == 0 {
@@ -252,7 +384,7 @@ pub fn bench_accuracy(
             EstimateMode::Tiled { tile: c.tile }
         };
         o.global = Some(gi);
-        let r = render(gpu, &s, &o, &|_, _, _| {})?;
+        let r = render(gpu, &s, &o, &mut ())?;
         let stage = |names: &[&str]| {
             r.timings
                 .stages
@@ -261,7 +393,7 @@ pub fn bench_accuracy(
                 .map(|st| st.wall_seconds)
                 .sum::<f64>()
         };
-        let metrics = compare(&r.image, &reference_img, None).map_err(anyhow::Error::msg)?;
+        let metrics = compare(&r.image, &reference_img, None)?;
         let (tp, bm, tr, re) = (
             stage(&["trace photons"]),
             stage(&["build map"]),
@@ -479,12 +611,7 @@ pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
     out.into_inner()
 }
 
-pub fn default_reference(scene_path: &Path) -> PathBuf {
-    let stem = scene_path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("reference_images")
-        .join(format!("{stem}.converged.exr"))
+/// reference_images/<scene>.converged.exr under the current folder.
+pub fn default_reference(scene: &Path) -> PathBuf {
+    PathBuf::from("reference_images").join(format!("{}.converged.exr", stem(scene)))
 }

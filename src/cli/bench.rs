@@ -1,9 +1,148 @@
-//! `photonmap bench build`: the photon-map builds against n.
+//! `photonmap bench`: benchmarks and the stress suite, commands rather than
+//! tests, each with `--json` so anyone can rerun them.
 
 use anyhow::{bail, Result};
+use clap::{Args, Subcommand};
 
-use photonmap::gpu::Gpu;
-use photonmap::photon::bench::{bench_size, paper_grid, BuildBenchRow};
+use photonmap::gpu::{Gpu, Platform};
+use photonmap::photon::bench::{bench_mask, bench_size, paper_grid, BuildBenchRow};
+use photonmap::stress::Outcome;
+
+use super::args::in_range;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// The stress suite: scale and place, sizes, crowding, grids, search edges,
+    /// difficult paths, the furnace; one JSON object per case with --json.
+    Stress(StressArgs),
+    /// Run time against error around a scene's defaults (photons, k, maximum
+    /// radius, shadow rays, build, tiling, samples), against its converged
+    /// reference; CSV, JSON, SVG and PNG plots of the Pareto front.
+    Accuracy(super::accuracy::AccuracyArgs),
+    /// Whether the stencil test skips fragment work on this driver (the
+    /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
+    Mask(MaskArgs),
+    /// Photon-map builds for n = 2^min .. 2^max synthetic photons: bitonic passes,
+    /// time per pass against a copy pass, binary search, stencil routing with and
+    /// without read-back.
+    Build(BuildArgs),
+}
+
+#[derive(Args)]
+pub struct StressArgs {
+    /// Only the cases that take seconds.
+    #[arg(long)]
+    pub quick: bool,
+    #[arg(long)]
+    pub json: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Args)]
+pub struct MaskArgs {
+    /// Side of the square pass in pixels (16..=8192).
+    #[arg(long, default_value_t = 512, value_parser = in_range(16, 8192))]
+    pub size: u32,
+    /// Rounds of sin/cos per pixel (1..=100000).
+    #[arg(long, default_value_t = 200, value_parser = in_range(1, 100_000))]
+    pub iterations: u32,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args)]
+pub struct BuildArgs {
+    /// Smallest size, 2^min photons (1..=24).
+    #[arg(long, default_value_t = 10, value_parser = in_range(1, 24))]
+    pub min_log2: u32,
+    /// Largest size, 2^max photons (min..=24).
+    #[arg(long, default_value_t = 20, value_parser = in_range(1, 24))]
+    pub max_log2: u32,
+    /// Stencil routing m (the paper: a 1024 x 1024 buffer of about 40^3 cells; 1..=16).
+    #[arg(long, default_value_t = 4, value_parser = in_range(1, 16))]
+    pub stencil_m: u32,
+    #[arg(long)]
+    pub json: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
+    match command {
+        BenchCommand::Stress(a) => run_stress(&a, platform),
+        BenchCommand::Accuracy(a) => super::accuracy::run_bench(&a, platform),
+        BenchCommand::Mask(a) => run_mask(&a, platform),
+        BenchCommand::Build(a) => {
+            if a.min_log2 > a.max_log2 {
+                bail!(
+                    "--min-log2 {} --max-log2 {}: the allowed range is 1 <= min <= max <= 24",
+                    a.min_log2,
+                    a.max_log2
+                );
+            }
+            let gpu = super::gpu(platform)?;
+            let bench = run_build_bench(&gpu, a.min_log2, a.max_log2, a.stencil_m, !a.quiet)?;
+            if a.json {
+                super::print_json(&bench)
+            } else {
+                print_build_bench(&bench);
+                Ok(())
+            }
+        }
+    }
+}
+
+fn run_stress(a: &StressArgs, platform: Platform) -> Result<()> {
+    let gpu = super::gpu(platform)?;
+    let cases = photonmap::stress::run(&gpu, a.quick, &super::progress_lines(a.quiet));
+    for c in &cases {
+        if a.json {
+            println!("{}", serde_json::to_string(c)?);
+        } else {
+            println!(
+                "{:<8} {:<70} {:>12.5} {:>7.2} s  {}",
+                format!("{:?}", c.outcome).to_lowercase(),
+                c.name,
+                c.value,
+                c.seconds,
+                c.message
+            );
+        }
+    }
+    if cases.iter().any(|c| c.outcome == Outcome::Fail) {
+        bail!("some stress cases failed");
+    }
+    Ok(())
+}
+
+fn run_mask(a: &MaskArgs, platform: Platform) -> Result<()> {
+    let gpu = super::gpu(platform)?;
+    let rows = bench_mask(&gpu, a.size, a.iterations as i32)?;
+    if a.json {
+        let renderer = gpu.capabilities().gl_renderer;
+        println!(
+            "{}",
+            serde_json::json!({ "renderer": renderer, "size": a.size, "iterations": a.iterations, "rows": rows })
+        );
+        return Ok(());
+    }
+    println!(
+        "{:>8} {:>11} {:>8} {:>10} {:>9}",
+        "masked", "where", "stencil", "wall ms", "relative"
+    );
+    for r in &rows {
+        let place = if r.contiguous { "contiguous" } else { "spread" };
+        println!(
+            "{:>7.0}% {place:>11} {:>8} {:>10.2} {:>9.3}",
+            r.masked_fraction * 100.0,
+            r.stencil_test,
+            r.wall_seconds * 1e3,
+            r.relative
+        );
+    }
+    Ok(())
+}
 
 #[derive(serde::Serialize)]
 pub struct BuildBench {
@@ -19,9 +158,6 @@ pub fn run_build_bench(
     block: u32,
     progress: bool,
 ) -> Result<BuildBench> {
-    if !(1..=24).contains(&min_log2) || !(min_log2..=24).contains(&max_log2) {
-        bail!("--min-log2 {min_log2} --max-log2 {max_log2}: the allowed range is 1 <= min <= max <= 24");
-    }
     let caps = gpu.capabilities();
     let bar = if progress {
         indicatif::ProgressBar::new((max_log2 - min_log2 + 1) as u64)

@@ -2,14 +2,41 @@
 //! report what happened (counts, passes, per-stage times).
 
 use anyhow::Result;
+use clap::Args;
 
-use photonmap::gpu::Gpu;
-use photonmap::photon::{
-    BitonicBuild, BuildMethod, PhotonTracer, RandomSource, StencilRouting, TraceReport, VertexFeed,
-};
+use photonmap::gpu::{Gpu, Platform};
+use photonmap::photon::{build_map, BuildMethod, PhotonConfig, PhotonMap, TraceReport};
 use photonmap::render::Timings;
 use photonmap::scene::pack::SceneTextures;
-use photonmap::scene::Scene;
+use photonmap::scene::{embedded, Scene};
+
+use super::args::PhotonMapArgs;
+
+/// Trace a scene's photons and build its photon map; report counts, passes and times.
+#[derive(Args)]
+pub struct PhotonsArgs {
+    /// Scene file, or the name of an embedded scene.
+    pub scene: std::path::PathBuf,
+    #[command(flatten)]
+    pub photons: PhotonMapArgs,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// As JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: &PhotonsArgs, platform: Platform) -> Result<()> {
+    let scene = embedded::load_path_or_name(&args.scene)?;
+    let gpu = super::gpu(platform)?;
+    let report = trace_and_build(&gpu, &scene, &(&args.photons).into(), args.seed)?;
+    if args.json {
+        super::print_json(&report)
+    } else {
+        print_report(&report);
+        Ok(())
+    }
+}
 
 #[derive(serde::Serialize)]
 pub struct PhotonReport {
@@ -35,89 +62,48 @@ pub struct PhotonReport {
     pub timings: Timings,
 }
 
-pub struct PhotonOptions {
-    pub seed: u32,
-    pub build: BuildMethod,
-    pub faithful: bool,
-    pub feed: VertexFeed,
-    pub stencil_block: u32,
-    /// Aim photons by projection maps when the scene stores caustics only.
-    pub projection_maps: bool,
-}
-
-pub fn trace_and_build(gpu: &Gpu, scene: &Scene, o: &PhotonOptions) -> Result<PhotonReport> {
+pub fn trace_and_build(
+    gpu: &Gpu,
+    scene: &Scene,
+    config: &PhotonConfig,
+    seed: u32,
+) -> Result<PhotonReport> {
     let textures = SceneTextures::new(gpu, scene)?;
-    let random = if o.faithful {
-        RandomSource::Texture
-    } else {
-        RandomSource::Hash
-    };
-    let mut tracer = PhotonTracer::with_random(gpu, random)?;
-    tracer.projection_maps = o.projection_maps;
-    let mut timings = Timings::default();
+    let mut totals = Timings::default();
     let wall = std::time::Instant::now();
-    let (frames, trace) = tracer.trace_to_stored(scene, &textures, o.seed)?;
-    // The kept trace; earlier attempts (choosing the emitted count) are in `trace`.
-    timings.add("trace photons", trace.gpu_seconds, frames.frames as usize);
-    let grid = photonmap::photon::fit::grid_for(gpu, scene, &frames)?;
-    let feed = if o.faithful {
-        VertexFeed::Readback
-    } else {
-        o.feed
-    };
-    let (in_map, in_grid, per_cell, over, block) = match o.build {
-        BuildMethod::Bitonic => {
-            let bitonic = BitonicBuild::with_addressing(gpu, o.faithful)?;
-            let map = bitonic.build(&frames, &grid, &mut timings)?;
-            let first: Vec<i32> = map.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
-            let cells = grid.cell_count() as usize;
-            let per_cell: Vec<u32> = (0..cells)
-                .map(|c| (first[c + 1] - first[c]) as u32)
-                .collect();
-            (
-                first[cells] as u64,
-                first[cells] as u64,
-                per_cell,
-                None,
-                None,
-            )
-        }
-        BuildMethod::Stencil => {
-            let map = StencilRouting::new(gpu)?.build(
-                &frames,
-                &grid,
-                o.stencil_block,
-                feed,
-                &mut timings,
-            )?;
-            let per_cell: Vec<u32> = map
-                .counts
-                .read_f32()
-                .chunks(4)
-                .take(grid.cell_count() as usize)
-                .map(|c| c[0] as u32)
-                .collect();
-            let slots = o.stencil_block * o.stencil_block;
+    let built = build_map(gpu, scene, &textures, config, seed, &mut totals)?;
+    // Tracing, then the build's own stages (not their total, which would count them twice).
+    let mut timings = Timings::default();
+    timings.stages.extend(
+        totals
+            .stages
+            .into_iter()
+            .filter(|s| s.name == "trace photons"),
+    );
+    timings
+        .stages
+        .extend(built.build_stages.stages.iter().cloned());
+    let per_cell = built.map.photons_per_cell();
+    let in_grid: u64 = per_cell.iter().map(|&c| c as u64).sum();
+    let (in_map, over, block) = match &built.map {
+        PhotonMap::Sorted(_) => (in_grid, None, None),
+        PhotonMap::Routed(m) => {
+            let slots = m.block * m.block;
             let in_map: u64 = per_cell.iter().map(|&c| c.min(slots) as u64).sum();
             let over = per_cell.iter().filter(|&&c| c > slots).count() as u32;
-            (
-                in_map,
-                per_cell.iter().map(|&c| c as u64).sum(),
-                per_cell,
-                Some(over),
-                Some(o.stencil_block),
-            )
+            (in_map, Some(over), Some(m.block))
         }
     };
     gpu.finish();
     timings.wall_seconds = wall.elapsed().as_secs_f64();
+    let grid = built.grid;
     Ok(PhotonReport {
         scene: scene.name.clone(),
-        seed: o.seed,
-        build: o.build,
-        faithful: o.faithful,
-        power_scale: frames.power_scale,
-        trace,
+        seed,
+        build: config.build,
+        faithful: config.faithful,
+        power_scale: built.power_scale,
+        trace: built.trace,
         grid_resolution: grid.resolution,
         grid_min: grid.min.to_array(),
         grid_max: grid.max.to_array(),

@@ -3,24 +3,51 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
+use clap::Args;
 use serde::Serialize;
 
-use photonmap::gpu::Gpu;
+use photonmap::gpu::{Gpu, Platform};
+use photonmap::image::write_atomically;
 use photonmap::photon::bench::{bench_size, paper_grid, BuildBenchRow};
-use photonmap::photon::BuildMethod;
-use photonmap::reference::knn::{software_image, SoftwareEstimate};
-use photonmap::render::image::write_atomically;
-use photonmap::render::{
-    render, EstimateMode, GlobalIllumination, Image, RenderOptions, SnapshotEvery, Snapshots,
-};
-use photonmap::scene::{load_scene, Scene};
+use photonmap::photon::{BuildMethod, PhotonConfig};
+use photonmap::render::software::software_image;
+use photonmap::render::{render, EstimateMode, GlobalIllumination, Image, RenderOptions};
+use photonmap::scene::{embedded, Scene};
 
-pub struct TablesOptions {
+use super::render::{SnapshotEvery, SnapshotWriter};
+
+/// Reproduce the paper's tables and figures into results/<renderer>/ (or --out).
+#[derive(Args)]
+pub struct TablesArgs {
+    /// Output folder (default: results/<renderer>/).
+    #[arg(long)]
     pub out: Option<PathBuf>,
+    /// A reduced run for CI: quarter resolution, one run, fewer sizes and modes.
+    #[arg(long)]
     pub quick: bool,
+    /// The paper's 2003 constraints (random-number texture, read-back, no compaction).
+    #[arg(long)]
     pub faithful: bool,
+    /// Runs per Table 1 cell, median and spread quoted (1..=20).
+    #[arg(long, default_value_t = 3, value_parser = super::args::in_range(1, 20))]
     pub runs: u32,
+    #[arg(long)]
+    pub json: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: &TablesArgs, platform: Platform) -> Result<()> {
+    let gpu = super::gpu(platform)?;
+    let (report, dir) = run_tables(&gpu, a, &super::progress_lines(a.quiet))?;
+    if a.json {
+        super::print_json(&report)?;
+    } else {
+        print!("{}", markdown(&report));
+        eprintln!("wrote {}", dir.display());
+    }
+    Ok(())
 }
 
 /// Table 1 of the paper (GeForce FX 5900 Ultra, seconds).
@@ -149,8 +176,11 @@ fn options(
     o.width = (scene.camera.width / scale).max(1);
     o.height = (scene.camera.height / scale).max(1);
     let mut gi = GlobalIllumination {
-        build,
-        faithful,
+        photons: PhotonConfig {
+            build,
+            faithful,
+            ..PhotonConfig::default()
+        },
         ..GlobalIllumination::default()
     };
     gi.estimate.mode = mode;
@@ -251,8 +281,7 @@ fn visibly_different(a: &Image, b: &Image) -> f64 {
 }
 
 fn write_png(path: &Path, img: &Image) -> Result<()> {
-    write_atomically(path, &img.png_bytes().map_err(anyhow::Error::msg)?)
-        .map_err(anyhow::Error::msg)
+    Ok(write_atomically(path, &img.png_bytes()?)?)
 }
 
 /// Counts the instructions of a kernel's optimised SPIR-V (glslangValidator -Os).
@@ -414,12 +443,9 @@ fn table2() -> Result<Vec<KernelCount>, String> {
 
 pub fn run_tables(
     gpu: &Gpu,
-    o: &TablesOptions,
+    o: &TablesArgs,
     progress: &dyn Fn(&str),
 ) -> Result<(TablesReport, PathBuf)> {
-    if !(1..=20).contains(&o.runs) {
-        bail!("--runs {}: the allowed range is 1..=20", o.runs);
-    }
     let caps = gpu.capabilities();
     let out = o
         .out
@@ -427,215 +453,25 @@ pub fn run_tables(
         .unwrap_or_else(|| default_out(&caps.gl_renderer));
     std::fs::create_dir_all(out.join("figure7"))
         .with_context(|| format!("creating {}", out.display()))?;
-    let scale = if o.quick { 4 } else { 1 };
-    let runs = if o.quick { 1 } else { o.runs };
-    let scenes_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
-
-    // Table 1 (and figure 7's images from the first run of each).
-    let mut table1 = Vec::new();
-    let mut totals = Vec::new();
-    let mut figure7_rows = Vec::new();
-    for (name, paper_bitonic, paper_stencil) in PAPER_TABLE1 {
-        let scene = load_scene(&scenes_dir.join(format!("{name}.toml")))?;
-        let mut row = Vec::new();
-        for (build, paper) in [
-            (BuildMethod::Bitonic, paper_bitonic),
-            (BuildMethod::Stencil, paper_stencil),
-        ] {
-            let mut walls = vec![Vec::new(); 4];
-            let mut gpus = vec![Vec::new(); 4];
-            let mut run_totals = Vec::new();
-            for run in 0..runs {
-                progress(&format!("Table 1: {name} {build:?} run {}/{runs}", run + 1));
-                let opts = options(
-                    &scene,
-                    scale,
-                    build,
-                    o.faithful,
-                    EstimateMode::Tiled { tile: 16 },
-                );
-                let r = render(gpu, &scene, &opts, &|_, _, _| {})?;
-                let mut total = 0.0;
-                for (i, stage) in STAGES.iter().enumerate() {
-                    let (w, g) = stage_seconds(&r.timings, stage);
-                    walls[i].push(w);
-                    gpus[i].push(g);
-                    total += w;
-                }
-                run_totals.push(total);
-                if run == 0 {
-                    let file = out
-                        .join("figure7")
-                        .join(format!("{name}_{build:?}.png").to_lowercase());
-                    write_png(&file, &r.image)?;
-                    row.push(r.image.clone());
-                    if build == BuildMethod::Bitonic {
-                        progress(&format!("Figure 7: {name} software reference"));
-                        let sw = software_image(&r.state, &scene, SoftwareEstimate::KdTree)
-                            .context("software reference")?;
-                        write_png(
-                            &out.join("figure7").join(format!("{name}_software.png")),
-                            &sw,
-                        )?;
-                        row.push(sw);
-                    }
-                }
-            }
-            for (i, stage) in STAGES.iter().enumerate() {
-                let med = median(&walls[i]);
-                table1.push(Table1Cell {
-                    scene: scene.name.clone(),
-                    build,
-                    stage: stage.to_string(),
-                    median_wall_seconds: med,
-                    min_wall_seconds: walls[i].iter().copied().fold(f64::INFINITY, f64::min),
-                    max_wall_seconds: walls[i].iter().copied().fold(0.0, f64::max),
-                    median_gpu_seconds: median(&gpus[i]),
-                    wall_seconds: walls[i].clone(),
-                    paper_seconds: paper[i],
-                    ratio_to_paper: med / paper[i],
-                    at_or_below_paper: med <= paper[i],
-                });
-            }
-            let paper_total: f64 = paper.iter().sum();
-            let med = median(&run_totals);
-            totals.push(Table1Total {
-                scene: scene.name.clone(),
-                build,
-                median_seconds: med,
-                paper_seconds: paper_total,
-                ratio_to_paper: med / paper_total,
-                at_most_a_quarter: med <= paper_total / 4.0,
-            });
-        }
-        // Row order as in figure 7: bitonic, stencil, software.
-        row.swap(1, 2);
-        figure7_rows.push(row);
-    }
+    let run = TablesRun {
+        gpu,
+        scale: if o.quick { 4 } else { 1 },
+        runs: if o.quick { 1 } else { o.runs },
+        quick: o.quick,
+        faithful: o.faithful,
+        out: &out,
+        progress,
+    };
+    let (table1, totals, figure7_rows) = run.table1()?;
     let figure7 = out.join("figure7.png");
     write_png(&figure7, &montage(&figure7_rows))?;
-
-    // Section 3.3: full convergence of the estimate by drawing mode.
-    let mut convergence = Vec::new();
-    let modes: Vec<(String, EstimateMode)> = if o.quick {
-        vec![
-            ("full screen".into(), EstimateMode::FullScreen),
-            ("16 x 16 tiles".into(), EstimateMode::Tiled { tile: 16 }),
-            ("mask every pass".into(), EstimateMode::Masked { every: 1 }),
-        ]
-    } else {
-        let mut m: Vec<(String, EstimateMode)> =
-            vec![("full screen".into(), EstimateMode::FullScreen)];
-        for t in [8, 16, 32, 64] {
-            m.push((format!("{t} x {t} tiles"), EstimateMode::Tiled { tile: t }));
-        }
-        m.push(("mask every pass".into(), EstimateMode::Masked { every: 1 }));
-        m
-    };
-    for name in ["glass_ball", "cornell_box"] {
-        let scene = load_scene(&scenes_dir.join(format!("{name}.toml")))?;
-        for (label, mode) in &modes {
-            progress(&format!("Section 3.3: {name} {label}"));
-            let r = render(
-                gpu,
-                &scene,
-                &options(&scene, scale, BuildMethod::Bitonic, o.faithful, *mode),
-                &|_, _, _| {},
-            )?;
-            let e = r.estimate.unwrap_or_default();
-            convergence.push(ConvergenceRow {
-                scene: scene.name.clone(),
-                mode: label.clone(),
-                wall_seconds: stage_seconds(&r.timings, "radiance estimate").0,
-                passes: e.passes,
-                tile_draws: e.tile_draws,
-            });
-        }
-    }
-
-    // Passes against n.
+    let convergence = run.section_3_3()?;
     let mut passes = Vec::new();
     for k in 10..=(if o.quick { 12 } else { 20 }) {
         progress(&format!("Passes: n = 2^{k}"));
         passes.push(bench_size(gpu, 1 << k, &paper_grid(), 4)?);
     }
-
-    // Figure 8: the GLASS BALL caustic during convergence.
-    progress("Figure 8: GLASS BALL snapshots");
-    let snap_dir = out.join("figure8");
-    std::fs::create_dir_all(&snap_dir)?;
-    for e in std::fs::read_dir(&snap_dir)?.flatten() {
-        let _ = std::fs::remove_file(e.path());
-    }
-    let scene = load_scene(&scenes_dir.join("glass_ball.toml"))?;
-    let mut opts = options(
-        &scene,
-        scale,
-        BuildMethod::Bitonic,
-        o.faithful,
-        EstimateMode::Tiled { tile: 16 },
-    );
-    if let Some(gi) = &mut opts.global {
-        gi.snapshots = Some(Snapshots {
-            dir: snap_dir.clone(),
-            every: SnapshotEvery::Passes(1),
-        });
-    }
-    let r = render(gpu, &scene, &opts, &|_, _, _| {})?;
-    let final_img = read_png(&snap_dir.join(&r.snapshots.last().context("no snapshots")?.file))?;
-    let mut snaps = Vec::new();
-    for s in &r.snapshots {
-        let img = read_png(&snap_dir.join(&s.file))?;
-        snaps.push((
-            s.file.clone(),
-            s.seconds,
-            visibly_different(&img, &final_img),
-        ));
-    }
-    let full = r.snapshots.last().map_or(0.0, |s| s.seconds);
-    // Visually converged: from here on, under 1% of pixels visibly differ from the final image.
-    let mut visual = full;
-    for i in (0..snaps.len()).rev() {
-        if snaps[i].2 < 0.01 {
-            visual = snaps[i].1;
-        } else {
-            break;
-        }
-    }
-    let picks: Vec<usize> = [0.1, 0.25, 0.5]
-        .iter()
-        .map(|f| snaps.iter().position(|s| s.1 >= f * full).unwrap_or(0))
-        .chain([snaps.len() - 1])
-        .collect();
-    let (w, h) = (final_img.width, final_img.height);
-    let crops: Vec<Image> = picks
-        .iter()
-        .map(|&i| {
-            read_png(&snap_dir.join(&snaps[i].0))
-                .map(|im| crop(&im, w * 3 / 10, h / 2, w * 2 / 5, h * 7 / 20))
-        })
-        .collect::<Result<_>>()?;
-    // Back to linear so png_bytes' sRGB encoding reproduces the snapshot values.
-    let crops: Vec<Image> = crops
-        .into_iter()
-        .map(|mut im| {
-            for p in &mut im.pixels {
-                for c in p.iter_mut() {
-                    *c = srgb_to_linear(*c);
-                }
-            }
-            im
-        })
-        .collect();
-    write_png(&out.join("figure8.png"), &montage(&[crops]))?;
-    let figure8 = Figure8 {
-        file: "figure8.png".into(),
-        snapshots: picks.iter().map(|&i| snaps[i].clone()).collect(),
-        full_convergence_seconds: full,
-        visual_convergence_seconds: visual,
-        criterion: "every later snapshot has under 1% of pixels differing from the final image by more than 2 of 255 sRGB levels".into(),
-    };
-
+    let figure8 = run.figure8()?;
     progress("Table 2: SPIR-V instruction counts");
     let report = TablesReport {
         renderer: caps.gl_renderer,
@@ -648,7 +484,7 @@ pub fn run_tables(
         } else {
             "the paper's resolution".into()
         },
-        runs,
+        runs: run.runs,
         command: format!(
             "photonmap tables{}{}",
             if o.quick { " --quick" } else { "" },
@@ -665,13 +501,226 @@ pub fn run_tables(
     write_atomically(
         &out.join("results.json"),
         serde_json::to_string_pretty(&report)?.as_bytes(),
-    )
-    .map_err(anyhow::Error::msg)?;
-    write_atomically(&out.join("table1.csv"), table1_csv(&report).as_bytes())
-        .map_err(anyhow::Error::msg)?;
-    write_atomically(&out.join("tables.md"), markdown(&report).as_bytes())
-        .map_err(anyhow::Error::msg)?;
+    )?;
+    write_atomically(&out.join("table1.csv"), table1_csv(&report).as_bytes())?;
+    write_atomically(&out.join("tables.md"), markdown(&report).as_bytes())?;
     Ok((report, out))
+}
+
+/// One `tables` run: its scale, runs per cell and output folder.
+struct TablesRun<'a> {
+    gpu: &'a Gpu,
+    scale: u32,
+    runs: u32,
+    quick: bool,
+    faithful: bool,
+    out: &'a Path,
+    progress: &'a dyn Fn(&str),
+}
+
+type Table1 = (Vec<Table1Cell>, Vec<Table1Total>, Vec<Vec<Image>>);
+
+impl TablesRun<'_> {
+    fn options(&self, scene: &Scene, build: BuildMethod, mode: EstimateMode) -> RenderOptions {
+        options(scene, self.scale, build, self.faithful, mode)
+    }
+
+    /// Table 1 (and figure 7's images from the first run of each).
+    fn table1(&self) -> Result<Table1> {
+        let (mut table1, mut totals, mut figure7_rows) = (Vec::new(), Vec::new(), Vec::new());
+        for (name, paper_bitonic, paper_stencil) in PAPER_TABLE1 {
+            let scene = embedded::load(name)?;
+            let mut row = Vec::new();
+            for (build, paper) in [
+                (BuildMethod::Bitonic, paper_bitonic),
+                (BuildMethod::Stencil, paper_stencil),
+            ] {
+                let (cells, total) = self.table1_cell(name, &scene, build, paper, &mut row)?;
+                table1.extend(cells);
+                totals.push(total);
+            }
+            // Row order as in figure 7: bitonic, stencil, software.
+            row.swap(1, 2);
+            figure7_rows.push(row);
+        }
+        Ok((table1, totals, figure7_rows))
+    }
+
+    /// One scene and build of Table 1: every stage over the runs, and the total.
+    fn table1_cell(
+        &self,
+        name: &str,
+        scene: &Scene,
+        build: BuildMethod,
+        paper: [f64; 4],
+        row: &mut Vec<Image>,
+    ) -> Result<(Vec<Table1Cell>, Table1Total)> {
+        let runs = self.runs;
+        let mut walls = vec![Vec::new(); 4];
+        let mut gpus = vec![Vec::new(); 4];
+        let mut run_totals = Vec::new();
+        for run in 0..runs {
+            (self.progress)(&format!("Table 1: {name} {build:?} run {}/{runs}", run + 1));
+            let opts = self.options(scene, build, EstimateMode::Tiled { tile: 16 });
+            let r = render(self.gpu, scene, &opts, &mut ())?;
+            let mut total = 0.0;
+            for (i, stage) in STAGES.iter().enumerate() {
+                let (w, g) = stage_seconds(&r.timings, stage);
+                walls[i].push(w);
+                gpus[i].push(g);
+                total += w;
+            }
+            run_totals.push(total);
+            if run == 0 {
+                let file = self
+                    .out
+                    .join("figure7")
+                    .join(format!("{name}_{build:?}.png").to_lowercase());
+                write_png(&file, &r.image)?;
+                row.push(r.image.clone());
+                if build == BuildMethod::Bitonic {
+                    (self.progress)(&format!("Figure 7: {name} software reference"));
+                    let sw = software_image(&r.state, scene).context("software reference")?;
+                    write_png(
+                        &self
+                            .out
+                            .join("figure7")
+                            .join(format!("{name}_software.png")),
+                        &sw,
+                    )?;
+                    row.push(sw);
+                }
+            }
+        }
+        let cells = STAGES
+            .iter()
+            .enumerate()
+            .map(|(i, stage)| {
+                let med = median(&walls[i]);
+                Table1Cell {
+                    scene: scene.name.clone(),
+                    build,
+                    stage: stage.to_string(),
+                    median_wall_seconds: med,
+                    min_wall_seconds: walls[i].iter().copied().fold(f64::INFINITY, f64::min),
+                    max_wall_seconds: walls[i].iter().copied().fold(0.0, f64::max),
+                    median_gpu_seconds: median(&gpus[i]),
+                    wall_seconds: walls[i].clone(),
+                    paper_seconds: paper[i],
+                    ratio_to_paper: med / paper[i],
+                    at_or_below_paper: med <= paper[i],
+                }
+            })
+            .collect();
+        let paper_total: f64 = paper.iter().sum();
+        let med = median(&run_totals);
+        let total = Table1Total {
+            scene: scene.name.clone(),
+            build,
+            median_seconds: med,
+            paper_seconds: paper_total,
+            ratio_to_paper: med / paper_total,
+            at_most_a_quarter: med <= paper_total / 4.0,
+        };
+        Ok((cells, total))
+    }
+
+    /// Section 3.3: full convergence of the estimate by drawing mode.
+    fn section_3_3(&self) -> Result<Vec<ConvergenceRow>> {
+        let mut convergence = Vec::new();
+        let mut modes: Vec<(String, EstimateMode)> =
+            vec![("full screen".into(), EstimateMode::FullScreen)];
+        let tiles: &[u32] = if self.quick { &[16] } else { &[8, 16, 32, 64] };
+        for &t in tiles {
+            modes.push((format!("{t} x {t} tiles"), EstimateMode::Tiled { tile: t }));
+        }
+        modes.push(("mask every pass".into(), EstimateMode::Masked { every: 1 }));
+        for name in ["glass_ball", "cornell_box"] {
+            let scene = embedded::load(name)?;
+            for (label, mode) in &modes {
+                (self.progress)(&format!("Section 3.3: {name} {label}"));
+                let opts = self.options(&scene, BuildMethod::Bitonic, *mode);
+                let r = render(self.gpu, &scene, &opts, &mut ())?;
+                let e = r.estimate.unwrap_or_default();
+                convergence.push(ConvergenceRow {
+                    scene: scene.name.clone(),
+                    mode: label.clone(),
+                    wall_seconds: stage_seconds(&r.timings, "radiance estimate").0,
+                    passes: e.passes,
+                    tile_draws: e.tile_draws,
+                });
+            }
+        }
+        Ok(convergence)
+    }
+
+    /// Figure 8: the GLASS BALL caustic during convergence.
+    fn figure8(&self) -> Result<Figure8> {
+        (self.progress)("Figure 8: GLASS BALL snapshots");
+        let snap_dir = self.out.join("figure8");
+        std::fs::create_dir_all(&snap_dir)?;
+        for e in std::fs::read_dir(&snap_dir)?.flatten() {
+            let _ = std::fs::remove_file(e.path());
+        }
+        let scene = embedded::load("glass_ball")?;
+        let opts = self.options(
+            &scene,
+            BuildMethod::Bitonic,
+            EstimateMode::Tiled { tile: 16 },
+        );
+        let mut writer = SnapshotWriter::new(snap_dir.clone(), SnapshotEvery::Passes(1));
+        render(self.gpu, &scene, &opts, &mut writer)?;
+        let written = writer.written;
+        let final_img = read_png(&snap_dir.join(&written.last().context("no snapshots")?.file))?;
+        let mut snaps = Vec::new();
+        for s in &written {
+            let img = read_png(&snap_dir.join(&s.file))?;
+            snaps.push((
+                s.file.clone(),
+                s.seconds,
+                visibly_different(&img, &final_img),
+            ));
+        }
+        let full = written.last().map_or(0.0, |s| s.seconds);
+        // Visually converged: from here on, under 1% of pixels visibly differ from the final image.
+        let mut visual = full;
+        for i in (0..snaps.len()).rev() {
+            if snaps[i].2 < 0.01 {
+                visual = snaps[i].1;
+            } else {
+                break;
+            }
+        }
+        let picks: Vec<usize> = [0.1, 0.25, 0.5]
+            .iter()
+            .map(|f| snaps.iter().position(|s| s.1 >= f * full).unwrap_or(0))
+            .chain([snaps.len() - 1])
+            .collect();
+        let (w, h) = (final_img.width, final_img.height);
+        let crops: Vec<Image> = picks
+            .iter()
+            .map(|&i| {
+                read_png(&snap_dir.join(&snaps[i].0)).map(|im| {
+                    // Back to linear so png_bytes' sRGB encoding reproduces the snapshot values.
+                    let mut c = crop(&im, w * 3 / 10, h / 2, w * 2 / 5, h * 7 / 20);
+                    for p in &mut c.pixels {
+                        for v in p.iter_mut() {
+                            *v = srgb_to_linear(*v);
+                        }
+                    }
+                    c
+                })
+            })
+            .collect::<Result<_>>()?;
+        write_png(&self.out.join("figure8.png"), &montage(&[crops]))?;
+        Ok(Figure8 {
+            file: "figure8.png".into(),
+            snapshots: picks.iter().map(|&i| snaps[i].clone()).collect(),
+            full_convergence_seconds: full,
+            visual_convergence_seconds: visual,
+            criterion: "every later snapshot has under 1% of pixels differing from the final image by more than 2 of 255 sRGB levels".into(),
+        })
+    }
 }
 
 fn srgb_to_linear(v: f32) -> f32 {

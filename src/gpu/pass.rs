@@ -1,94 +1,177 @@
-//! Binding a program with its uniforms and input textures for one pass.
+//! One pass: a program made current, its uniforms and input textures, and the
+//! draw into a target with its full fixed-function state.
 
 use glow::HasContext;
 
-use super::{Program, Texture};
+use super::{DrawState, Error, Program, Result, Target, Texture, VertexBuffer};
 
-/// The program in use plus the texture units handed out so far.
+/// The program in use plus the texture units handed out so far. A uniform the
+/// program does not declare is remembered and makes the next draw fail.
 pub struct Bindings<'a> {
     program: &'a Program,
     gl: &'a glow::Context,
     next_unit: u32,
+    error: Option<Error>,
 }
 
 impl Program {
-    /// Makes this program current; uniforms and textures are then set on the result.
+    /// Makes this program current; uniforms and textures are then set on the
+    /// result, and the result draws.
     pub fn bind(&self) -> Bindings<'_> {
-        // SAFETY: program belongs to the current context.
-        #[allow(unsafe_code)]
-        let gl = unsafe {
-            let gl = &self.gpu_ctx().gl;
-            gl.use_program(Some(self.raw));
-            gl
-        };
+        let gl = self.gpu().gl();
+        // SAFETY: gpu module doc; the program is this value's own.
+        unsafe { gl.use_program(Some(self.raw)) };
         Bindings {
             program: self,
             gl,
             next_unit: 0,
+            error: None,
         }
     }
 }
 
-#[allow(unsafe_code)]
 impl Bindings<'_> {
-    pub fn texture(&mut self, name: &str, texture: &Texture) -> &mut Self {
-        let unit = self.next_unit;
-        self.next_unit += 1;
-        unsafe {
-            self.gl.active_texture(glow::TEXTURE0 + unit);
-            self.gl.bind_texture(glow::TEXTURE_2D, Some(texture.raw));
-            self.gl
-                .uniform_1_i32(self.program.uniform(name).as_ref(), unit as i32);
+    /// Sets uniform `name` through `set` if the program declares it.
+    fn set(
+        &mut self,
+        name: &str,
+        set: impl FnOnce(&glow::Context, Option<&glow::UniformLocation>),
+    ) -> &mut Self {
+        match self.program.uniform(name) {
+            Ok(location) => set(self.gl, location.as_ref()),
+            Err(e) => {
+                self.error.get_or_insert(e);
+            }
         }
         self
     }
+
+    pub fn texture(&mut self, name: &str, texture: &Texture) -> &mut Self {
+        let unit = self.next_unit;
+        self.next_unit += 1;
+        // SAFETY: gpu module doc; the program is current and the location, if
+        // any, is its own.
+        self.set(name, |gl, l| unsafe {
+            gl.active_texture(glow::TEXTURE0 + unit);
+            gl.bind_texture(glow::TEXTURE_2D, Some(texture.raw));
+            gl.uniform_1_i32(l, unit as i32);
+        })
+    }
+
     pub fn int(&mut self, name: &str, v: i32) -> &mut Self {
-        unsafe {
-            self.gl
-                .uniform_1_i32(self.program.uniform(name).as_ref(), v)
-        };
-        self
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe { gl.uniform_1_i32(l, v) })
     }
+
     pub fn uint(&mut self, name: &str, v: u32) -> &mut Self {
-        unsafe {
-            self.gl
-                .uniform_1_u32(self.program.uniform(name).as_ref(), v)
-        };
-        self
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe { gl.uniform_1_u32(l, v) })
     }
+
     pub fn float(&mut self, name: &str, v: f32) -> &mut Self {
-        unsafe {
-            self.gl
-                .uniform_1_f32(self.program.uniform(name).as_ref(), v)
-        };
-        self
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe { gl.uniform_1_f32(l, v) })
     }
+
     pub fn vec2(&mut self, name: &str, v: [f32; 2]) -> &mut Self {
-        unsafe {
-            self.gl
-                .uniform_2_f32(self.program.uniform(name).as_ref(), v[0], v[1])
-        };
-        self
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe { gl.uniform_2_f32(l, v[0], v[1]) })
     }
+
     pub fn vec3(&mut self, name: &str, v: [f32; 3]) -> &mut Self {
-        unsafe {
-            self.gl
-                .uniform_3_f32(self.program.uniform(name).as_ref(), v[0], v[1], v[2])
-        };
-        self
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe {
+            gl.uniform_3_f32(l, v[0], v[1], v[2])
+        })
     }
-    pub fn ivec3(&mut self, name: &str, v: [i32; 3]) -> &mut Self {
-        unsafe {
-            self.gl
-                .uniform_3_i32(self.program.uniform(name).as_ref(), v[0], v[1], v[2])
-        };
-        self
-    }
+
     pub fn ivec2(&mut self, name: &str, v: [i32; 2]) -> &mut Self {
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe { gl.uniform_2_i32(l, v[0], v[1]) })
+    }
+
+    pub fn ivec3(&mut self, name: &str, v: [i32; 3]) -> &mut Self {
+        // SAFETY: as for `texture`.
+        self.set(name, |gl, l| unsafe {
+            gl.uniform_3_i32(l, v[0], v[1], v[2])
+        })
+    }
+
+    /// Fails with the first undeclared uniform, else binds `target` over the
+    /// viewport (x, y, w, h) and applies `state`.
+    fn prepare(&mut self, target: &Target, state: &DrawState, viewport: [i32; 4]) -> Result<()> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        target.bind_region(viewport[0], viewport[1], viewport[2], viewport[3]);
+        self.program.gpu().apply(state);
+        Ok(())
+    }
+
+    /// One full-screen triangle (3 vertices from gl_VertexID, no buffers).
+    pub fn draw_fullscreen(&mut self, target: &Target, state: &DrawState) -> Result<()> {
+        self.draw_region(
+            target,
+            state,
+            [0, 0, target.width as i32, target.height as i32],
+        )
+    }
+
+    /// A full-screen triangle clipped to the viewport (x, y, w, h) of
+    /// `target`: a pass over one band of a texture (a photon frame).
+    pub fn draw_region(
+        &mut self,
+        target: &Target,
+        state: &DrawState,
+        viewport: [i32; 4],
+    ) -> Result<()> {
+        self.prepare(target, state, viewport)?;
+        let gpu = self.program.gpu();
+        gpu.bind_empty_vertex_array();
+        // SAFETY: gpu module doc; the vertex shader makes its vertices from
+        // gl_VertexID, so no buffer is read.
+        unsafe { self.gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+        Ok(())
+    }
+
+    /// Points `first..first + count` (positions from gl_VertexID in the
+    /// vertex program).
+    pub fn draw_points(
+        &mut self,
+        target: &Target,
+        state: &DrawState,
+        first: i32,
+        count: i32,
+    ) -> Result<()> {
+        self.prepare(
+            target,
+            state,
+            [0, 0, target.width as i32, target.height as i32],
+        )?;
+        self.program.gpu().bind_empty_vertex_array();
+        // SAFETY: as for draw_region.
+        unsafe { self.gl.draw_arrays(glow::POINTS, first, count) };
+        Ok(())
+    }
+
+    /// Every vertex of `vertices` as a point.
+    pub fn draw_vertices(
+        &mut self,
+        target: &Target,
+        state: &DrawState,
+        vertices: &VertexBuffer,
+    ) -> Result<()> {
+        self.prepare(
+            target,
+            state,
+            [0, 0, target.width as i32, target.height as i32],
+        )?;
+        // SAFETY: gpu module doc; the vertex array is the buffer's own and
+        // describes `count` vertices.
         unsafe {
-            self.gl
-                .uniform_2_i32(self.program.uniform(name).as_ref(), v[0], v[1])
-        };
-        self
+            self.gl.bind_vertex_array(Some(vertices.vao));
+            self.gl.draw_arrays(glow::POINTS, 0, vertices.count as i32);
+        }
+        Ok(())
     }
 }

@@ -1,11 +1,11 @@
 //! GLSL programs from glsl/, embedded at build time, with `#include "path"`
 //! (paths from glsl/) and compile errors reported as `glsl/<file>:<line>`.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use glow::HasContext;
 
-use super::{Gpu, GpuError};
+use super::{Error, Gpu, Result, ShaderError};
 
 include!(concat!(env!("OUT_DIR"), "/glsl_sources.rs"));
 
@@ -21,21 +21,54 @@ fn source_of(name: &str) -> Option<&'static str> {
         .map(|(_, s)| *s)
 }
 
-/// The source a driver receives for `name` (includes resolved, `defines`
-/// after #version), for offline compilers; None if a file is missing.
+/// The source a driver receives for `name` (includes resolved, the layout
+/// constants and `defines` after #version), for offline compilers; None if a
+/// file is missing.
 pub fn preprocessed_source(name: &str, defines: &[(&str, String)]) -> Option<String> {
     let lookup = |n: &str| source_of(n).map(str::to_string);
-    preprocess(&lookup, name, defines).ok().map(|p| p.text)
+    preprocess(&lookup, name, &with_layout(defines))
+        .ok()
+        .map(|p| p.text)
 }
 
-/// A shader that did not compile or link, located in its glsl/ file.
-#[derive(Debug, thiserror::Error)]
-#[error("glsl/{file}:{line}: {message}\n--- driver log ---\n{log}")]
-pub struct ShaderError {
-    pub file: String,
-    pub line: u32,
-    pub message: String,
-    pub log: String,
+/// The constants of src/layout.rs, then the program's own defines.
+fn with_layout<'a>(defines: &[(&'a str, String)]) -> Vec<(&'a str, String)> {
+    let mut all = crate::layout::glsl_defines();
+    all.extend(defines.iter().cloned());
+    all
+}
+
+/// Uniform names a preprocessed source declares (`uniform <type> <name>[...];`,
+/// several names per line allowed). Both branches of an #ifdef count: a name in
+/// neither is a misspelling.
+fn declared_uniforms(text: &str) -> HashSet<String> {
+    let mut names = HashSet::new();
+    for line in text.lines() {
+        let line = line.trim_start();
+        let Some(rest) = line
+            .strip_prefix("uniform ")
+            .or_else(|| line.split_once(") uniform ").map(|(_, r)| r))
+        else {
+            continue;
+        };
+        let decl = rest.split(';').next().unwrap_or("");
+        // Skip the type (and any precision qualifier): names follow the last type word.
+        let mut words = decl.splitn(2, char::is_whitespace);
+        let mut ty = words.next().unwrap_or("");
+        let mut list = words.next().unwrap_or("").trim_start();
+        while matches!(ty, "highp" | "mediump" | "lowp") {
+            let mut w = list.splitn(2, char::is_whitespace);
+            ty = w.next().unwrap_or("");
+            list = w.next().unwrap_or("").trim_start();
+        }
+        for name in list.split(',') {
+            let name = name.split(['[', '=']).next().unwrap_or("").trim();
+            if !name.is_empty() {
+                names.insert(name.to_string());
+            }
+        }
+    }
+    names
 }
 
 /// Source after `#include` resolution. Each file's lines are numbered
@@ -53,7 +86,7 @@ fn preprocess(
     lookup: &dyn Fn(&str) -> Option<String>,
     root: &str,
     defines: &[(&str, String)],
-) -> Result<Preprocessed, ShaderError> {
+) -> std::result::Result<Preprocessed, ShaderError> {
     let mut out = Preprocessed {
         text: String::new(),
         files: Vec::new(),
@@ -70,7 +103,7 @@ fn expand(
     defines: &[(&str, String)],
     out: &mut Preprocessed,
     included: &mut HashMap<String, usize>,
-) -> Result<(), ShaderError> {
+) -> std::result::Result<(), ShaderError> {
     if included.contains_key(name) {
         return Ok(()); // every include is guarded: a helper is pasted once
     }
@@ -142,22 +175,20 @@ fn parse_log(log: &str) -> Option<(usize, u32, String)> {
 /// A linked vertex + fragment program.
 pub struct Program {
     gpu: Gpu,
-    pub raw: glow::Program,
+    pub(crate) raw: glow::Program,
     pub name: String,
+    /// Every uniform either stage's source declares.
+    declared: HashSet<String>,
     uniforms: std::cell::RefCell<HashMap<String, Option<glow::UniformLocation>>>,
 }
 
 impl Program {
     /// A fragment program drawn over a full-screen triangle.
-    pub fn fullscreen(gpu: &Gpu, fragment: &str) -> Result<Self, GpuError> {
+    pub fn fullscreen(gpu: &Gpu, fragment: &str) -> Result<Self> {
         Self::new(gpu, "common/fullscreen.vert", fragment, &[])
     }
 
-    pub fn fullscreen_with(
-        gpu: &Gpu,
-        fragment: &str,
-        defines: &[(&str, String)],
-    ) -> Result<Self, GpuError> {
+    pub fn fullscreen_with(gpu: &Gpu, fragment: &str, defines: &[(&str, String)]) -> Result<Self> {
         Self::new(gpu, "common/fullscreen.vert", fragment, defines)
     }
 
@@ -166,7 +197,7 @@ impl Program {
         vertex: &str,
         fragment: &str,
         defines: &[(&str, String)],
-    ) -> Result<Self, GpuError> {
+    ) -> Result<Self> {
         let lookup = |n: &str| source_of(n).map(str::to_string);
         Self::from_lookup(gpu, &lookup, vertex, fragment, defines)
     }
@@ -179,18 +210,29 @@ impl Program {
         vertex: &str,
         fragment: &str,
         defines: &[(&str, String)],
-    ) -> Result<Self, GpuError> {
+    ) -> Result<Self> {
+        let defines = with_layout(defines);
+        let vs_source = preprocess(lookup, vertex, &defines)?;
+        let fs_source = preprocess(lookup, fragment, &defines)?;
+        let mut declared = declared_uniforms(&vs_source.text);
+        declared.extend(declared_uniforms(&fs_source.text));
+        let vs = compile(gpu, glow::VERTEX_SHADER, vertex, &vs_source)?;
         let gl = gpu.gl();
-        let vs = compile(gpu, lookup, glow::VERTEX_SHADER, vertex, defines)?;
-        let fs = match compile(gpu, lookup, glow::FRAGMENT_SHADER, fragment, defines) {
+        let fs = match compile(gpu, glow::FRAGMENT_SHADER, fragment, &fs_source) {
             Ok(fs) => fs,
             Err(e) => {
+                // SAFETY: gpu module doc; the shader was made just above.
                 unsafe { gl.delete_shader(vs) };
                 return Err(e);
             }
         };
+        // SAFETY: gpu module doc; both shaders compiled on this context, and
+        // each object is deleted on every path that does not return it.
         unsafe {
-            let raw = gl.create_program().map_err(GpuError::Gl)?;
+            let raw = gl.create_program().map_err(|message| Error::Create {
+                what: format!("the program glsl/{fragment}"),
+                message,
+            })?;
             gl.attach_shader(raw, vs);
             gl.attach_shader(raw, fs);
             gl.link_program(raw);
@@ -211,36 +253,45 @@ impl Program {
                 gpu: gpu.clone(),
                 raw,
                 name: fragment.to_string(),
+                declared,
                 uniforms: Default::default(),
             })
         }
     }
 
-    pub(super) fn gpu_ctx(&self) -> &super::GlContext {
-        &self.gpu.ctx
+    pub(super) fn gpu(&self) -> &Gpu {
+        &self.gpu
     }
 
-    pub(super) fn uniform(&self, name: &str) -> Option<glow::UniformLocation> {
+    /// The location of a uniform the program declares (None when the driver
+    /// optimised it away); an error for a name neither source declares.
+    pub(super) fn uniform(&self, name: &str) -> Result<Option<glow::UniformLocation>> {
+        if let Some(l) = self.uniforms.borrow().get(name) {
+            return Ok(l.clone());
+        }
+        if !self.declared.contains(name) {
+            return Err(Error::UndeclaredUniform {
+                program: self.name.clone(),
+                name: name.to_string(),
+            });
+        }
+        // SAFETY: gpu module doc; the program is this value's own.
+        let location = unsafe { self.gpu.gl().get_uniform_location(self.raw, name) };
         self.uniforms
             .borrow_mut()
-            .entry(name.to_string())
-            .or_insert_with(|| unsafe { self.gpu.gl().get_uniform_location(self.raw, name) })
-            .as_ref()
-            .copied()
+            .insert(name.to_string(), location.clone());
+        Ok(location)
     }
 }
 
-fn compile(
-    gpu: &Gpu,
-    lookup: &dyn Fn(&str) -> Option<String>,
-    stage: u32,
-    name: &str,
-    defines: &[(&str, String)],
-) -> Result<glow::Shader, GpuError> {
-    let pre = preprocess(lookup, name, defines)?;
+fn compile(gpu: &Gpu, stage: u32, name: &str, pre: &Preprocessed) -> Result<glow::Shader> {
     let gl = gpu.gl();
-    unsafe {
-        let sh = gl.create_shader(stage).map_err(GpuError::Gl)?;
+    // SAFETY: gpu module doc; the shader is deleted if it does not compile.
+    let log = unsafe {
+        let sh = gl.create_shader(stage).map_err(|message| Error::Create {
+            what: format!("a shader for glsl/{name}"),
+            message,
+        })?;
         gl.shader_source(sh, &pre.text);
         gl.compile_shader(sh);
         if gl.get_shader_compile_status(sh) {
@@ -248,29 +299,31 @@ fn compile(
         }
         let log = gl.get_shader_info_log(sh);
         gl.delete_shader(sh);
-        let (file, line, message) = match parse_log(&log) {
-            Some((_, line, msg)) => (
-                pre.files
-                    .get((line / LINE_STRIDE) as usize)
-                    .cloned()
-                    .unwrap_or_else(|| name.to_string()),
-                line % LINE_STRIDE,
-                msg,
-            ),
-            None => (name.to_string(), 0, "compile error".to_string()),
-        };
-        Err(ShaderError {
-            file,
-            line,
-            message,
-            log,
-        }
-        .into())
+        log
+    };
+    let (file, line, message) = match parse_log(&log) {
+        Some((_, line, msg)) => (
+            pre.files
+                .get((line / LINE_STRIDE) as usize)
+                .cloned()
+                .unwrap_or_else(|| name.to_string()),
+            line % LINE_STRIDE,
+            msg,
+        ),
+        None => (name.to_string(), 0, "compile error".to_string()),
+    };
+    Err(ShaderError {
+        file,
+        line,
+        message,
+        log,
     }
+    .into())
 }
 
 impl Drop for Program {
     fn drop(&mut self) {
+        // SAFETY: gpu module doc; the program is this value's own.
         unsafe { self.gpu.gl().delete_program(self.raw) };
     }
 }
@@ -287,6 +340,16 @@ mod tests {
         );
         let (src, line, _) = parse_log("2(7) : error C1008: undefined variable \"x\"").unwrap();
         assert_eq!((src, line), (2, 7));
+    }
+
+    #[test]
+    fn declared_uniforms_are_read_from_the_source() {
+        let names = declared_uniforms(
+            "#version 450 core\nuniform sampler2D u_a; // x\n  uniform highp int u_b, u_c[4];\nlayout(binding = 0) uniform vec3 u_d;\nfloat uniform_x;\n",
+        );
+        let mut names: Vec<_> = names.into_iter().collect();
+        names.sort();
+        assert_eq!(names, ["u_a", "u_b", "u_c", "u_d"]);
     }
 
     #[test]

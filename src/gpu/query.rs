@@ -1,78 +1,69 @@
-//! GL queries: timer queries for per-stage GPU time, occlusion queries for
-//! counting fragments (and, later, stopping finished tiles).
+//! GL queries around a span of commands: GPU time (per-stage timings) or
+//! fragments that passed every test (tiles still searching, live photons).
 
 use glow::HasContext;
 
-use super::{Gpu, GpuError};
+use super::{Error, Gpu, Result};
 
-/// GL_TIME_ELAPSED around a span of GL commands.
-pub struct TimerQuery {
+pub struct Query {
     gpu: Gpu,
     raw: glow::Query,
+    target: u32,
 }
 
-impl TimerQuery {
-    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
-        let raw = unsafe { gpu.gl().create_query() }.map_err(GpuError::Gl)?;
+impl Query {
+    /// GL_TIME_ELAPSED: `seconds` reads the GPU time of the span.
+    pub fn timer(gpu: &Gpu) -> Result<Self> {
+        Self::new(gpu, glow::TIME_ELAPSED)
+    }
+
+    /// GL_SAMPLES_PASSED: `count` reads the fragments that passed.
+    pub fn occlusion(gpu: &Gpu) -> Result<Self> {
+        Self::new(gpu, glow::SAMPLES_PASSED)
+    }
+
+    fn new(gpu: &Gpu, target: u32) -> Result<Self> {
+        // SAFETY: gpu module doc.
+        let raw = unsafe { gpu.gl().create_query() }.map_err(|message| Error::Create {
+            what: "a query".into(),
+            message,
+        })?;
         Ok(Self {
             gpu: gpu.clone(),
             raw,
+            target,
         })
     }
+
     pub fn begin(&self) {
-        unsafe { self.gpu.gl().begin_query(glow::TIME_ELAPSED, self.raw) }
+        // SAFETY: gpu module doc; the query is this value's own.
+        unsafe { self.gpu.gl().begin_query(self.target, self.raw) }
     }
+
     pub fn end(&self) {
-        unsafe { self.gpu.gl().end_query(glow::TIME_ELAPSED) }
+        // SAFETY: gpu module doc.
+        unsafe { self.gpu.gl().end_query(self.target) }
     }
-    /// Elapsed GPU seconds; waits for the result.
-    pub fn seconds(&self) -> f64 {
-        let ns = unsafe {
-            self.gpu
-                .gl()
-                .get_query_parameter_u64(self.raw, glow::QUERY_RESULT)
-        };
-        ns as f64 * 1e-9
-    }
-}
 
-impl Drop for TimerQuery {
-    fn drop(&mut self) {
-        unsafe { self.gpu.gl().delete_query(self.raw) }
-    }
-}
-
-/// GL_SAMPLES_PASSED: how many fragments passed every test during a span.
-pub struct OcclusionQuery {
-    gpu: Gpu,
-    raw: glow::Query,
-}
-
-impl OcclusionQuery {
-    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
-        let raw = unsafe { gpu.gl().create_query() }.map_err(GpuError::Gl)?;
-        Ok(Self {
-            gpu: gpu.clone(),
-            raw,
-        })
-    }
-    pub fn begin(&self) {
-        unsafe { self.gpu.gl().begin_query(glow::SAMPLES_PASSED, self.raw) }
-    }
-    pub fn end(&self) {
-        unsafe { self.gpu.gl().end_query(glow::SAMPLES_PASSED) }
-    }
-    pub fn samples(&self) -> u64 {
+    /// The result of the last span; waits for it.
+    pub fn count(&self) -> u64 {
+        // SAFETY: gpu module doc; the query is this value's own and has ended.
         unsafe {
             self.gpu
                 .gl()
                 .get_query_parameter_u64(self.raw, glow::QUERY_RESULT)
         }
     }
+
+    /// A timer query's span in seconds; waits for it.
+    pub fn seconds(&self) -> f64 {
+        self.count() as f64 * 1e-9
+    }
 }
 
-impl Drop for OcclusionQuery {
+impl Drop for Query {
     fn drop(&mut self) {
+        // SAFETY: gpu module doc; the query is this value's own.
         unsafe { self.gpu.gl().delete_query(self.raw) }
     }
 }

@@ -1,8 +1,8 @@
-//! Float and integer textures, render targets over them, and ping-pong pairs.
+//! Float and integer textures, read with texelFetch (nearest, no filtering).
 
 use glow::HasContext;
 
-use super::{Gpu, GpuError};
+use super::{Error, Gpu, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TexFormat {
@@ -21,6 +21,11 @@ impl TexFormat {
             TexFormat::R32F => 1,
         }
     }
+
+    pub fn is_integer(self) -> bool {
+        matches!(self, TexFormat::Rgba32I | TexFormat::Rg32I)
+    }
+
     fn gl(self) -> (u32, u32, u32) {
         match self {
             TexFormat::Rgba32F => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
@@ -32,17 +37,50 @@ impl TexFormat {
     }
 }
 
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f32 {}
+    impl Sealed for i32 {}
+}
+
+/// A channel type that texels are uploaded from and read back into: plain
+/// 4-byte values for which every bit pattern is valid (sealed: f32 and i32).
+pub trait Texel: sealed::Sealed + Copy + Default {
+    /// Whether textures of this channel type are integer textures.
+    const INTEGER: bool;
+}
+
+impl Texel for f32 {
+    const INTEGER: bool = false;
+}
+
+impl Texel for i32 {
+    const INTEGER: bool = true;
+}
+
+fn bytes_of<T: Texel>(data: &[T]) -> &[u8] {
+    // SAFETY: T is f32 or i32 (sealed): no padding, 4-byte aligned, any bytes valid.
+    unsafe { std::slice::from_raw_parts(data.as_ptr().cast::<u8>(), std::mem::size_of_val(data)) }
+}
+
+fn bytes_of_mut<T: Texel>(data: &mut [T]) -> &mut [u8] {
+    // SAFETY: as in `bytes_of`; every bit pattern is a valid f32 or i32.
+    unsafe {
+        std::slice::from_raw_parts_mut(data.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(data))
+    }
+}
+
 /// A 2D texture with nearest filtering, read with texelFetch.
 pub struct Texture {
     gpu: Gpu,
-    pub raw: glow::Texture,
+    pub(crate) raw: glow::Texture,
     pub width: u32,
     pub height: u32,
     pub format: TexFormat,
 }
 
 impl Texture {
-    pub fn new(gpu: &Gpu, width: u32, height: u32, format: TexFormat) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, format: TexFormat) -> Result<Self> {
         Self::with_levels(gpu, width, height, format, 1)
     }
 
@@ -53,17 +91,21 @@ impl Texture {
         height: u32,
         format: TexFormat,
         levels: u32,
-    ) -> Result<Self, GpuError> {
-        let max = unsafe { gpu.gl().get_parameter_i32(glow::MAX_TEXTURE_SIZE) } as u32;
+    ) -> Result<Self> {
+        let max = gpu.max_texture_size();
         if width == 0 || height == 0 || width > max || height > max {
-            return Err(GpuError::Gl(format!(
+            return Err(Error::TooLarge(format!(
                 "texture of {width} x {height} texels: each side must be 1..={max} on this driver"
             )));
         }
         let gl = gpu.gl();
-        let raw = unsafe { gl.create_texture() }.map_err(GpuError::Gl)?;
         let (internal, _, _) = format.gl();
-        unsafe {
+        // SAFETY: gpu module doc; the texture is created, bound and sized here.
+        let (raw, code) = unsafe {
+            let raw = gl.create_texture().map_err(|message| Error::Create {
+                what: format!("a {width} x {height} {format:?} texture"),
+                message,
+            })?;
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
             gl.tex_storage_2d(
                 glow::TEXTURE_2D,
@@ -80,23 +122,30 @@ impl Texture {
             ] {
                 gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
             }
-        }
-        let err = unsafe { gl.get_error() };
-        if err != glow::NO_ERROR {
-            unsafe { gl.delete_texture(raw) };
-            let bytes = width as u64
-                * height as u64
-                * format.channels() as u64
-                * 4
-                * (1 + (levels > 1) as u64 / 3);
-            return Err(GpuError::Gl(if err == glow::OUT_OF_MEMORY {
-                format!(
-                    "out of memory creating a {width} x {height} {format:?} texture ({:.1} GiB)",
-                    bytes as f64 / (1u64 << 30) as f64
-                )
+            let code = gl.get_error();
+            if code != glow::NO_ERROR {
+                gl.delete_texture(raw);
+            }
+            (raw, code)
+        };
+        if code != glow::NO_ERROR {
+            let resource = format!("a {width} x {height} {format:?} texture");
+            return Err(if code == glow::OUT_OF_MEMORY {
+                let bytes = width as u64
+                    * height as u64
+                    * format.channels() as u64
+                    * 4
+                    * (1 + (levels > 1) as u64 / 3);
+                Error::OutOfMemory {
+                    resource,
+                    gib: bytes as f64 / (1u64 << 30) as f64,
+                }
             } else {
-                format!("creating a {width} x {height} {format:?} texture: GL error 0x{err:04x}")
-            }));
+                Error::Gl {
+                    what: format!("creating {resource}"),
+                    code,
+                }
+            });
         }
         Ok(Self {
             gpu: gpu.clone(),
@@ -114,14 +163,14 @@ impl Texture {
         height: u32,
         format: TexFormat,
         data: &[f32],
-    ) -> Result<Self, GpuError> {
+    ) -> Result<Self> {
         let t = Self::new(gpu, width, height, format)?;
-        t.upload_f32(data)?;
+        t.upload(data)?;
         Ok(t)
     }
 
     /// An RGBA32I texture filled from `data` (4 ints a texel).
-    pub fn from_i32(gpu: &Gpu, width: u32, height: u32, data: &[i32]) -> Result<Self, GpuError> {
+    pub fn from_i32(gpu: &Gpu, width: u32, height: u32, data: &[i32]) -> Result<Self> {
         Self::from_i32_format(gpu, width, height, TexFormat::Rgba32I, data)
     }
 
@@ -131,37 +180,48 @@ impl Texture {
         height: u32,
         format: TexFormat,
         data: &[i32],
-    ) -> Result<Self, GpuError> {
+    ) -> Result<Self> {
         let t = Self::new(gpu, width, height, format)?;
-        assert!(t.is_integer(), "from_i32 with a float format");
+        t.upload(data)?;
+        Ok(t)
+    }
+
+    /// Replaces level 0 with `data` (row 0 first, `channels` values a texel).
+    pub fn upload<T: Texel>(&self, data: &[T]) -> Result<()> {
+        assert_eq!(T::INTEGER, self.is_integer(), "texel type against format");
         assert_eq!(
             data.len(),
-            t.texel_count() * format.channels(),
+            self.texel_count() * self.format.channels(),
             "texture data size"
         );
-        let (_, fmt, ty) = t.format.gl();
+        let (_, fmt, ty) = self.format.gl();
+        // SAFETY: gpu module doc; `data` holds exactly the texels of level 0.
         unsafe {
-            let gl = gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(t.raw));
+            let gl = self.gpu.gl();
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
             gl.tex_sub_image_2d(
                 glow::TEXTURE_2D,
                 0,
                 0,
                 0,
-                t.width as i32,
-                t.height as i32,
+                self.width as i32,
+                self.height as i32,
                 fmt,
                 ty,
                 glow::PixelUnpackData::Slice(Some(bytes_of(data))),
             );
         }
-        gpu.check("uploading an integer texture")?;
-        Ok(t)
+        self.gpu.check("uploading a texture")
+    }
+
+    pub fn upload_f32(&self, data: &[f32]) -> Result<()> {
+        self.upload(data)
     }
 
     /// Restricts which mip levels samplers see (texelFetch's lod counts from `base`).
     pub fn set_level_range(&self, base: u32, max: u32) {
+        // SAFETY: gpu module doc.
         unsafe {
             let gl = self.gpu.gl();
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
@@ -170,11 +230,13 @@ impl Texture {
         }
     }
 
-    /// Reads mip level `level` back (row 0 first) into T, `channels` values a texel.
-    fn read_level<T: Copy + Default>(&self, level: u32) -> Vec<T> {
+    /// Reads mip level `level` back (row 0 first), `channels` values a texel.
+    pub fn read_level<T: Texel>(&self, level: u32) -> Vec<T> {
+        assert_eq!(T::INTEGER, self.is_integer(), "texel type against format");
         let (w, h) = ((self.width >> level).max(1), (self.height >> level).max(1));
         let mut out = vec![T::default(); (w * h) as usize * self.format.channels()];
         let (_, fmt, ty) = self.format.gl();
+        // SAFETY: gpu module doc; `out` has room for every texel of the level.
         unsafe {
             let gl = self.gpu.gl();
             gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
@@ -192,298 +254,31 @@ impl Texture {
 
     /// Reads the whole texture back (row 0 first) as floats.
     pub fn read_f32(&self) -> Vec<f32> {
-        assert!(!self.is_integer(), "read_f32 on an integer texture");
         self.read_level(0)
     }
 
     /// Reads an integer texture back (row 0 first), `channels` ints a texel.
     pub fn read_i32(&self) -> Vec<i32> {
-        assert!(self.is_integer(), "read_i32 on a float texture");
         self.read_level(0)
     }
 
     /// Reads a mip level of an integer texture (row 0 first).
     pub fn read_i32_texel(&self, level: u32) -> Vec<i32> {
-        assert!(self.is_integer(), "read_i32_texel on a float texture");
         self.read_level(level)
     }
 
     pub fn is_integer(&self) -> bool {
-        matches!(self.format, TexFormat::Rgba32I | TexFormat::Rg32I)
+        self.format.is_integer()
     }
 
     pub fn texel_count(&self) -> usize {
         self.width as usize * self.height as usize
     }
-
-    pub fn upload_f32(&self, data: &[f32]) -> Result<(), GpuError> {
-        assert!(!self.is_integer(), "upload_f32 on an integer texture");
-        assert_eq!(
-            data.len(),
-            self.texel_count() * self.format.channels(),
-            "texture data size"
-        );
-        let (_, fmt, ty) = self.format.gl();
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
-            gl.tex_sub_image_2d(
-                glow::TEXTURE_2D,
-                0,
-                0,
-                0,
-                self.width as i32,
-                self.height as i32,
-                fmt,
-                ty,
-                glow::PixelUnpackData::Slice(Some(bytes_of(data))),
-            );
-        }
-        self.gpu.check("uploading a float texture")
-    }
 }
 
 impl Drop for Texture {
     fn drop(&mut self) {
+        // SAFETY: gpu module doc; the texture is this value's own.
         unsafe { self.gpu.gl().delete_texture(self.raw) };
-    }
-}
-
-fn bytes_of<T: Copy>(data: &[T]) -> &[u8] {
-    // SAFETY: f32 and i32 are plain old data with no padding.
-    unsafe { std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data)) }
-}
-
-fn bytes_of_mut<T: Copy>(data: &mut [T]) -> &mut [u8] {
-    // SAFETY: as above; every bit pattern is a valid f32 or i32.
-    unsafe {
-        std::slice::from_raw_parts_mut(data.as_mut_ptr() as *mut u8, std::mem::size_of_val(data))
-    }
-}
-
-/// A framebuffer over one or more textures of equal size (multiple render targets),
-/// optionally with a depth-stencil buffer.
-pub struct Target {
-    gpu: Gpu,
-    raw: glow::Framebuffer,
-    depth_stencil: Option<glow::Renderbuffer>,
-    pub width: u32,
-    pub height: u32,
-    pub attachments: usize,
-}
-
-impl Target {
-    pub fn new(gpu: &Gpu, colors: &[&Texture]) -> Result<Self, GpuError> {
-        Self::build(gpu, colors, false, 0)
-    }
-
-    /// A target over mip level `level` of one texture.
-    pub fn for_level(gpu: &Gpu, color: &Texture, level: u32) -> Result<Self, GpuError> {
-        Self::build(gpu, &[color], false, level)
-    }
-
-    pub fn with_stencil(gpu: &Gpu, colors: &[&Texture]) -> Result<Self, GpuError> {
-        Self::build(gpu, colors, true, 0)
-    }
-
-    fn build(
-        gpu: &Gpu,
-        colors: &[&Texture],
-        depth_stencil: bool,
-        level: u32,
-    ) -> Result<Self, GpuError> {
-        assert!(!colors.is_empty(), "a target needs a colour attachment");
-        let size_at = |t: &Texture| ((t.width >> level).max(1), (t.height >> level).max(1));
-        let (width, height) = size_at(colors[0]);
-        assert!(
-            colors.iter().all(|t| size_at(t) == (width, height)),
-            "all attachments of a target must have one size"
-        );
-        let gl = gpu.gl();
-        let raw = unsafe { gl.create_framebuffer() }.map_err(GpuError::Gl)?;
-        let mut rb = None;
-        unsafe {
-            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(raw));
-            let mut bufs = Vec::new();
-            for (i, t) in colors.iter().enumerate() {
-                let att = glow::COLOR_ATTACHMENT0 + i as u32;
-                gl.framebuffer_texture_2d(
-                    glow::FRAMEBUFFER,
-                    att,
-                    glow::TEXTURE_2D,
-                    Some(t.raw),
-                    level as i32,
-                );
-                bufs.push(att);
-            }
-            gl.draw_buffers(&bufs);
-            if depth_stencil {
-                let r = gl.create_renderbuffer().map_err(GpuError::Gl)?;
-                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(r));
-                gl.renderbuffer_storage(
-                    glow::RENDERBUFFER,
-                    glow::DEPTH24_STENCIL8,
-                    width as i32,
-                    height as i32,
-                );
-                gl.framebuffer_renderbuffer(
-                    glow::FRAMEBUFFER,
-                    glow::DEPTH_STENCIL_ATTACHMENT,
-                    glow::RENDERBUFFER,
-                    Some(r),
-                );
-                rb = Some(r);
-            }
-            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
-            if status != glow::FRAMEBUFFER_COMPLETE {
-                gl.delete_framebuffer(raw);
-                if let Some(r) = rb {
-                    gl.delete_renderbuffer(r);
-                }
-                return Err(GpuError::Gl(format!(
-                    "framebuffer incomplete: 0x{status:04x}"
-                )));
-            }
-        }
-        Ok(Self {
-            gpu: gpu.clone(),
-            raw,
-            depth_stencil: rb,
-            width,
-            height,
-            attachments: colors.len(),
-        })
-    }
-
-    pub fn bind(&self) {
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.raw));
-            gl.viewport(0, 0, self.width as i32, self.height as i32);
-        }
-    }
-
-    /// Clears every colour attachment to `value`.
-    pub fn clear(&self, value: [f32; 4]) {
-        self.bind();
-        unsafe {
-            for i in 0..self.attachments {
-                self.gpu
-                    .gl()
-                    .clear_buffer_f32_slice(glow::COLOR, i as u32, &value);
-            }
-        }
-    }
-
-    /// Clears depth to `depth` and stencil to `stencil` (a target with_stencil).
-    pub fn clear_depth_stencil(&self, depth: f32, stencil: i32) {
-        self.bind();
-        unsafe {
-            self.gpu.gl().depth_mask(true);
-            self.gpu.gl().stencil_mask(0xff);
-            self.gpu
-                .gl()
-                .clear_buffer_depth_stencil(glow::DEPTH_STENCIL, 0, depth, stencil);
-        }
-    }
-
-    /// Reads the stencil buffer back (row 0 first), for tests.
-    pub fn read_stencil(&self) -> Vec<u8> {
-        self.bind();
-        let mut out = vec![0u8; (self.width * self.height) as usize];
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
-            gl.read_pixels(
-                0,
-                0,
-                self.width as i32,
-                self.height as i32,
-                glow::STENCIL_INDEX,
-                glow::UNSIGNED_BYTE,
-                glow::PixelPackData::Slice(Some(&mut out)),
-            );
-        }
-        out
-    }
-
-    pub fn stencil_bits(&self) -> i32 {
-        self.bind();
-        if self.depth_stencil.is_none() {
-            return 0;
-        }
-        unsafe {
-            self.gpu.gl().get_framebuffer_attachment_parameter_i32(
-                glow::FRAMEBUFFER,
-                glow::DEPTH_STENCIL_ATTACHMENT,
-                glow::FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE,
-            )
-        }
-    }
-}
-
-impl Drop for Target {
-    fn drop(&mut self) {
-        unsafe {
-            self.gpu.gl().delete_framebuffer(self.raw);
-            if let Some(r) = self.depth_stencil {
-                self.gpu.gl().delete_renderbuffer(r);
-            }
-        }
-    }
-}
-
-/// Two sets of textures with a target each: a pass reads `current` and writes
-/// `next`, then `swap` makes what it wrote current (never sample what you draw to).
-pub struct PingPong {
-    pub textures: [Vec<Texture>; 2],
-    targets: [Target; 2],
-    current: usize,
-}
-
-impl PingPong {
-    pub fn new(
-        gpu: &Gpu,
-        width: u32,
-        height: u32,
-        formats: &[TexFormat],
-    ) -> Result<Self, GpuError> {
-        let make = || -> Result<Vec<Texture>, GpuError> {
-            formats
-                .iter()
-                .map(|&f| Texture::new(gpu, width, height, f))
-                .collect()
-        };
-        let textures = [make()?, make()?];
-        let targets = [
-            Target::new(gpu, &textures[0].iter().collect::<Vec<_>>())?,
-            Target::new(gpu, &textures[1].iter().collect::<Vec<_>>())?,
-        ];
-        Ok(Self {
-            textures,
-            targets,
-            current: 0,
-        })
-    }
-
-    pub fn current(&self) -> &[Texture] {
-        &self.textures[self.current]
-    }
-
-    pub fn next_target(&self) -> &Target {
-        &self.targets[1 - self.current]
-    }
-
-    pub fn current_target(&self) -> &Target {
-        &self.targets[self.current]
-    }
-
-    pub fn swap(&mut self) {
-        self.current = 1 - self.current;
-    }
-
-    pub fn current_index(&self) -> usize {
-        self.current
     }
 }

@@ -3,29 +3,39 @@
 
 use glow::HasContext;
 
-use super::{Gpu, GpuError};
+use super::{Error, Gpu, Result};
 
 /// Interleaved f32 vertex attributes with their vertex array.
 pub struct VertexBuffer {
     gpu: Gpu,
-    vao: glow::VertexArray,
+    pub(crate) vao: glow::VertexArray,
     vbo: glow::Buffer,
     pub count: usize,
 }
 
 impl VertexBuffer {
     /// `components[a]` floats for attribute location a, interleaved per vertex.
-    pub fn from_f32(gpu: &Gpu, data: &[f32], components: &[i32]) -> Result<Self, GpuError> {
+    pub fn from_f32(gpu: &Gpu, data: &[f32], components: &[i32]) -> Result<Self> {
         let stride: i32 = components.iter().sum();
         assert_eq!(data.len() % stride as usize, 0, "vertex data size");
         let gl = gpu.gl();
+        let create = |what: &str, message: String| Error::Create {
+            what: what.into(),
+            message,
+        };
+        // SAFETY: gpu module doc; the buffer is filled from `data`'s own bytes
+        // (f32 has no padding) and its attributes lie within each vertex.
         unsafe {
-            let vao = gl.create_vertex_array().map_err(GpuError::Gl)?;
-            let vbo = gl.create_buffer().map_err(GpuError::Gl)?;
+            let vao = gl
+                .create_vertex_array()
+                .map_err(|m| create("a vertex array", m))?;
+            let vbo = gl
+                .create_buffer()
+                .map_err(|m| create("a vertex buffer", m))?;
             gl.bind_vertex_array(Some(vao));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
             let bytes =
-                std::slice::from_raw_parts(data.as_ptr() as *const u8, std::mem::size_of_val(data));
+                std::slice::from_raw_parts(data.as_ptr().cast::<u8>(), std::mem::size_of_val(data));
             gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes, glow::STATIC_DRAW);
             let mut offset = 0;
             for (location, &n) in components.iter().enumerate() {
@@ -50,21 +60,11 @@ impl VertexBuffer {
             })
         }
     }
-
-    /// Draws every vertex as a point into `target` with the current program.
-    pub fn draw_points(&self, target: &super::Target) {
-        target.bind();
-        unsafe {
-            self.gpu.gl().bind_vertex_array(Some(self.vao));
-            self.gpu
-                .gl()
-                .draw_arrays(glow::POINTS, 0, self.count as i32);
-        }
-    }
 }
 
 impl Drop for VertexBuffer {
     fn drop(&mut self) {
+        // SAFETY: gpu module doc; both objects are this value's own.
         unsafe {
             self.gpu.gl().delete_vertex_array(self.vao);
             self.gpu.gl().delete_buffer(self.vbo);

@@ -3,8 +3,8 @@
 
 use glam::Vec3;
 
-use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture, TimerQuery};
-use crate::render::Timings;
+use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
+use crate::timing::Timings;
 
 use super::bitonic::{sort_texture_size, BitonicBuild};
 use super::{Grid, PhotonFrames, StencilRouting, VertexFeed};
@@ -34,10 +34,10 @@ pub struct BuildBenchRow {
 }
 
 /// Photons at uniform random points of the unit cube, all stored, one frame.
-pub fn synthetic_frames(gpu: &Gpu, n: u64, seed: u32) -> Result<PhotonFrames, GpuError> {
+pub fn synthetic_frames(gpu: &Gpu, n: u64, seed: u32) -> Result<PhotonFrames> {
     let (width, height) = sort_texture_size(n);
     let mut state = seed;
-    let mut next = || crate::reference::random::rng_next(&mut state);
+    let mut next = || crate::random::rng_next(&mut state);
     let texels = (width * height) as usize;
     let (mut pos, mut pow, inc) = (
         vec![0f32; texels * 4],
@@ -60,7 +60,7 @@ fn stage(t: &Timings, name: &str) -> f64 {
 }
 
 /// Benchmarks one size. `grid` is the paper's ~40^3 cells; `block` is m.
-pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBenchRow, GpuError> {
+pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBenchRow> {
     let frames = synthetic_frames(gpu, n, 0x5eed)?;
     let bitonic = BitonicBuild::new(gpu)?;
     let routing = StencilRouting::new(gpu)?;
@@ -88,13 +88,14 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     ];
     let copy = Program::fullscreen(gpu, "bench/copy_pairs.frag")?;
     let copies = sort.passes.max(1);
-    let q = TimerQuery::new(gpu)?;
+    let q = Query::timer(gpu)?;
     gpu.finish();
     let wall = std::time::Instant::now();
     q.begin();
     for i in 0..copies {
-        copy.bind().texture("u_pairs", &textures[i % 2]);
-        gpu.draw_fullscreen(&targets[1 - i % 2]);
+        copy.bind()
+            .texture("u_pairs", &textures[i % 2])
+            .draw_fullscreen(&targets[1 - i % 2], &DrawState::PLAIN)?;
     }
     q.end();
     gpu.finish();
@@ -176,38 +177,35 @@ pub struct MaskBenchRow {
 
 /// Does the stencil test skip fragment work on this driver? Times a heavy pass
 /// over `size` x `size` pixels with 0%, 50% and 90% of them masked.
-pub fn bench_mask(gpu: &Gpu, size: u32, iterations: i32) -> Result<Vec<MaskBenchRow>, GpuError> {
+pub fn bench_mask(gpu: &Gpu, size: u32, iterations: i32) -> Result<Vec<MaskBenchRow>> {
     let tex = Texture::new(gpu, size, size, TexFormat::Rgba32F)?;
     let target = Target::with_stencil(gpu, &[&tex])?;
     let heavy = Program::fullscreen(gpu, "bench/heavy.frag")?;
     let pattern = Program::fullscreen(gpu, "bench/mask_pattern.frag")?;
-    let run = |tenths: i32, contiguous: bool, stencil: bool| -> f64 {
+    let run = |tenths: i32, contiguous: bool, stencil: bool| -> Result<f64> {
         target.clear_depth_stencil(1.0, 0);
-        if stencil {
-            gpu.set_stencil_routing(true);
-            gpu.set_color_writes(false);
-            gpu.set_depth_test_always_no_write();
-            gpu.stencil(glow::ALWAYS, 1, [glow::KEEP, glow::KEEP, glow::REPLACE]);
+        let state = if stencil {
             pattern
                 .bind()
                 .int("u_masked_tenths", tenths)
                 .int("u_contiguous", contiguous as i32)
-                .int("u_width", size as i32);
-            gpu.draw_fullscreen(&target);
-            gpu.set_color_writes(true);
-            gpu.stencil(glow::EQUAL, 0, [glow::KEEP, glow::KEEP, glow::KEEP]);
-        }
+                .int("u_width", size as i32)
+                .draw_fullscreen(&target, &DrawState::stencil_replace(1))?;
+            DrawState::where_stencil_equals(0)
+        } else {
+            DrawState::PLAIN
+        };
         gpu.finish();
         let t0 = std::time::Instant::now();
-        heavy.bind().int("u_iterations", iterations);
-        gpu.draw_fullscreen(&target);
+        heavy
+            .bind()
+            .int("u_iterations", iterations)
+            .draw_fullscreen(&target, &state)?;
         gpu.finish();
-        let s = t0.elapsed().as_secs_f64();
-        gpu.set_stencil_routing(false);
-        s
+        Ok(t0.elapsed().as_secs_f64())
     };
-    run(0, false, false); // warm-up: compile and first touch
-    let base = run(0, false, false);
+    run(0, false, false)?; // warm-up: compile and first touch
+    let base = run(0, false, false)?;
     let mut rows = vec![MaskBenchRow {
         masked_fraction: 0.0,
         contiguous: false,
@@ -216,7 +214,7 @@ pub fn bench_mask(gpu: &Gpu, size: u32, iterations: i32) -> Result<Vec<MaskBench
         relative: 1.0,
     }];
     for (tenths, contiguous) in [(0, false), (5, false), (9, false), (5, true), (9, true)] {
-        let s = run(tenths, contiguous, true);
+        let s = run(tenths, contiguous, true)?;
         rows.push(MaskBenchRow {
             masked_fraction: tenths as f64 / 10.0,
             contiguous,

@@ -3,16 +3,16 @@
 //! binary-search pass that writes each grid cell's first photon, and a gather
 //! of the photon records into sorted order.
 
-use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture, TimerQuery};
-use crate::render::Timings;
+use crate::error::Error;
+use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
+use crate::timing::Timings;
 
 use super::{Grid, PhotonFrames};
 
 /// Float addresses are exact below 2^24 (the float mantissa).
 pub const FLOAT_ADDRESS_LIMIT: u64 = 1 << 24;
 
-/// The key of records that are not in the map: they sort last.
-pub const INVALID_KEY: i32 = i32::MAX;
+pub use crate::layout::INVALID_KEY;
 
 /// The photon map of build A.
 pub struct SortedPhotonMap {
@@ -44,9 +44,9 @@ pub struct BitonicBuild {
     gpu: Gpu,
     /// Compact stored records on the GPU before sorting (a HistoPyramid); off
     /// for the paper's way, sorting every record of every frame.
-    pub compact: bool,
+    compact: bool,
     /// Float 1D -> 2D addressing (the paper's); exact below 2^24 only.
-    pub float_addressing: bool,
+    float_addressing: bool,
     pyramid_base: Program,
     pyramid_reduce: Program,
     compact_pass: Program,
@@ -57,13 +57,13 @@ pub struct BitonicBuild {
 }
 
 impl BitonicBuild {
-    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu) -> Result<Self> {
         Self::with_addressing(gpu, false)
     }
 
     /// `float_addressing`: the paper's convert1dto2d in floats (`--faithful`),
     /// which also sorts every record (no compaction).
-    pub fn with_addressing(gpu: &Gpu, float_addressing: bool) -> Result<Self, GpuError> {
+    pub fn with_addressing(gpu: &Gpu, float_addressing: bool) -> Result<Self> {
         let defines: Vec<(&str, String)> = if float_addressing {
             vec![("FLOAT_ADDRESSING", "1".into())]
         } else {
@@ -84,9 +84,16 @@ impl BitonicBuild {
         })
     }
 
+    /// The same build with compaction switched on or off (off sorts every
+    /// record of every frame, as the paper does).
+    pub fn compacting(mut self, compact: bool) -> Self {
+        self.compact = compact;
+        self
+    }
+
     /// Sorts the (key, payload) pairs in `pairs` (RG32I or RGBA32I, width x
     /// height a power of two) by key, then payload. Returns the sorted texture and the passes run.
-    pub fn sort(&self, pairs: Texture) -> Result<(Texture, u32), GpuError> {
+    pub fn sort(&self, pairs: Texture) -> Result<(Texture, u32)> {
         let (w, h) = (pairs.width, pairs.height);
         let n = w as u64 * h as u64;
         assert!(
@@ -94,9 +101,10 @@ impl BitonicBuild {
             "bitonic sort needs a power-of-two texel count"
         );
         if self.float_addressing && n > FLOAT_ADDRESS_LIMIT {
-            return Err(GpuError::Gl(format!(
-                "--faithful float addressing is exact only below 2^24 = {FLOAT_ADDRESS_LIMIT} texels; this sort has {n}: use fewer photons or drop --faithful"
-            )));
+            return Err(Error::FloatAddressLimit {
+                texels: n,
+                limit: FLOAT_ADDRESS_LIMIT,
+            });
         }
         // Ping-pong between the input and one more texture: read one, draw the other.
         let other = Texture::new(&self.gpu, w, h, pairs.format)?;
@@ -118,12 +126,13 @@ impl BitonicBuild {
                         [0, (v / w as u64) as i32]
                     }
                 };
-                let mut b = self.bitonic.bind();
-                b.texture("u_pairs", &textures[current])
+                self.bitonic
+                    .bind()
+                    .texture("u_pairs", &textures[current])
                     .ivec2("u_stage_xy", split(stage))
                     .ivec2("u_distance_xy", split(distance))
-                    .int("u_width", w as i32);
-                self.gpu.draw_fullscreen(&targets[1 - current]);
+                    .int("u_width", w as i32)
+                    .draw_fullscreen(&targets[1 - current], &DrawState::PLAIN)?;
                 current = 1 - current;
                 passes += 1;
                 distance /= 2;
@@ -137,19 +146,20 @@ impl BitonicBuild {
     }
 
     /// For each cell 0..=cells, the lower bound of the cell in the sorted pairs.
-    pub fn binary_search(&self, sorted: &Texture, cells: u32) -> Result<(Texture, u32), GpuError> {
+    pub fn binary_search(&self, sorted: &Texture, cells: u32) -> Result<(Texture, u32)> {
         let entries = cells as u64 + 1;
         let grid_width = (entries as f64).sqrt().ceil() as u32;
         let grid_height = (entries.div_ceil(grid_width as u64)) as u32;
         let first = Texture::new(&self.gpu, grid_width, grid_height, TexFormat::Rgba32I)?;
         let target = Target::new(&self.gpu, &[&first])?;
-        let mut b = self.search.bind();
-        b.texture("u_sorted", sorted)
+        self.search
+            .bind()
+            .texture("u_sorted", sorted)
             .int("u_sorted_width", sorted.width as i32)
             .int("u_sorted_count", (sorted.width * sorted.height) as i32)
             .int("u_grid_width", grid_width as i32)
-            .int("u_cell_count", cells as i32);
-        self.gpu.draw_fullscreen(&target);
+            .int("u_cell_count", cells as i32)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
         self.gpu.check("binary search")?;
         Ok((first, grid_width))
     }
@@ -157,11 +167,7 @@ impl BitonicBuild {
     /// (cell, record) pairs of the stored records only, packed into the first
     /// slots of a power-of-two texture: HistoPyramid count, reduce, traverse.
     /// Returns the pairs and the number of stored records.
-    pub fn compacted_pairs(
-        &self,
-        frames: &PhotonFrames,
-        grid: &Grid,
-    ) -> Result<(Texture, u32), GpuError> {
+    pub fn compacted_pairs(&self, frames: &PhotonFrames, grid: &Grid) -> Result<(Texture, u32)> {
         let (w, h) = sort_texture_size(frames.record_count() as u64);
         let levels = 32 - w.max(h).leading_zeros();
         let pyramid = Texture::with_levels(&self.gpu, w, h, TexFormat::Rgba32I, levels)?;
@@ -175,15 +181,17 @@ impl BitonicBuild {
                 .int("u_record_width", frames.width as i32)
                 .int("u_record_count", frames.record_count() as i32)
                 .int("u_frame_height", frames.frame_height as i32)
-                .int("u_photons_used", frames.photons_used as i32);
-            self.gpu.draw_fullscreen(&target);
+                .int("u_photons_used", frames.photons_used as i32)
+                .draw_fullscreen(&target, &DrawState::PLAIN)?;
         }
         for level in 1..levels {
             // Samplers see only the level below while this one is drawn.
             pyramid.set_level_range(level - 1, level - 1);
             let target = Target::for_level(&self.gpu, &pyramid, level)?;
-            self.pyramid_reduce.bind().texture("u_below", &pyramid);
-            self.gpu.draw_fullscreen(&target);
+            self.pyramid_reduce
+                .bind()
+                .texture("u_below", &pyramid)
+                .draw_fullscreen(&target, &DrawState::PLAIN)?;
         }
         pyramid.set_level_range(0, levels - 1);
         let count = pyramid.read_i32_texel(levels - 1)[0] as u32;
@@ -197,8 +205,8 @@ impl BitonicBuild {
             .texture("u_position", &frames.position)
             .int("u_record_width", frames.width as i32)
             .int("u_out_width", cw as i32)
-            .int("u_count", count as i32);
-        self.gpu.draw_fullscreen(&target);
+            .int("u_count", count as i32)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
         self.gpu.check("compacting stored photons")?;
         Ok((pairs, count))
     }
@@ -209,8 +217,8 @@ impl BitonicBuild {
         frames: &PhotonFrames,
         grid: &Grid,
         timings: &mut Timings,
-    ) -> Result<SortedPhotonMap, GpuError> {
-        let query = TimerQuery::new(&self.gpu)?;
+    ) -> Result<SortedPhotonMap> {
+        let query = Query::timer(&self.gpu)?;
         let pairs = if self.compact {
             query.begin();
             let (pairs, _) = self.compacted_pairs(frames, grid)?;
@@ -234,8 +242,8 @@ impl BitonicBuild {
                 .int("u_record_width", frames.width as i32)
                 .int("u_record_count", frames.record_count() as i32)
                 .int("u_frame_height", frames.frame_height as i32)
-                .int("u_photons_used", frames.photons_used as i32);
-            self.gpu.draw_fullscreen(&target);
+                .int("u_photons_used", frames.photons_used as i32)
+                .draw_fullscreen(&target, &DrawState::PLAIN)?;
             query.end();
             timings.add("keys", query.seconds(), 1);
             drop(target);
@@ -262,8 +270,8 @@ impl BitonicBuild {
             .texture("u_incoming", &frames.incoming)
             .int("u_sorted_width", w as i32)
             .int("u_record_width", frames.width as i32)
-            .float("u_power_scale", frames.power_scale);
-        self.gpu.draw_fullscreen(&target);
+            .float("u_power_scale", frames.power_scale)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
         query.end();
         timings.add("gather", query.seconds(), 1);
         self.gpu.check("gathering sorted photons")?;

@@ -4,18 +4,14 @@
 
 use glam::Vec3;
 
-use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 
 use super::{Grid, PhotonFrames};
 
 /// The grid a scene's photon map uses: the bounds the scene fixes, else the
 /// box of the stored photons (`fitted_grid`), else the scene's own box. Every
 /// build (render, `photonmap photons`) takes its grid from here.
-pub fn grid_for(
-    gpu: &Gpu,
-    scene: &crate::scene::Scene,
-    frames: &PhotonFrames,
-) -> Result<Grid, GpuError> {
+pub fn grid_for(gpu: &Gpu, scene: &crate::scene::Scene, frames: &PhotonFrames) -> Result<Grid> {
     if scene.photon_map.grid_bounds.is_some() {
         return Ok(Grid::for_scene(scene));
     }
@@ -31,7 +27,7 @@ pub fn grid_for(
 }
 
 /// The box of the stored photons in use, or None if there are none.
-pub fn photon_bounds(gpu: &Gpu, frames: &PhotonFrames) -> Result<Option<(Vec3, Vec3)>, GpuError> {
+pub fn photon_bounds(gpu: &Gpu, frames: &PhotonFrames) -> Result<Option<(Vec3, Vec3)>> {
     let base = Program::fullscreen(gpu, "photon/bounds_base.frag")?;
     let reduce = Program::fullscreen(gpu, "photon/bounds_reduce.frag")?;
     let (mut w, mut h) = (frames.width, frames.frame_height * frames.frames);
@@ -44,8 +40,8 @@ pub fn photon_bounds(gpu: &Gpu, frames: &PhotonFrames) -> Result<Option<(Vec3, V
             .texture("u_power", &frames.power)
             .int("u_record_width", frames.width as i32)
             .int("u_frame_height", frames.frame_height as i32)
-            .int("u_photons_used", frames.photons_used as i32);
-        gpu.draw_fullscreen(&target);
+            .int("u_photons_used", frames.photons_used as i32)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
     }
     while w > 1 || h > 1 {
         (w, h) = (w.div_ceil(2), h.div_ceil(2));
@@ -55,8 +51,11 @@ pub fn photon_bounds(gpu: &Gpu, frames: &PhotonFrames) -> Result<Option<(Vec3, V
         );
         {
             let target = Target::new(gpu, &[&nlo, &nhi])?;
-            reduce.bind().texture("u_min", &lo).texture("u_max", &hi);
-            gpu.draw_fullscreen(&target);
+            reduce
+                .bind()
+                .texture("u_min", &lo)
+                .texture("u_max", &hi)
+                .draw_fullscreen(&target, &DrawState::PLAIN)?;
         }
         (lo, hi) = (nlo, nhi);
     }

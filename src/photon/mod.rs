@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod bitonic;
+pub mod build;
 pub mod fit;
 pub mod projection;
 pub mod stencil_routing;
@@ -15,9 +16,10 @@ use crate::gpu::Bindings;
 use crate::scene::Scene;
 
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
+pub use build::{build_map, BuiltMap, PhotonConfig};
 pub use projection::ProjectionMaps;
 pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
-pub use trace::{PhotonFrames, PhotonTracer, RandomSource, TraceReport};
+pub use trace::{PhotonFrames, PhotonTracer, RandomSource, TraceConfig, TraceReport};
 
 /// The uniform grid photons are sorted or routed into.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,6 +87,36 @@ pub enum BuildMethod {
 pub enum PhotonMap {
     Sorted(SortedPhotonMap),
     Routed(RoutedPhotonMap),
+}
+
+impl PhotonMap {
+    pub fn grid(&self) -> &Grid {
+        match self {
+            PhotonMap::Sorted(m) => &m.grid,
+            PhotonMap::Routed(m) => &m.grid,
+        }
+    }
+
+    /// Photons destined to each cell (read back): the sorted map's cell
+    /// ranges, or stencil routing's exact counts (which may exceed m^2).
+    pub fn photons_per_cell(&self) -> Vec<u32> {
+        let cells = self.grid().cell_count() as usize;
+        match self {
+            PhotonMap::Sorted(m) => {
+                let first: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
+                (0..cells)
+                    .map(|c| (first[c + 1] - first[c]) as u32)
+                    .collect()
+            }
+            PhotonMap::Routed(m) => m
+                .counts
+                .read_f32()
+                .chunks(4)
+                .take(cells)
+                .map(|c| c[0] as u32)
+                .collect(),
+        }
+    }
 }
 
 /// The smallest power of two >= n.

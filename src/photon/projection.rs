@@ -11,7 +11,7 @@
 
 use glam::{Vec3, Vec4};
 
-use crate::reference::photon::{sample_cosine, sample_sphere};
+use crate::sampling::{basis_around, sample_cosine, sample_sphere};
 use crate::scene::{Geometry, Light, Scene};
 
 pub const DEFAULT_RESOLUTION: u32 = 64;
@@ -227,7 +227,7 @@ pub fn bounding_spheres(g: &Geometry) -> Vec<(Vec3, f32)> {
             // Arc k spans angles [k, k+1] * step; its sphere sits on the
             // chord's midpoint at mid-height and reaches the arc's corners.
             let step = 2.0 * std::f32::consts::PI / PIECES as f32;
-            let (t, b) = crate::reference::photon::basis_around(axis);
+            let (t, b) = basis_around(axis);
             let half = 0.5 * step;
             let reach = ((radius * half.sin()).powi(2) + 0.25 * height * height).sqrt();
             (0..PIECES)
@@ -456,7 +456,7 @@ mod tests {
                             radius,
                             height,
                         } => {
-                            let (t, bb) = crate::reference::photon::basis_around(axis);
+                            let (t, bb) = basis_around(axis);
                             let phi = a * 2.0 * std::f32::consts::PI;
                             base + b * height * axis + radius * (phi.cos() * t + phi.sin() * bb)
                         }

@@ -11,10 +11,12 @@
 //!   counts photons per cell with additive blending into a float texture, and
 //!   the power of stored photons is scaled by destined / stored from that count.
 
+use crate::error::Error;
 use crate::gpu::{
-    max_texture_size, Gpu, GpuError, Program, Target, TexFormat, Texture, TimerQuery, VertexBuffer,
+    Blend, Compare, DepthTest, DrawState, Gpu, Program, Query, Result, StencilOp, StencilTest,
+    Target, TexFormat, Texture, VertexBuffer,
 };
-use crate::render::Timings;
+use crate::timing::Timings;
 
 use super::{Grid, PhotonFrames};
 
@@ -46,12 +48,12 @@ pub struct RoutedPhotonMap {
 }
 
 /// Blocks per row and the routing buffer's size for `cells` cells of m x m.
-pub fn routing_layout(cells: u32, block: u32, max_size: u32) -> Result<(u32, u32, u32), GpuError> {
+pub fn routing_layout(cells: u32, block: u32, max_size: u32) -> Result<(u32, u32, u32)> {
     let per_row = (cells as f64).sqrt().ceil().max(1.0) as u32;
     let rows = cells.div_ceil(per_row);
     let (w, h) = (per_row as u64 * block as u64, rows as u64 * block as u64);
     if w > max_size as u64 || h > max_size as u64 {
-        return Err(GpuError::Gl(format!(
+        return Err(Error::TooLarge(format!(
             "stencil routing of {cells} cells of {block} x {block} slots needs a {w} x {h} buffer; this driver allows {max_size} a side: use a smaller m or fewer grid cells"
         )));
     }
@@ -69,7 +71,7 @@ pub struct StencilRouting {
 }
 
 impl StencilRouting {
-    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu) -> Result<Self> {
         let readback = [("READBACK", "1".to_string())];
         Ok(Self {
             gpu: gpu.clone(),
@@ -90,7 +92,7 @@ impl StencilRouting {
         block: u32,
         feed: VertexFeed,
         timings: &mut Timings,
-    ) -> Result<RoutedPhotonMap, GpuError> {
+    ) -> Result<RoutedPhotonMap> {
         Ok(self
             .build_inner(frames, grid, block, feed, timings, false)?
             .0)
@@ -102,7 +104,7 @@ impl StencilRouting {
         frames: &PhotonFrames,
         grid: &Grid,
         block: u32,
-    ) -> Result<(Vec<u8>, RoutedPhotonMap), GpuError> {
+    ) -> Result<(Vec<u8>, RoutedPhotonMap)> {
         let (map, stencil) = self.build_inner(
             frames,
             grid,
@@ -122,12 +124,12 @@ impl StencilRouting {
         feed: VertexFeed,
         timings: &mut Timings,
         read_stencil: bool,
-    ) -> Result<(RoutedPhotonMap, Option<Vec<u8>>), GpuError> {
+    ) -> Result<(RoutedPhotonMap, Option<Vec<u8>>)> {
         if !(1..=16).contains(&block) {
-            return Err(GpuError::Gl(format!("stencil routing block m = {block}: the allowed range is 1..=16 (m^2 slots must fit 8 stencil bits)")));
+            return Err(Error::InvalidOption(format!("stencil routing block m = {block}: the allowed range is 1..=16 (m^2 slots must fit 8 stencil bits)")));
         }
         let cells = grid.cell_count();
-        let (per_row, width, height) = routing_layout(cells, block, max_texture_size(&self.gpu))?;
+        let (per_row, width, height) = routing_layout(cells, block, self.gpu.max_texture_size())?;
         let t = |w, h| Texture::new(&self.gpu, w, h, TexFormat::Rgba32F);
         let (position, raw_power, incoming) =
             (t(width, height)?, t(width, height)?, t(width, height)?);
@@ -135,82 +137,47 @@ impl StencilRouting {
         let count_width = (cells as f64).sqrt().ceil() as u32;
         let counts = t(count_width, cells.div_ceil(count_width))?;
         let count_target = Target::new(&self.gpu, &[&counts])?;
-        let query = TimerQuery::new(&self.gpu)?;
-
-        // The paper's read-back: photon records to the CPU, back as vertices.
+        let query = Query::timer(&self.gpu)?;
         let vertices = match feed {
             VertexFeed::VertexFetch => None,
-            VertexFeed::Readback => {
-                let wall = std::time::Instant::now();
-                let (p, w, i) = (
-                    frames.position.read_f32(),
-                    frames.power.read_f32(),
-                    frames.incoming.read_f32(),
-                );
-                let mut data = Vec::with_capacity(p.len() * 3);
-                for k in 0..p.len() / 4 {
-                    data.extend_from_slice(&p[4 * k..4 * k + 4]);
-                    data.extend_from_slice(&w[4 * k..4 * k + 4]);
-                    data.extend_from_slice(&i[4 * k..4 * k + 4]);
-                }
-                let vb = VertexBuffer::from_f32(&self.gpu, &data, &[4, 4, 4])?;
-                timings.add("read-back (wall)", wall.elapsed().as_secs_f64(), 1);
-                Some(vb)
-            }
+            VertexFeed::Readback => Some(self.read_back(frames, timings)?),
         };
-        let draw = |program: &Program, target: &Target, size: [i32; 2], per_row: u32, m: u32| {
-            let mut b = program.bind();
-            grid.bind(&mut b);
-            b.int("u_record_width", frames.width as i32)
-                .int("u_frame_height", frames.frame_height as i32)
-                .int("u_photons_used", frames.photons_used as i32)
-                .int("u_blocks_per_row", per_row as i32)
-                .ivec2("u_target_size", size)
-                .int("u_block", m as i32);
-            match &vertices {
-                Some(vb) => vb.draw_points(target),
-                None => {
-                    b.texture("u_position", &frames.position)
-                        .texture("u_power", &frames.power)
-                        .texture("u_incoming", &frames.incoming);
-                    self.gpu
-                        .draw_points(target, 0, frames.record_count() as i32);
-                }
-            }
+        let draw = Draw {
+            frames,
+            grid,
+            vertices: vertices.as_ref(),
         };
 
         query.begin();
         target.clear([0.0; 4]);
         target.clear_depth_stencil(1.0, 0);
         // Stencil pattern 0..m^2-1 per block (stencil export; colour untouched).
-        self.gpu.set_stencil_routing(true);
-        self.gpu.set_color_writes(false);
-        self.gpu.set_depth_test_always_no_write();
-        self.gpu
-            .stencil(glow::ALWAYS, 0, [glow::KEEP, glow::KEEP, glow::REPLACE]);
-        self.pattern.bind().int("u_block", block as i32);
-        self.gpu.draw_fullscreen(&target);
-        self.gpu.set_color_writes(true);
-        // Route: write where the stencil is m^2-1 (and the slot was never written), always increment.
-        self.gpu.set_stencil_routing(true);
-        self.gpu.stencil(
-            glow::EQUAL,
-            (block * block - 1) as i32,
-            [glow::INCR, glow::INCR, glow::INCR],
-        );
-        let program = if vertices.is_some() {
-            &self.route_readback
-        } else {
-            &self.route_fetch
+        self.pattern
+            .bind()
+            .int("u_block", block as i32)
+            .draw_fullscreen(&target, &DrawState::stencil_replace(0))?;
+        // Route: write where the stencil is m^2-1 (and the slot was never
+        // written: depth LESS against the clear), always increment.
+        let route = DrawState {
+            color_writes: true,
+            blend: Blend::Off,
+            depth: DepthTest::On {
+                compare: Compare::Less,
+                write: true,
+            },
+            stencil: StencilTest::On {
+                compare: Compare::Equal,
+                reference: (block * block - 1) as i32,
+                fail: StencilOp::Incr,
+                depth_fail: StencilOp::Incr,
+                pass: StencilOp::Incr,
+            },
         };
-        draw(
-            program,
-            &target,
-            [width as i32, height as i32],
-            per_row,
-            block,
-        );
-        self.gpu.set_stencil_routing(false);
+        let program = match &vertices {
+            Some(_) => &self.route_readback,
+            None => &self.route_fetch,
+        };
+        draw.points(program, &target, &route, per_row, block)?;
         query.end();
         timings.add("route", query.seconds(), 2);
         let stencil = read_stencil.then(|| target.read_stencil());
@@ -218,20 +185,11 @@ impl StencilRouting {
         // Count destined photons per cell exactly.
         query.begin();
         count_target.clear([0.0; 4]);
-        self.gpu.set_additive_blend(true);
-        let program = if vertices.is_some() {
-            &self.count_readback
-        } else {
-            &self.count_fetch
+        let program = match &vertices {
+            Some(_) => &self.count_readback,
+            None => &self.count_fetch,
         };
-        draw(
-            program,
-            &count_target,
-            [counts.width as i32, counts.height as i32],
-            count_width,
-            1,
-        );
-        self.gpu.set_additive_blend(false);
+        draw.points(program, &count_target, &DrawState::ADDITIVE, count_width, 1)?;
         query.end();
         timings.add("count", query.seconds(), 1);
 
@@ -239,15 +197,16 @@ impl StencilRouting {
         let power = t(width, height)?;
         let power_target = Target::new(&self.gpu, &[&power])?;
         query.begin();
-        let mut b = self.redistribute.bind();
-        b.texture("u_routed_position", &position)
+        self.redistribute
+            .bind()
+            .texture("u_routed_position", &position)
             .texture("u_routed_power", &raw_power)
             .texture("u_counts", &counts)
             .int("u_block", block as i32)
             .int("u_blocks_per_row", per_row as i32)
             .int("u_count_width", count_width as i32)
-            .float("u_power_scale", frames.power_scale);
-        self.gpu.draw_fullscreen(&power_target);
+            .float("u_power_scale", frames.power_scale)
+            .draw_fullscreen(&power_target, &DrawState::PLAIN)?;
         query.end();
         timings.add("redistribute", query.seconds(), 1);
         self.gpu.check("stencil routing")?;
@@ -262,5 +221,62 @@ impl StencilRouting {
             grid: *grid,
         };
         Ok((map, stencil))
+    }
+
+    /// The paper's read-back: photon records to the CPU, back as vertices.
+    fn read_back(&self, frames: &PhotonFrames, timings: &mut Timings) -> Result<VertexBuffer> {
+        let wall = std::time::Instant::now();
+        let (p, w, i) = (
+            frames.position.read_f32(),
+            frames.power.read_f32(),
+            frames.incoming.read_f32(),
+        );
+        let mut data = Vec::with_capacity(p.len() * 3);
+        for k in 0..p.len() / 4 {
+            data.extend_from_slice(&p[4 * k..4 * k + 4]);
+            data.extend_from_slice(&w[4 * k..4 * k + 4]);
+            data.extend_from_slice(&i[4 * k..4 * k + 4]);
+        }
+        let vb = VertexBuffer::from_f32(&self.gpu, &data, &[4, 4, 4])?;
+        timings.add("read-back (wall)", wall.elapsed().as_secs_f64(), 1);
+        Ok(vb)
+    }
+}
+
+/// Every photon record drawn as a point, by vertex fetch or from read-back vertices.
+struct Draw<'a> {
+    frames: &'a PhotonFrames,
+    grid: &'a Grid,
+    vertices: Option<&'a VertexBuffer>,
+}
+
+impl Draw<'_> {
+    /// Points of size `m` into blocks laid `per_row` to a row of `target`.
+    fn points(
+        &self,
+        program: &Program,
+        target: &Target,
+        state: &DrawState,
+        per_row: u32,
+        m: u32,
+    ) -> Result<()> {
+        let f = self.frames;
+        let mut b = program.bind();
+        self.grid.bind(&mut b);
+        b.int("u_record_width", f.width as i32)
+            .int("u_frame_height", f.frame_height as i32)
+            .int("u_photons_used", f.photons_used as i32)
+            .int("u_blocks_per_row", per_row as i32)
+            .ivec2("u_target_size", [target.width as i32, target.height as i32])
+            .int("u_block", m as i32);
+        match self.vertices {
+            Some(vb) => b.draw_vertices(target, state, vb),
+            None => {
+                b.texture("u_position", &f.position)
+                    .texture("u_power", &f.power)
+                    .texture("u_incoming", &f.incoming);
+                b.draw_points(target, state, 0, f.record_count() as i32)
+            }
+        }
     }
 }

@@ -2,7 +2,8 @@
 //! pass per bounce, each writing its own frame (a band of rows) of four RGBA32F
 //! textures. Photon i sits at texel (i % width, i / width) of every frame.
 
-use crate::gpu::{max_texture_size, Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::error::Error;
+use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
@@ -35,6 +36,33 @@ pub struct PhotonFrames {
 }
 
 impl PhotonFrames {
+    /// Frames of `frames` bands of `width` x `frame_height` texels, made
+    /// from the four record textures (each `width` x `frame_height * frames`).
+    fn assemble(
+        gpu: &Gpu,
+        [position, power, incoming, outgoing]: [Texture; 4],
+        frame_height: u32,
+        frames: u32,
+    ) -> Result<Self> {
+        let target = Target::new(gpu, &[&position, &power, &incoming, &outgoing])?;
+        let width = position.width;
+        Ok(Self {
+            position,
+            power,
+            incoming,
+            outgoing,
+            target,
+            width,
+            frame_height,
+            frames,
+            emitted: width * frame_height,
+            photons_used: width * frame_height,
+            power_scale: 1.0,
+            gpu_seconds: 0.0,
+            projection: None,
+        })
+    }
+
     /// Texels in all frames: the records a photon-map build reads.
     pub fn record_count(&self) -> u32 {
         self.width * self.frame_height * self.frames
@@ -65,14 +93,14 @@ impl PhotonFrames {
 
 /// Frame width and height for `emitted` photons and `frames` frames: square-ish
 /// frames (width a power of two) stacked within the driver's texture size.
-pub fn frame_layout(emitted: u32, frames: u32, max_size: u32) -> Result<(u32, u32), GpuError> {
+pub fn frame_layout(emitted: u32, frames: u32, max_size: u32) -> Result<(u32, u32)> {
     // Square-ish, but wide enough that all frames fit the driver's height.
     let square = (emitted as f64).sqrt().ceil() as u64;
     let needed = (emitted as u64 * frames as u64).div_ceil(max_size as u64);
     let width = (square.max(needed).next_power_of_two() as u32).clamp(1, max_size);
     let frame_height = emitted.div_ceil(width).max(1);
     if frame_height as u64 * frames as u64 > max_size as u64 {
-        return Err(GpuError::Gl(format!(
+        return Err(Error::TooLarge(format!(
             "{emitted} photons x {frames} frames need {} x {} texels; this driver allows {max_size} a side: emit fewer photons or allow fewer bounces",
             width,
             frame_height as u64 * frames as u64
@@ -128,22 +156,38 @@ pub enum RandomSource {
     Texture,
 }
 
-pub struct PhotonTracer {
-    gpu: Gpu,
-    emit: Program,
-    bounce: Program,
-    count: Program,
-    probe: Program,
-    /// Stop bouncing once an occlusion query finds no live photon (issue 8's
-    /// skip; the frames not traced are left out of every build).
+/// How a `PhotonTracer` traces (fixed when it is made).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceConfig {
+    pub random: RandomSource,
+    /// Stop bouncing once an occlusion query finds no live photon (the frames
+    /// not traced are left out of every build).
     pub stop_when_dead: bool,
     /// Aim photons by projection maps when the scene stores caustics only
     /// (off: emit everywhere and keep only the caustic paths, to compare).
     pub projection_maps: bool,
+}
+
+impl Default for TraceConfig {
+    fn default() -> Self {
+        Self {
+            random: RandomSource::Hash,
+            stop_when_dead: true,
+            projection_maps: true,
+        }
+    }
+}
+
+pub struct PhotonTracer {
+    gpu: Gpu,
+    config: TraceConfig,
+    emit: Program,
+    bounce: Program,
+    count: Program,
+    probe: Program,
     /// Emission through projection maps, compiled on first use.
     emit_projected: std::cell::OnceCell<Program>,
     defines: Vec<(&'static str, String)>,
-    random: RandomSource,
 }
 
 /// Projection maps ready for emission: the maps and their texture.
@@ -152,43 +196,54 @@ struct Aim {
     texture: Texture,
 }
 
-/// Random numbers per photon per frame in the texture source.
-const RANDOM_PER_TEXEL_PAIR: usize = 8;
+/// Per-frame state of one trace: the frames' textures, the random numbers,
+/// and the queries that time passes and probe for live photons.
+struct Trace<'a> {
+    frames: PhotonFrames,
+    random: Option<Texture>,
+    aim: Option<&'a Aim>,
+    timer: Query,
+    alive: Query,
+    probe: Option<(Texture, Target)>,
+}
 
 impl PhotonTracer {
-    pub fn new(gpu: &Gpu) -> Result<Self, GpuError> {
-        Self::with_random(gpu, RandomSource::Hash)
+    pub fn new(gpu: &Gpu) -> Result<Self> {
+        Self::with_config(gpu, TraceConfig::default())
     }
 
-    pub fn with_random(gpu: &Gpu, random: RandomSource) -> Result<Self, GpuError> {
-        let defines: Vec<(&'static str, String)> = match random {
+    pub fn with_config(gpu: &Gpu, config: TraceConfig) -> Result<Self> {
+        let defines: Vec<(&'static str, String)> = match config.random {
             RandomSource::Hash => vec![],
             RandomSource::Texture => vec![("RANDOM_TEXTURE", "1".into())],
         };
         Ok(Self {
             gpu: gpu.clone(),
+            config,
             emit: Program::fullscreen_with(gpu, "photon/emit.frag", &defines)?,
             bounce: Program::fullscreen_with(gpu, "photon/trace.frag", &defines)?,
             count: Program::fullscreen(gpu, "photon/stored_count.frag")?,
             probe: Program::fullscreen(gpu, "photon/alive_probe.frag")?,
-            stop_when_dead: true,
-            projection_maps: true,
             emit_projected: std::cell::OnceCell::new(),
             defines,
-            random,
         })
     }
 
+    pub fn config(&self) -> TraceConfig {
+        self.config
+    }
+
     /// The random-number texture: for frame f and photon texel (x, y), the
-    /// first 8 numbers of the hash stream that frame would use.
+    /// first RANDOM_PER_PHOTON_FRAME numbers of the hash stream that frame would use.
     fn random_texture(
         &self,
         seed: u32,
         width: u32,
         frame_height: u32,
         frames: u32,
-    ) -> Result<Texture, GpuError> {
-        use crate::reference::random::{rng_init, rng_next};
+    ) -> Result<Texture> {
+        use crate::layout::RANDOM_PER_PHOTON_FRAME;
+        use crate::random::{rng_init, rng_next};
         let mut data = vec![0f32; (width * 2 * frame_height * frames * 4) as usize];
         for f in 0..frames {
             for y in 0..frame_height {
@@ -196,7 +251,7 @@ impl PhotonTracer {
                     let mut state = rng_init(seed, [x, y], 0x10000000 + f);
                     let row = (f * frame_height + y) as usize;
                     let base = (row * (width as usize * 2) + x as usize * 2) * 4;
-                    for k in 0..RANDOM_PER_TEXEL_PAIR {
+                    for k in 0..RANDOM_PER_PHOTON_FRAME {
                         data[base + k] = rng_next(&mut state);
                     }
                 }
@@ -218,7 +273,7 @@ impl PhotonTracer {
         textures: &SceneTextures,
         seed: u32,
         emitted: u32,
-    ) -> Result<PhotonFrames, GpuError> {
+    ) -> Result<PhotonFrames> {
         let aim = self.aim_for(scene)?;
         self.trace_aimed(scene, textures, aim.as_ref(), seed, emitted)
     }
@@ -231,147 +286,176 @@ impl PhotonTracer {
         aim: Option<&Aim>,
         seed: u32,
         emitted: u32,
-    ) -> Result<PhotonFrames, GpuError> {
+    ) -> Result<PhotonFrames> {
         let frames = scene.photon_map.max_bounces + 1;
-        let (width, frame_height) = frame_layout(emitted, frames, max_texture_size(&self.gpu))?;
+        let (width, frame_height) = frame_layout(emitted, frames, self.gpu.max_texture_size())?;
         let height = frame_height * frames;
         let t = || Texture::new(&self.gpu, width, height, TexFormat::Rgba32F);
-        let (position, power, incoming, outgoing) = (t()?, t()?, t()?, t()?);
         // No clear: emission and every bounce write each texel of their frame.
-        let target = Target::new(&self.gpu, &[&position, &power, &incoming, &outgoing])?;
-        let (w, fh) = (width as i32, frame_height as i32);
-        let query = crate::gpu::TimerQuery::new(&self.gpu)?;
-        let random = match self.random {
-            RandomSource::Hash => None,
-            RandomSource::Texture => {
-                Some(self.random_texture(seed, width, frame_height, frames)?)
-            }
+        let mut pass = Trace {
+            frames: PhotonFrames::assemble(
+                &self.gpu,
+                [t()?, t()?, t()?, t()?],
+                frame_height,
+                frames,
+            )?,
+            random: match self.config.random {
+                RandomSource::Hash => None,
+                RandomSource::Texture => {
+                    Some(self.random_texture(seed, width, frame_height, frames)?)
+                }
+            },
+            aim,
+            timer: Query::timer(&self.gpu)?,
+            alive: Query::occlusion(&self.gpu)?,
+            probe: None,
         };
-        let emit = match aim {
-            None => &self.emit,
-            Some(_) => self.emit_projected()?,
-        };
-        let alive_query = crate::gpu::OcclusionQuery::new(&self.gpu)?;
-        let mut probe_target: Option<Result<(Texture, Target), GpuError>> = None;
-        let mut frames_used = frames;
+        pass.frames.emitted = emitted;
+        pass.frames.photons_used = emitted;
         // Each pass timed alone: a timer query spanning the probes' occlusion
         // read-backs reads nonsense on llvmpipe.
         let mut gpu_seconds = 0.0;
         self.gpu.finish();
         let wall = std::time::Instant::now();
-        query.begin();
-        {
-            let mut b = emit.bind();
-            textures.bind(&mut b);
-            if let Some(r) = &random {
-                b.texture("u_random_numbers", r);
-            }
-            if let Some(aim) = aim {
-                b.texture("u_projection", &aim.texture).int(
-                    "u_projection_resolution",
-                    scene.photon_map.projection_resolution as i32,
-                );
-            }
-            b.uint("u_seed", seed)
-                .int("u_emitted", emitted as i32)
-                .int("u_width", w);
-            self.gpu.draw_region(&target, 0, 0, w, fh);
-        }
-        query.end();
-        gpu_seconds += query.seconds();
-        for bounce in 1..frames as i32 {
-            // The previous frame was drawn into these very textures.
-            self.gpu.texture_barrier();
-            let mut b = self.bounce.bind();
-            textures.bind(&mut b);
-            if let Some(r) = &random {
-                b.texture("u_random_numbers", r);
-            }
-            b.texture("u_position", &position)
-                .texture("u_power", &power)
-                .texture("u_incoming", &incoming)
-                .texture("u_outgoing", &outgoing)
-                .uint("u_seed", seed)
-                .int("u_bounce", bounce)
-                .int("u_frame_height", fh)
-                .int("u_store_direct", scene.photon_map.store_direct as i32)
-                .int("u_caustics_only", scene.photon_map.caustics_only as i32);
-            query.begin();
-            self.gpu.draw_region(&target, 0, bounce * fh, w, fh);
-            query.end();
-            gpu_seconds += query.seconds();
-            if self.stop_when_dead && bounce + 1 < frames as i32 {
-                // How many photons of this frame go on? None: the rest is dark.
-                self.gpu.texture_barrier();
-                let probe_target = probe_target.get_or_insert_with(|| {
-                    Texture::new(&self.gpu, width, frame_height, TexFormat::R32F)
-                        .and_then(|t| Target::new(&self.gpu, &[&t]).map(|target| (t, target)))
-                });
-                let (_, probe) = probe_target
-                    .as_ref()
-                    .map_err(|e| GpuError::Gl(e.to_string()))?;
-                self.probe
-                    .bind()
-                    .texture("u_incoming", &incoming)
-                    .int("u_frame_row", bounce * fh);
-                self.gpu.set_color_writes(false);
-                alive_query.begin();
-                self.gpu.draw_fullscreen(probe);
-                alive_query.end();
-                self.gpu.set_color_writes(true);
-                if alive_query.samples() == 0 {
-                    frames_used = bounce as u32 + 1;
-                    break;
-                }
+        gpu_seconds += self.emit_pass(scene, textures, &pass, seed)?;
+        let mut frames_used = frames;
+        for bounce in 1..frames {
+            gpu_seconds += self.bounce_pass(scene, textures, &pass, seed, bounce)?;
+            if self.config.stop_when_dead
+                && bounce + 1 < frames
+                && self.live_photons(&mut pass, bounce)? == 0
+            {
+                // No photon of this frame goes on: the rest is dark.
+                frames_used = bounce + 1;
+                break;
             }
         }
-
         self.gpu.finish();
         // llvmpipe has been seen to return nonsense (hours) for these timer
         // queries once occlusion queries are read between them: a GPU time
         // longer than the wall clock cannot be, so keep the wall clock then.
-        let gpu_seconds = if gpu_seconds > wall.elapsed().as_secs_f64() {
-            wall.elapsed().as_secs_f64()
-        } else {
-            gpu_seconds
-        };
+        let wall = wall.elapsed().as_secs_f64();
         self.gpu.check("photon tracing")?;
-        Ok(PhotonFrames {
-            position,
-            power,
-            incoming,
-            outgoing,
-            target,
-            width,
-            frame_height,
-            frames: frames_used,
-            emitted,
-            photons_used: emitted,
-            power_scale: 1.0,
-            gpu_seconds,
-            projection: aim.map(|a| a.maps.clone()),
-        })
+        let mut frames = pass.frames;
+        frames.frames = frames_used;
+        frames.gpu_seconds = gpu_seconds.min(wall);
+        frames.projection = aim.map(|a| a.maps.clone());
+        Ok(frames)
+    }
+
+    /// Emission into frame 0; returns its GPU seconds.
+    fn emit_pass(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        pass: &Trace<'_>,
+        seed: u32,
+    ) -> Result<f64> {
+        let f = &pass.frames;
+        let emit = match pass.aim {
+            None => &self.emit,
+            Some(_) => self.emit_projected()?,
+        };
+        let mut b = emit.bind();
+        textures.bind(&mut b);
+        if let Some(r) = &pass.random {
+            b.texture("u_random_numbers", r);
+        }
+        if let Some(aim) = pass.aim {
+            b.texture("u_projection", &aim.texture).int(
+                "u_projection_resolution",
+                scene.photon_map.projection_resolution as i32,
+            );
+        }
+        b.uint("u_seed", seed)
+            .int("u_emitted", f.emitted as i32)
+            .int("u_width", f.width as i32);
+        pass.timer.begin();
+        let drawn = b.draw_region(
+            &f.target,
+            &DrawState::PLAIN,
+            [0, 0, f.width as i32, f.frame_height as i32],
+        );
+        pass.timer.end();
+        drawn?;
+        Ok(pass.timer.seconds())
+    }
+
+    /// Bounce `bounce` from frame bounce - 1 into frame `bounce`; returns its GPU seconds.
+    fn bounce_pass(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        pass: &Trace<'_>,
+        seed: u32,
+        bounce: u32,
+    ) -> Result<f64> {
+        let f = &pass.frames;
+        // The previous frame was drawn into these very textures.
+        self.gpu.texture_barrier();
+        let mut b = self.bounce.bind();
+        textures.bind(&mut b);
+        if let Some(r) = &pass.random {
+            b.texture("u_random_numbers", r);
+        }
+        let fh = f.frame_height as i32;
+        b.texture("u_position", &f.position)
+            .texture("u_power", &f.power)
+            .texture("u_incoming", &f.incoming)
+            .texture("u_outgoing", &f.outgoing)
+            .uint("u_seed", seed)
+            .int("u_bounce", bounce as i32)
+            .int("u_frame_height", fh)
+            .int("u_store_direct", scene.photon_map.store_direct as i32)
+            .int("u_caustics_only", scene.photon_map.caustics_only as i32);
+        pass.timer.begin();
+        let drawn = b.draw_region(
+            &f.target,
+            &DrawState::PLAIN,
+            [0, bounce as i32 * fh, f.width as i32, fh],
+        );
+        pass.timer.end();
+        drawn?;
+        Ok(pass.timer.seconds())
+    }
+
+    /// How many photons of frame `bounce` go on (an occlusion query).
+    fn live_photons(&self, pass: &mut Trace<'_>, bounce: u32) -> Result<u64> {
+        self.gpu.texture_barrier();
+        let (width, frame_height) = (pass.frames.width, pass.frames.frame_height);
+        if pass.probe.is_none() {
+            let t = Texture::new(&self.gpu, width, frame_height, TexFormat::R32F)?;
+            let target = Target::new(&self.gpu, &[&t])?;
+            pass.probe = Some((t, target));
+        }
+        let (_, probe) = pass.probe.as_ref().expect("made above");
+        let mut b = self.probe.bind();
+        b.texture("u_incoming", &pass.frames.incoming)
+            .int("u_frame_row", (bounce * frame_height) as i32);
+        pass.alive.begin();
+        let drawn = b.draw_fullscreen(probe, &DrawState::NO_COLOR);
+        pass.alive.end();
+        drawn?;
+        Ok(pass.alive.count())
     }
 
     /// The projection maps this scene's photons are aimed by, and their
     /// texture, if any: the scene stores caustics only and they are not
     /// switched off.
-    fn aim_for(&self, scene: &Scene) -> Result<Option<Aim>, GpuError> {
-        if !(scene.photon_map.caustics_only && self.projection_maps) {
+    fn aim_for(&self, scene: &Scene) -> Result<Option<Aim>> {
+        if !(scene.photon_map.caustics_only && self.config.projection_maps) {
             return Ok(None);
         }
         let maps = ProjectionMaps::for_scene(scene);
         if maps.kept_power_fraction(scene) <= 0.0 {
-            return Err(GpuError::Gl(
-                "the scene stores caustics only, but no light can send a photon towards a mirror or glass shape".into(),
-            ));
+            return Err(Error::NoCausticPath);
         }
         let t = maps.texels(scene);
         let texture = Texture::from_f32(&self.gpu, t.width, t.height, TexFormat::Rgba32F, &t.data)?;
         Ok(Some(Aim { maps, texture }))
     }
 
-    fn emit_projected(&self) -> Result<&Program, GpuError> {
+    fn emit_projected(&self) -> Result<&Program> {
         if let Some(p) = self.emit_projected.get() {
             return Ok(p);
         }
@@ -383,7 +467,7 @@ impl PhotonTracer {
 
     /// Stored records per photon index, counted on the GPU (one float per
     /// photon read back, not the power texture of every frame).
-    pub fn stored_per_photon(&self, frames: &PhotonFrames) -> Result<Vec<u32>, GpuError> {
+    pub fn stored_per_photon(&self, frames: &PhotonFrames) -> Result<Vec<u32>> {
         let counts = Texture::new(
             &self.gpu,
             frames.width,
@@ -395,8 +479,8 @@ impl PhotonTracer {
             .bind()
             .texture("u_power", &frames.power)
             .int("u_frame_height", frames.frame_height as i32)
-            .int("u_frames", frames.frames as i32);
-        self.gpu.draw_fullscreen(&target);
+            .int("u_frames", frames.frames as i32)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
         Ok(counts
             .read_f32()
             .into_iter()
@@ -417,11 +501,11 @@ impl PhotonTracer {
         scene: &Scene,
         textures: &SceneTextures,
         seed: u32,
-    ) -> Result<(PhotonFrames, TraceReport), GpuError> {
+    ) -> Result<(PhotonFrames, TraceReport)> {
         let target = scene.photon_map.photons_stored;
         let max_emitted = {
             let frames = scene.photon_map.max_bounces + 1;
-            let max = max_texture_size(&self.gpu) as u64;
+            let max = self.gpu.max_texture_size() as u64;
             // Whole rows per frame of the widest frame.
             ((max / frames as u64) * max).min(u32::MAX as u64 / 2) as u32
         };
@@ -442,22 +526,14 @@ impl PhotonTracer {
             let counts = self.stored_per_photon(&frames)?;
             let total: u64 = counts.iter().map(|&c| c as u64).sum();
             if total >= target as u64 {
-                let mut sum = 0u32;
-                let mut used = counts.len() as u32;
-                for (i, &c) in counts.iter().enumerate() {
-                    sum += c;
-                    if sum >= target {
-                        used = i as u32 + 1;
-                        break;
-                    }
-                }
+                let (used, stored) = photons_reaching(&counts, target);
                 frames.photons_used = used;
                 frames.power_scale = emitted as f32 / used as f32;
                 let report = TraceReport {
                     attempts,
                     emitted,
                     photons_used: used,
-                    stored: sum,
+                    stored,
                     target,
                     gpu_seconds: frames.gpu_seconds,
                     gpu_seconds_all_attempts: all_seconds,
@@ -466,14 +542,15 @@ impl PhotonTracer {
                 return Ok((frames, report));
             }
             if total == 0 && emitted >= 250_000 {
-                return Err(GpuError::Gl(format!(
-                    "{emitted} photons emitted and none stored: no diffuse surface is reached after a bounce (photon maps store diffuse hits after the first; add a diffuse surface{remedy})"
-                )));
+                return Err(Error::NoPhotonsStored { emitted, remedy });
             }
             if emitted >= max_emitted || attempts.len() >= 8 {
-                return Err(GpuError::Gl(format!(
-                    "{emitted} photons emitted stored only {total} of the {target} asked for: the scene's lights reach too few diffuse surfaces after a bounce (lower photons_stored{remedy})"
-                )));
+                return Err(Error::TooFewPhotonsStored {
+                    emitted,
+                    stored: total,
+                    target,
+                    remedy,
+                });
             }
             let grow = if total == 0 {
                 16.0
@@ -483,6 +560,19 @@ impl PhotonTracer {
             emitted = ((emitted as f64 * grow) as u64 + 64).min(max_emitted as u64) as u32;
         }
     }
+}
+
+/// The first M photons (in index order) whose stored records reach `target`,
+/// and how many records they store.
+fn photons_reaching(counts: &[u32], target: u32) -> (u32, u32) {
+    let mut sum = 0u32;
+    for (i, &c) in counts.iter().enumerate() {
+        sum += c;
+        if sum >= target {
+            return (i as u32 + 1, sum);
+        }
+    }
+    (counts.len() as u32, sum)
 }
 
 impl PhotonFrames {
@@ -502,26 +592,17 @@ impl PhotonFrames {
         power: &[f32],
         incoming: &[f32],
         photons_used: u32,
-    ) -> Result<Self, GpuError> {
+    ) -> Result<Self> {
         let height = frame_height * frames;
         let t = |d: &[f32]| Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, d);
-        let (position, power, incoming) = (t(position)?, t(power)?, t(incoming)?);
         let outgoing = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
-        let target = Target::new(gpu, &[&position, &power, &incoming, &outgoing])?;
-        Ok(Self {
-            position,
-            power,
-            incoming,
-            outgoing,
-            target,
-            width,
+        let mut f = Self::assemble(
+            gpu,
+            [t(position)?, t(power)?, t(incoming)?, outgoing],
             frame_height,
             frames,
-            emitted: width * frame_height,
-            photons_used,
-            power_scale: 1.0,
-            gpu_seconds: 0.0,
-            projection: None,
-        })
+        )?;
+        f.photons_used = photons_used;
+        Ok(f)
     }
 }

@@ -11,6 +11,7 @@ use crate::scene::{Material, Scene};
 use super::intersect::intersect_geometry;
 use super::random::{rng_init, rng_next};
 use super::ray_trace::{closest_hit, fresnel_dielectric, offset_scale};
+pub use crate::sampling::{basis_around, sample_cosine, sample_sphere};
 
 const PI: f32 = std::f32::consts::PI;
 
@@ -21,30 +22,6 @@ pub struct PhotonRecord {
     pub power: Vec4,
     pub incoming: Vec4,
     pub outgoing: Vec4,
-}
-
-pub fn basis_around(n: Vec3) -> (Vec3, Vec3) {
-    let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (s + n.z);
-    let c = n.x * n.y * a;
-    (
-        Vec3::new(1.0 + s * n.x * n.x * a, s * c, -s * n.x),
-        Vec3::new(c, s + n.y * n.y * a, -n.y),
-    )
-}
-
-pub fn sample_cosine(n: Vec3, u1: f32, u2: f32) -> Vec3 {
-    let r = u1.sqrt();
-    let phi = 2.0 * PI * u2;
-    let (t, b) = basis_around(n);
-    (r * phi.cos() * t + r * phi.sin() * b + (1.0 - u1).max(0.0).sqrt() * n).normalize()
-}
-
-pub fn sample_sphere(u1: f32, u2: f32) -> Vec3 {
-    let z = 1.0 - 2.0 * u1;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u2;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
 fn reflect(d: Vec3, n: Vec3) -> Vec3 {

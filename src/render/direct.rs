@@ -1,13 +1,12 @@
 //! Direct illumination by shadow rays, emitters seen along eye paths, and the
 //! record of each eye path's first diffuse hit (what the radiance estimate reads).
 
-use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::scene::pack::SceneTextures;
 
 use super::{HitBuffers, Image};
 
 pub struct DirectLight {
-    gpu: Gpu,
     /// Accumulated radiance per pixel (linear RGB).
     pub radiance: Texture,
     /// First diffuse hit: position (w = 1 where one exists).
@@ -20,18 +19,10 @@ pub struct DirectLight {
     program: Program,
 }
 
-/// Splits N samples into an nx x ny grid of strata, nx the largest divisor <= sqrt(N).
-pub fn strata(n: u32) -> (u32, u32) {
-    let mut nx = (n as f64).sqrt().floor() as u32;
-    while nx > 1 && !n.is_multiple_of(nx) {
-        nx -= 1;
-    }
-    let nx = nx.max(1);
-    (nx, n / nx)
-}
+pub use crate::sampling::strata;
 
 impl DirectLight {
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self> {
         let t = || Texture::new(gpu, width, height, TexFormat::Rgba32F);
         let (radiance, diffuse_position, diffuse_normal, diffuse_throughput) =
             (t()?, t()?, t()?, t()?);
@@ -45,7 +36,6 @@ impl DirectLight {
             ],
         )?;
         Ok(Self {
-            gpu: gpu.clone(),
             radiance,
             diffuse_position,
             diffuse_normal,
@@ -68,7 +58,7 @@ impl DirectLight {
         samples: std::ops::Range<u32>,
         depth: u32,
         seed: u32,
-    ) {
+    ) -> Result<()> {
         let (nx, _) = strata(shadow_rays);
         let mut b = self.program.bind();
         scene.bind(&mut b);
@@ -78,10 +68,8 @@ impl DirectLight {
             .int("u_shadow_rays", shadow_rays as i32)
             .int("u_strata_x", nx as i32)
             .int("u_sample_begin", samples.start as i32)
-            .int("u_sample_end", samples.end as i32);
-        self.gpu.set_additive_blend(true);
-        self.gpu.draw_fullscreen(&self.target);
-        self.gpu.set_additive_blend(false);
+            .int("u_sample_end", samples.end as i32)
+            .draw_fullscreen(&self.target, &DrawState::ADDITIVE)
     }
 
     pub fn read_radiance(&self) -> Image {
@@ -90,20 +78,5 @@ impl DirectLight {
             self.radiance.height,
             &self.radiance.read_f32(),
         )
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn strata_cover_every_sample_count() {
-        assert_eq!(super::strata(32), (4, 8));
-        assert_eq!(super::strata(4), (2, 2));
-        assert_eq!(super::strata(1), (1, 1));
-        assert_eq!(super::strata(7), (1, 7));
-        for n in 1..=1024 {
-            let (a, b) = super::strata(n);
-            assert_eq!(a * b, n);
-        }
     }
 }

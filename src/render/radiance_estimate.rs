@@ -3,8 +3,8 @@
 //! occlusion query (or full screen, or full screen behind a per-pixel stencil
 //! mask), and the composed image, also of the running estimate.
 
-use crate::gpu::{Gpu, GpuError, OcclusionQuery, Program, Target, TexFormat, Texture, TimerQuery};
-use crate::photon::{Grid, PhotonMap};
+use crate::gpu::{Bindings, DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
+use crate::photon::PhotonMap;
 use crate::scene::pack::SceneTextures;
 
 use super::{DirectLight, Image};
@@ -88,12 +88,7 @@ pub struct RadianceEstimate {
 }
 
 /// The search program for a map kind and a way of drawing.
-fn search_program(
-    gpu: &Gpu,
-    routed: bool,
-    tiles: bool,
-    float_addressing: bool,
-) -> Result<Program, GpuError> {
+fn search_program(gpu: &Gpu, routed: bool, tiles: bool, float_addressing: bool) -> Result<Program> {
     let mut defines: Vec<(&str, String)> = if routed {
         vec![("ROUTED", "1".into())]
     } else {
@@ -111,7 +106,7 @@ fn search_program(
 }
 
 impl RadianceEstimate {
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self> {
         let flux = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
         let cursor = Texture::new(gpu, width, height, TexFormat::Rgba32I)?;
         let done = Texture::new(gpu, width, height, TexFormat::Rgba32I)?;
@@ -135,6 +130,28 @@ impl RadianceEstimate {
         })
     }
 
+    /// The search program for this map and mode, compiled on first use.
+    fn search_program(
+        &self,
+        map: &PhotonMap,
+        options: &EstimateOptions,
+    ) -> Result<std::rc::Rc<Program>> {
+        let routed = matches!(map, PhotonMap::Routed(_));
+        let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
+        let key = (routed, tiled, options.float_addressing);
+        if let Some(p) = self.search.borrow().get(&key) {
+            return Ok(p.clone());
+        }
+        let p = std::rc::Rc::new(search_program(
+            &self.gpu,
+            routed,
+            tiled,
+            options.float_addressing,
+        )?);
+        self.search.borrow_mut().insert(key, p.clone());
+        Ok(p)
+    }
+
     /// Runs the search to the end; `on_pass` sees every pass.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
@@ -145,138 +162,40 @@ impl RadianceEstimate {
         max_radius: f32,
         options: &EstimateOptions,
         on_pass: &mut dyn FnMut(&PassReport<'_>),
-    ) -> Result<EstimateStats, GpuError> {
+    ) -> Result<EstimateStats> {
         self.gpu.finish();
         let wall = std::time::Instant::now();
-        let routed = matches!(map, PhotonMap::Routed(_));
-        let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
-        let key = (routed, tiled, options.float_addressing);
-        let cached = self.search.borrow().get(&key).cloned();
-        let search = match cached {
-            Some(p) => p,
-            None => {
-                let p = std::rc::Rc::new(search_program(
-                    &self.gpu,
-                    routed,
-                    tiled,
-                    options.float_addressing,
-                )?);
-                self.search.borrow_mut().insert(key, p.clone());
-                p
-            }
-        };
-        let timer = TimerQuery::new(&self.gpu)?;
+        let search = self.search_program(map, options)?;
+        let timer = Query::timer(&self.gpu)?;
         let mut stats = EstimateStats::default();
-
         self.init
             .bind()
-            .texture("u_query_position", &direct.diffuse_position);
-        self.gpu.draw_fullscreen(&self.target);
+            .texture("u_query_position", &direct.diffuse_position)
+            .draw_fullscreen(&self.target, &DrawState::PLAIN)?;
         self.target.clear_depth_stencil(1.0, 0);
         self.gpu.texture_barrier();
-
-        let bind_search = |b: &mut crate::gpu::Bindings<'_>| {
-            let grid: &Grid = match map {
-                PhotonMap::Sorted(m) => {
-                    b.texture("u_map_position", &m.position)
-                        .texture("u_map_power", &m.power)
-                        .texture("u_grid_first", &m.grid_first)
-                        .int("u_grid_width", m.grid_width as i32)
-                        .int("u_sorted_width", m.position.width as i32);
-                    &m.grid
-                }
-                PhotonMap::Routed(m) => {
-                    b.texture("u_map_position", &m.position)
-                        .texture("u_map_power", &m.power)
-                        .texture("u_map_counts", &m.counts)
-                        .int("u_count_width", m.count_width as i32)
-                        .int("u_block", m.block as i32)
-                        .int("u_blocks_per_row", m.blocks_per_row as i32);
-                    &m.grid
-                }
-            };
-            b.vec3("u_grid_min", grid.min.to_array())
-                .vec3("u_grid_max", grid.max.to_array())
-                .ivec3("u_grid_resolution", grid.resolution.map(|v| v as i32))
-                .texture("u_query_position", &direct.diffuse_position)
-                .texture("u_state_flux", &self.flux)
-                .texture("u_state_cursor", &self.cursor)
-                .texture("u_state_done", &self.done)
-                .int("u_k", k as i32)
-                .float("u_max_radius", max_radius)
-                .int("u_budget", options.budget as i32);
+        let query = SearchQuery {
+            map,
+            direct,
+            k,
+            max_radius,
+            budget: options.budget,
         };
-
-        let (tile, tiles_per_row, tile_count) = match options.mode {
-            EstimateMode::Tiled { tile } => {
-                let per_row = self.width.div_ceil(tile);
-                (tile, per_row, per_row * self.height.div_ceil(tile))
-            }
-            _ => (0, 0, 0),
-        };
-        stats.tiles = tile_count as u64;
-        let mut active_tiles: Vec<u32> = (0..tile_count).collect();
-        let queries: Vec<OcclusionQuery> = (0..tile_count.max(1))
-            .map(|_| OcclusionQuery::new(&self.gpu))
-            .collect::<Result<_, _>>()?;
-
+        let mut tiles = Tiles::new(options.mode, self.width, self.height);
+        stats.tiles = tiles.count as u64;
+        let queries: Vec<Query> = (0..tiles.count.max(1))
+            .map(|_| Query::occlusion(&self.gpu))
+            .collect::<Result<_>>()?;
         for pass in 0..options.max_passes {
             timer.begin();
             let searching = match options.mode {
                 EstimateMode::Tiled { .. } => {
                     let mut b = search.bind();
-                    bind_search(&mut b);
-                    b.int("u_tile", tile as i32)
-                        .int("u_tiles_per_row", tiles_per_row as i32)
-                        .ivec2("u_target_size", [self.width as i32, self.height as i32]);
-                    self.target.bind();
-                    for (q, &t) in queries.iter().zip(&active_tiles) {
-                        q.begin();
-                        self.gpu.draw_points_bound(t as i32, 1);
-                        q.end();
-                    }
-                    stats.tile_draws += active_tiles.len() as u64;
-                    let counts: Vec<u64> = queries
-                        .iter()
-                        .take(active_tiles.len())
-                        .map(|q| q.samples())
-                        .collect();
-                    let mut kept = Vec::with_capacity(active_tiles.len());
-                    for (t, c) in active_tiles.iter().zip(&counts) {
-                        if *c > 0 {
-                            kept.push(*t);
-                        }
-                    }
-                    active_tiles = kept;
-                    counts.iter().sum()
+                    self.bind_search(&mut b, &query);
+                    tiles.draw(&mut b, &self.target, &queries, &mut stats)?
                 }
                 EstimateMode::FullScreen | EstimateMode::Masked { .. } => {
-                    if let EstimateMode::Masked { every } = options.mode {
-                        self.gpu.set_stencil_routing(true);
-                        if pass % every.max(1) == 0 {
-                            // Stencil := 1 where the search is done.
-                            self.gpu.set_color_writes(false);
-                            self.gpu.set_depth_test_always_no_write();
-                            self.gpu.stencil(
-                                glow::ALWAYS,
-                                1,
-                                [glow::KEEP, glow::KEEP, glow::REPLACE],
-                            );
-                            self.mask.bind().texture("u_state_done", &self.done);
-                            self.gpu.draw_fullscreen(&self.target);
-                            self.gpu.set_color_writes(true);
-                        }
-                        self.gpu.set_depth_test_always_no_write();
-                        self.gpu
-                            .stencil(glow::EQUAL, 0, [glow::KEEP, glow::KEEP, glow::KEEP]);
-                    }
-                    let mut b = search.bind();
-                    bind_search(&mut b);
-                    queries[0].begin();
-                    self.gpu.draw_fullscreen(&self.target);
-                    queries[0].end();
-                    self.gpu.set_stencil_routing(false);
-                    queries[0].samples()
+                    self.full_screen_pass(&search, &query, options.mode, pass, &queries[0])?
                 }
             };
             timer.end();
@@ -304,6 +223,68 @@ impl RadianceEstimate {
         Ok(stats)
     }
 
+    /// The photon map, the queries and the search state, as knn_search.frag declares them.
+    fn bind_search(&self, b: &mut Bindings<'_>, q: &SearchQuery<'_>) {
+        let grid = q.map.grid();
+        match q.map {
+            PhotonMap::Sorted(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_grid_first", &m.grid_first)
+                    .int("u_grid_width", m.grid_width as i32)
+                    .int("u_sorted_width", m.position.width as i32);
+            }
+            PhotonMap::Routed(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_counts", &m.counts)
+                    .int("u_count_width", m.count_width as i32)
+                    .int("u_block", m.block as i32)
+                    .int("u_blocks_per_row", m.blocks_per_row as i32);
+            }
+        }
+        grid.bind(b);
+        b.texture("u_query_position", &q.direct.diffuse_position)
+            .texture("u_state_flux", &self.flux)
+            .texture("u_state_cursor", &self.cursor)
+            .texture("u_state_done", &self.done)
+            .int("u_k", q.k as i32)
+            .float("u_max_radius", q.max_radius)
+            .int("u_budget", q.budget as i32);
+    }
+
+    /// One full-screen search pass (behind the stencil mask, refreshed every
+    /// `every` passes, in masked mode); returns the pixels still searching.
+    fn full_screen_pass(
+        &self,
+        search: &Program,
+        query: &SearchQuery<'_>,
+        mode: EstimateMode,
+        pass: u32,
+        counter: &Query,
+    ) -> Result<u64> {
+        let state = match mode {
+            EstimateMode::Masked { every } => {
+                if pass % every.max(1) == 0 {
+                    // Stencil := 1 where the search is done.
+                    self.mask
+                        .bind()
+                        .texture("u_state_done", &self.done)
+                        .draw_fullscreen(&self.target, &DrawState::stencil_replace(1))?;
+                }
+                DrawState::where_stencil_equals(0)
+            }
+            _ => DrawState::PLAIN,
+        };
+        let mut b = search.bind();
+        self.bind_search(&mut b, query);
+        counter.begin();
+        let drawn = b.draw_fullscreen(&self.target, &state);
+        counter.end();
+        drawn?;
+        Ok(counter.count())
+    }
+
     /// The image from the current state (final or running): direct light plus
     /// the estimate at each first diffuse hit, as chosen.
     pub fn compose(
@@ -314,7 +295,7 @@ impl RadianceEstimate {
         max_radius: f32,
         include_direct: bool,
         include_indirect: bool,
-    ) -> Image {
+    ) -> Result<Image> {
         let mut b = self.compose.bind();
         scene.bind(&mut b);
         b.texture("u_direct", &direct.radiance)
@@ -325,8 +306,81 @@ impl RadianceEstimate {
             .int("u_k", k as i32)
             .float("u_max_radius", max_radius)
             .int("u_include_direct", include_direct as i32)
-            .int("u_include_indirect", include_indirect as i32);
-        self.gpu.draw_fullscreen(&self.image_target);
-        Image::from_gl_rgba(self.width, self.height, &self.image.read_f32())
+            .int("u_include_indirect", include_indirect as i32)
+            .draw_fullscreen(&self.image_target, &DrawState::PLAIN)?;
+        Ok(Image::from_gl_rgba(
+            self.width,
+            self.height,
+            &self.image.read_f32(),
+        ))
+    }
+}
+
+/// What one search looks for: in which map, from which first hits, how far.
+struct SearchQuery<'a> {
+    map: &'a PhotonMap,
+    direct: &'a DirectLight,
+    k: u32,
+    max_radius: f32,
+    budget: u32,
+}
+
+/// The tiles of tiled mode (section 3.3): those still searching are drawn,
+/// one occlusion query each, and a tile whose count is 0 is not drawn again.
+struct Tiles {
+    tile: u32,
+    per_row: u32,
+    count: u32,
+    active: Vec<u32>,
+}
+
+impl Tiles {
+    fn new(mode: EstimateMode, width: u32, height: u32) -> Self {
+        let (tile, per_row, count) = match mode {
+            EstimateMode::Tiled { tile } => {
+                let per_row = width.div_ceil(tile);
+                (tile, per_row, per_row * height.div_ceil(tile))
+            }
+            _ => (0, 0, 0),
+        };
+        Self {
+            tile,
+            per_row,
+            count,
+            active: (0..count).collect(),
+        }
+    }
+
+    /// Draws every active tile; returns the pixels still searching.
+    fn draw(
+        &mut self,
+        b: &mut Bindings<'_>,
+        target: &Target,
+        queries: &[Query],
+        stats: &mut EstimateStats,
+    ) -> Result<u64> {
+        b.int("u_tile", self.tile as i32)
+            .int("u_tiles_per_row", self.per_row as i32)
+            .ivec2("u_target_size", [target.width as i32, target.height as i32]);
+        for (q, &t) in queries.iter().zip(&self.active) {
+            q.begin();
+            let drawn = b.draw_points(target, &DrawState::PLAIN, t as i32, 1);
+            q.end();
+            drawn?;
+        }
+        stats.tile_draws += self.active.len() as u64;
+        let counts: Vec<u64> = queries
+            .iter()
+            .take(self.active.len())
+            .map(|q| q.count())
+            .collect();
+        let mut kept = Vec::with_capacity(self.active.len());
+        for (t, c) in self.active.iter().zip(&counts) {
+            if *c > 0 {
+                kept.push(*t);
+            }
+        }
+        self.active = kept;
+        Ok(counts.iter().sum())
     }
 }

@@ -1,11 +1,11 @@
 //! Eye rays, closest hits and specular continuation as fragment passes over
 //! per-pixel ray and hit textures (breadth-first: one depth at a time).
 
-use crate::gpu::{Gpu, GpuError, Program, Target, TexFormat, Texture};
+use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Camera;
 
-use super::RenderOptions;
+use super::PassPlan;
 
 /// Per-pixel rays: origin (w = active), unit direction, throughput.
 pub struct RayBuffers {
@@ -38,7 +38,6 @@ impl HitBuffers {
 }
 
 pub struct RayTracer {
-    gpu: Gpu,
     pub rays: RayBuffers,
     pub hits: HitBuffers,
     eye_program: Program,
@@ -46,12 +45,12 @@ pub struct RayTracer {
     specular_program: Program,
 }
 
-fn rgba(gpu: &Gpu, w: u32, h: u32) -> Result<Texture, GpuError> {
+fn rgba(gpu: &Gpu, w: u32, h: u32) -> Result<Texture> {
     Texture::new(gpu, w, h, TexFormat::Rgba32F)
 }
 
 impl RayTracer {
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self> {
         let (origin, direction, throughput) = (
             rgba(gpu, width, height)?,
             rgba(gpu, width, height)?,
@@ -79,7 +78,6 @@ impl RayTracer {
             target,
         };
         Ok(Self {
-            gpu: gpu.clone(),
             rays,
             hits,
             eye_program: Program::fullscreen(gpu, "render/eye_rays.frag")?,
@@ -90,44 +88,42 @@ impl RayTracer {
 
     /// One ray per pixel: through its centre with one sample per pixel (the
     /// paper), else through a jittered point of stratum `sample` of spp.
-    pub fn eye_rays(&self, camera: &Camera, options: &RenderOptions, sample: u32, seed: u32) {
-        let (strata_x, strata_y) = super::direct::strata(options.spp.max(1));
+    pub fn eye_rays(&self, camera: &Camera, plan: &PassPlan, sample: u32, seed: u32) -> Result<()> {
+        let (strata_x, strata_y) = crate::sampling::strata(plan.spp);
         let (u, v, w) = camera.basis();
         let tan_v = (camera.vfov_degrees.to_radians() * 0.5).tan();
-        let aspect = options.width as f32 / options.height as f32;
+        let aspect = plan.width as f32 / plan.height as f32;
         let mut b = self.eye_program.bind();
         b.vec3("u_camera_position", camera.position.to_array())
             .vec3("u_camera_right", u.to_array())
             .vec3("u_camera_up", v.to_array())
             .vec3("u_camera_backward", w.to_array())
             .vec2("u_tan_half_fov", [tan_v * aspect, tan_v])
-            .vec2(
-                "u_image_size",
-                [options.width as f32, options.height as f32],
-            )
-            .int("u_jitter", (options.spp > 1) as i32)
+            .vec2("u_image_size", [plan.width as f32, plan.height as f32])
+            .int("u_jitter", (plan.spp > 1) as i32)
             .int("u_sample", sample as i32)
             .ivec2("u_strata", [strata_x as i32, strata_y as i32])
-            .uint("u_seed", seed);
-        self.gpu.draw_fullscreen(&self.rays.target);
+            .uint("u_seed", seed)
+            .draw_fullscreen(&self.rays.target, &DrawState::PLAIN)
     }
 
     /// Closest hit of every active ray into the hit textures.
-    pub fn intersect(&self, scene: &SceneTextures) {
+    pub fn intersect(&self, scene: &SceneTextures) -> Result<()> {
         let mut b = self.intersect_program.bind();
         scene.bind(&mut b);
         b.texture("u_ray_origin", &self.rays.origin)
             .texture("u_ray_direction", &self.rays.direction)
-            .texture("u_ray_throughput", &self.rays.throughput);
-        self.gpu.draw_fullscreen(&self.hits.target);
+            .texture("u_ray_throughput", &self.rays.throughput)
+            .draw_fullscreen(&self.hits.target, &DrawState::PLAIN)
     }
 
     /// Reflected or refracted rays from the specular hits of this depth.
-    pub fn specular(&self, scene: &SceneTextures, depth: u32, seed: u32) {
+    pub fn specular(&self, scene: &SceneTextures, depth: u32, seed: u32) -> Result<()> {
         let mut b = self.specular_program.bind();
         scene.bind(&mut b);
         self.hits.bind(&mut b);
-        b.uint("u_seed", seed).int("u_depth", depth as i32);
-        self.gpu.draw_fullscreen(&self.rays.target);
+        b.uint("u_seed", seed)
+            .int("u_depth", depth as i32)
+            .draw_fullscreen(&self.rays.target, &DrawState::PLAIN)
     }
 }

@@ -2,6 +2,7 @@
 //! paper's per-scene parameters, loaded from TOML (+ OBJ) and validated.
 
 pub mod camera_path;
+pub mod embedded;
 pub mod load;
 pub mod pack;
 

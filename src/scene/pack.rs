@@ -1,12 +1,12 @@
 //! The scene packed into float textures once, in the layout glsl/common/scene.glsl reads.
 
-use crate::gpu::{Gpu, GpuError, TexFormat, Texture};
+use crate::gpu::{Gpu, Result, TexFormat, Texture};
+use crate::layout::{
+    LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE, MAT_EMITTER, MAT_GLASS,
+    MAT_MIRROR, PRIMITIVE_TEXELS, PRIM_CYLINDER, PRIM_PARALLELOGRAM, PRIM_SPHERE, PRIM_TRIANGLE,
+};
 
 use super::{Geometry, Light, Material, Scene};
-
-pub const PRIMITIVE_TEXELS: u32 = 4;
-pub const MATERIAL_TEXELS: u32 = 3;
-pub const LIGHT_TEXELS: u32 = 6;
 
 /// Rows of RGBA floats, one row per primitive / material / light.
 pub struct PackedScene {
@@ -41,10 +41,10 @@ pub fn pack_geometry(g: &Geometry) -> [[f32; 4]; 3] {
 
 pub fn geometry_kind(g: &Geometry) -> f32 {
     match g {
-        Geometry::Sphere { .. } => 0.0,
-        Geometry::Cylinder { .. } => 1.0,
-        Geometry::Parallelogram { .. } => 2.0,
-        Geometry::Triangle { .. } => 3.0,
+        Geometry::Sphere { .. } => PRIM_SPHERE as f32,
+        Geometry::Cylinder { .. } => PRIM_CYLINDER as f32,
+        Geometry::Parallelogram { .. } => PRIM_PARALLELOGRAM as f32,
+        Geometry::Triangle { .. } => PRIM_TRIANGLE as f32,
     }
 }
 
@@ -58,12 +58,14 @@ impl PackedScene {
         let mut materials = Vec::new();
         for m in &scene.materials {
             let (kind, ior, color, normal) = match *m {
-                Material::Diffuse { albedo } => (0.0, 1.0, albedo, glam::Vec3::ZERO),
-                Material::Mirror { reflectance } => (1.0, 1.0, reflectance, glam::Vec3::ZERO),
-                Material::Glass { ior } => (2.0, ior, glam::Vec3::ONE, glam::Vec3::ZERO),
-                Material::Emitter { radiance, normal } => (3.0, 1.0, radiance, normal),
+                Material::Diffuse { albedo } => (MAT_DIFFUSE, 1.0, albedo, glam::Vec3::ZERO),
+                Material::Mirror { reflectance } => {
+                    (MAT_MIRROR, 1.0, reflectance, glam::Vec3::ZERO)
+                }
+                Material::Glass { ior } => (MAT_GLASS, ior, glam::Vec3::ONE, glam::Vec3::ZERO),
+                Material::Emitter { radiance, normal } => (MAT_EMITTER, 1.0, radiance, normal),
             };
-            materials.push([kind, ior, 0.0, 0.0]);
+            materials.push([kind as f32, ior, 0.0, 0.0]);
             materials.push([color.x, color.y, color.z, 0.0]);
             materials.push([normal.x, normal.y, normal.z, 0.0]);
         }
@@ -100,7 +102,7 @@ impl PackedScene {
                     radiance,
                 } => {
                     lights.extend([
-                        [0.0, normal.x, normal.y, normal.z],
+                        [LIGHT_AREA as f32, normal.x, normal.y, normal.z],
                         v(corner),
                         v(edge1),
                         v(edge2),
@@ -113,7 +115,7 @@ impl PackedScene {
                     intensity,
                 } => {
                     lights.extend([
-                        [1.0, 0.0, 0.0, 0.0],
+                        [LIGHT_POINT as f32, 0.0, 0.0, 0.0],
                         v(position),
                         [0.0; 4],
                         [0.0; 4],
@@ -145,7 +147,7 @@ pub struct SceneTextures {
     pub offset_floor: f32,
 }
 
-fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture, GpuError> {
+fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture> {
     let height = (rows.len() as u32 / width).max(1);
     let mut data: Vec<f32> = rows.iter().flatten().copied().collect();
     data.resize((width * height * 4) as usize, 0.0);
@@ -153,7 +155,7 @@ fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture, GpuError>
 }
 
 impl SceneTextures {
-    pub fn new(gpu: &Gpu, scene: &Scene) -> Result<Self, GpuError> {
+    pub fn new(gpu: &Gpu, scene: &Scene) -> Result<Self> {
         let p = PackedScene::new(scene);
         Ok(Self {
             primitives: upload(gpu, &p.primitives, PRIMITIVE_TEXELS)?,

@@ -4,13 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use photonmap::gpu::{EglPlatform, Gpu};
+use photonmap::gpu::{Gpu, Platform};
 use photonmap::render::Image;
 use photonmap::scene::{load_scene, Scene};
 
 pub fn gpu() -> Gpu {
-    Gpu::new(EglPlatform::Auto)
-        .expect("a GL 4 context (install libegl1 libegl-mesa0 libgl1-mesa-dri)")
+    Gpu::new(Platform::Auto).expect("a GL 4 context (install libegl1 libegl-mesa0 libgl1-mesa-dri)")
 }
 
 pub fn root() -> PathBuf {
@@ -27,5 +26,5 @@ pub fn rmse(a: &Image, b: &Image) -> f64 {
 }
 
 pub fn write_exr(path: &Path, img: &Image) {
-    photonmap::render::image::write_atomically(path, &img.exr_bytes().unwrap()).unwrap();
+    photonmap::image::write_atomically(path, &img.exr_bytes().unwrap()).unwrap();
 }

@@ -2,6 +2,8 @@
 
 use std::path::Path;
 
+use crate::error::{Error, Result};
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     pub width: u32,
@@ -49,15 +51,38 @@ impl Image {
         self.pixels[(y * self.width + x) as usize]
     }
 
-    /// The per-pixel mean of equally sized images.
-    pub fn average(images: &[Image]) -> Image {
-        let mut out = Image::new(images[0].width, images[0].height);
-        for img in images {
-            for (o, p) in out.pixels.iter_mut().zip(&img.pixels) {
-                for c in 0..3 {
-                    o[c] += p[c] / images.len() as f32;
-                }
+    /// Adds `other` pixel by pixel (equal sizes).
+    pub fn add(&mut self, other: &Image) {
+        assert_eq!(
+            (self.width, self.height),
+            (other.width, other.height),
+            "images of one size"
+        );
+        for (a, p) in self.pixels.iter_mut().zip(&other.pixels) {
+            for c in 0..3 {
+                a[c] += p[c];
             }
+        }
+    }
+
+    /// Divides every channel by `n`.
+    pub fn divide(&mut self, n: f32) {
+        for p in &mut self.pixels {
+            for c in p.iter_mut() {
+                *c /= n;
+            }
+        }
+    }
+
+    /// The per-pixel mean of equally sized images: summed in order, then one
+    /// division (the box filter of a render's eye samples).
+    pub fn average(images: &[Image]) -> Image {
+        let mut out = images[0].clone();
+        for img in &images[1..] {
+            out.add(img);
+        }
+        if images.len() > 1 {
+            out.divide(images.len() as f32);
         }
         out
     }
@@ -77,7 +102,7 @@ impl Image {
     }
 
     /// 8-bit sRGB PNG (values clamped to [0, 1] before the transfer function).
-    pub fn png_bytes(&self) -> Result<Vec<u8>, String> {
+    pub fn png_bytes(&self) -> Result<Vec<u8>> {
         let mut buf = Vec::with_capacity(self.pixels.len() * 3);
         for p in &self.pixels {
             for c in p {
@@ -85,15 +110,15 @@ impl Image {
             }
         }
         let img = image::RgbImage::from_raw(self.width, self.height, buf)
-            .ok_or("image buffer size mismatch")?;
+            .ok_or_else(|| Error::Image("image buffer size mismatch".into()))?;
         let mut out = std::io::Cursor::new(Vec::new());
         img.write_to(&mut out, image::ImageFormat::Png)
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| Error::Image(format!("encoding a PNG: {e}")))?;
         Ok(out.into_inner())
     }
 
     /// Linear float RGB OpenEXR, the same orientation as the PNG.
-    pub fn exr_bytes(&self) -> Result<Vec<u8>, String> {
+    pub fn exr_bytes(&self) -> Result<Vec<u8>> {
         use exr::prelude::*;
         let w = self.width as usize;
         let layer = Layer::new(
@@ -109,11 +134,11 @@ impl Image {
         exr::image::Image::from_layer(layer)
             .write()
             .to_buffered(&mut out)
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| crate::error::Error::Image(format!("encoding an EXR: {e}")))?;
         Ok(out.into_inner())
     }
 
-    pub fn read_exr(path: &Path) -> Result<Self, String> {
+    pub fn read_exr(path: &Path) -> Result<Self> {
         use exr::prelude::*;
         let img = read_first_rgba_layer_from_file(
             path,
@@ -130,7 +155,9 @@ impl Image {
                 px[pos.y() * *w + pos.x()] = [r, g, b];
             },
         )
-        .map_err(|e| format!("cannot read EXR {}: {e}", path.display()))?;
+        .map_err(|e| {
+            crate::error::Error::Image(format!("cannot read EXR {}: {e}", path.display()))
+        })?;
         let (w, h, pixels) = img.layer_data.channel_data.pixels;
         Ok(Self {
             width: w as u32,
@@ -142,14 +169,18 @@ impl Image {
 
 /// Writes `bytes` to `path` all or nothing: a temporary file beside it, then a
 /// rename, so a failure never leaves a partial image behind.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+    let name = path.file_name().ok_or_else(|| {
+        Error::io(
+            "write",
+            path,
+            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
+        )
+    })?;
     // Unique per process and call, so concurrent writers never share a temporary.
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -158,9 +189,12 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
         name.to_string_lossy(),
         std::process::id()
     ));
-    std::fs::write(&tmp, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    if let Err(e) = std::fs::write(&tmp, bytes) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::io("write", path, e));
+    }
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
-        format!("cannot write {}: {e}", path.display())
+        Error::io("write", path, e)
     })
 }

@@ -1,0 +1,95 @@
+//! The one error type of the library. Every variant says what went wrong in
+//! words a user can act on; the binary adds context with anyhow and nothing else.
+
+use std::path::PathBuf;
+
+pub use crate::scene::SceneError;
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A shader that did not compile or link, located in its glsl/ file.
+#[derive(Debug, thiserror::Error)]
+#[error("glsl/{file}:{line}: {message}\n--- driver log ---\n{log}")]
+pub struct ShaderError {
+    pub file: String,
+    pub line: u32,
+    pub message: String,
+    pub log: String,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The headless platform (EGL or OSMesa) could not give a GL 4.5 context.
+    #[error("{0}")]
+    Platform(String),
+    #[error(transparent)]
+    Shader(#[from] ShaderError),
+    /// glGetError after a stage: a bug in this program, named by the stage.
+    #[error("GL: {what}: GL error 0x{code:04x}")]
+    Gl { what: String, code: u32 },
+    /// The driver could not create an object (texture, framebuffer, query...).
+    #[error("GL: creating {what}: {message}")]
+    Create { what: String, message: String },
+    #[error("GL: out of memory creating {resource} ({gib:.1} GiB)")]
+    OutOfMemory { resource: String, gib: f64 },
+    /// A resource larger than the driver allows; `message` says what to change.
+    #[error("GL: {0}")]
+    TooLarge(String),
+    /// A framebuffer the driver will not draw to.
+    #[error("GL: framebuffer incomplete: 0x{0:04x}")]
+    IncompleteFramebuffer(u32),
+    /// A uniform set from Rust that the program does not declare (a misspelled
+    /// name would otherwise read 0 and fail silently).
+    #[error("glsl/{program}: sets uniform {name}, which the program does not declare")]
+    UndeclaredUniform { program: String, name: String },
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error("cannot {action} {}: {source}", path.display())]
+    Io {
+        action: &'static str,
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// An image that cannot be encoded or decoded.
+    #[error("{0}")]
+    Image(String),
+    /// Two images that should have one size.
+    #[error("image sizes differ: {a_width} x {a_height} and {b_width} x {b_height}")]
+    SizeMismatch {
+        a_width: u32,
+        a_height: u32,
+        b_width: u32,
+        b_height: u32,
+    },
+    /// A parameter outside its allowed range, or options that exclude each other.
+    #[error("{0}")]
+    InvalidOption(String),
+    /// The paper's float addressing refuses what floats cannot address exactly.
+    #[error("GL: --faithful float addressing is exact only below 2^24 = {limit} texels; this sort has {texels}: use fewer photons or drop --faithful")]
+    FloatAddressLimit { texels: u64, limit: u64 },
+    /// Photon tracing stored nothing the map could hold.
+    #[error("GL: {emitted} photons emitted and none stored: no diffuse surface is reached after a bounce (photon maps store diffuse hits after the first; add a diffuse surface{remedy})")]
+    NoPhotonsStored { emitted: u32, remedy: &'static str },
+    #[error("GL: {emitted} photons emitted stored only {stored} of the {target} asked for: the scene's lights reach too few diffuse surfaces after a bounce (lower photons_stored{remedy})")]
+    TooFewPhotonsStored {
+        emitted: u32,
+        stored: u64,
+        target: u32,
+        remedy: &'static str,
+    },
+    #[error("GL: the scene stores caustics only, but no light can send a photon towards a mirror or glass shape")]
+    NoCausticPath,
+    /// Work the caller asked to stop (a signal).
+    #[error("interrupted")]
+    Interrupted,
+}
+
+impl Error {
+    pub fn io(action: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            action,
+            path: path.into(),
+            source,
+        }
+    }
+}

@@ -1,0 +1,68 @@
+//! Numbers that Rust and GLSL must agree on, defined once here. Every program
+//! is compiled with them as `#define`s (`glsl_defines`), so no shader spells a
+//! texel count or a kind code itself.
+
+/// Texels per row of each packed-scene texture (src/scene/pack.rs).
+pub const PRIMITIVE_TEXELS: u32 = 4;
+pub const MATERIAL_TEXELS: u32 = 3;
+pub const LIGHT_TEXELS: u32 = 6;
+
+/// Primitive kinds, the first float of a primitive's head texel.
+pub const PRIM_SPHERE: u32 = 0;
+pub const PRIM_CYLINDER: u32 = 1;
+pub const PRIM_PARALLELOGRAM: u32 = 2;
+pub const PRIM_TRIANGLE: u32 = 3;
+
+/// Material kinds, the first float of a material's head texel.
+pub const MAT_DIFFUSE: u32 = 0;
+pub const MAT_MIRROR: u32 = 1;
+pub const MAT_GLASS: u32 = 2;
+pub const MAT_EMITTER: u32 = 3;
+
+/// Light kinds, the first float of a light's head texel.
+pub const LIGHT_AREA: u32 = 0;
+pub const LIGHT_POINT: u32 = 1;
+
+/// The key of photon records that are not in the map: they sort last.
+pub const INVALID_KEY: i32 = i32::MAX;
+
+/// Random numbers per photon per frame in the `--faithful` random-number
+/// texture: two RGBA texels side by side.
+pub const RANDOM_PER_PHOTON_FRAME: usize = 8;
+
+/// pi as every shader writes it (the same f32 as `std::f32::consts::PI`).
+const PI_GLSL: &str = "3.14159265358979";
+
+/// The constants above as `(name, value)` pairs for the GLSL preprocessor.
+pub fn glsl_defines() -> Vec<(&'static str, String)> {
+    let u = |v: u32| v.to_string();
+    vec![
+        ("PRIMITIVE_TEXELS", u(PRIMITIVE_TEXELS)),
+        ("MATERIAL_TEXELS", u(MATERIAL_TEXELS)),
+        ("LIGHT_TEXELS", u(LIGHT_TEXELS)),
+        ("PRIM_SPHERE", u(PRIM_SPHERE)),
+        ("PRIM_CYLINDER", u(PRIM_CYLINDER)),
+        ("PRIM_PARALLELOGRAM", u(PRIM_PARALLELOGRAM)),
+        ("PRIM_TRIANGLE", u(PRIM_TRIANGLE)),
+        ("MAT_DIFFUSE", u(MAT_DIFFUSE)),
+        ("MAT_MIRROR", u(MAT_MIRROR)),
+        ("MAT_GLASS", u(MAT_GLASS)),
+        ("MAT_EMITTER", u(MAT_EMITTER)),
+        ("LIGHT_AREA", u(LIGHT_AREA)),
+        ("LIGHT_POINT", u(LIGHT_POINT)),
+        ("INVALID_KEY", format!("0x{INVALID_KEY:x}")),
+        (
+            "RANDOM_PER_PHOTON_FRAME",
+            RANDOM_PER_PHOTON_FRAME.to_string(),
+        ),
+        ("PI", PI_GLSL.into()),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn glsl_pi_is_the_f32_pi() {
+        assert_eq!(super::PI_GLSL.parse::<f32>().unwrap(), std::f32::consts::PI);
+    }
+}

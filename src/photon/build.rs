@@ -1,0 +1,145 @@
+//! The photon half of Figure 1 in one call: trace photons until the map can
+//! hold the scene's `photons_stored`, choose the grid, and build the map by
+//! bitonic sort or stencil routing. `render`, `photonmap photons` and the
+//! benchmarks all build their maps here.
+
+use crate::gpu::{Gpu, Result};
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+use crate::timing::Timings;
+
+use super::trace::{TraceConfig, TraceReport};
+use super::{
+    fit, BitonicBuild, BuildMethod, Grid, PhotonMap, PhotonTracer, RandomSource, StencilRouting,
+    VertexFeed,
+};
+
+/// How photons are traced and the map built (what the scene file does not fix).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PhotonConfig {
+    pub build: BuildMethod,
+    /// Stencil routing: m, each cell holds m x m photons.
+    pub stencil_block: u32,
+    pub feed: VertexFeed,
+    /// The paper's 2003 constraints: a random-number texture, read-back before
+    /// routing, float addressing, no compaction.
+    pub faithful: bool,
+    /// Trace every bounce up to max_bounces even when no photon is left alive.
+    pub all_bounces: bool,
+    /// Aim photons by projection maps when the scene stores caustics only.
+    pub projection_maps: bool,
+}
+
+impl Default for PhotonConfig {
+    fn default() -> Self {
+        Self {
+            build: BuildMethod::Bitonic,
+            stencil_block: 4,
+            feed: VertexFeed::VertexFetch,
+            faithful: false,
+            all_bounces: false,
+            projection_maps: true,
+        }
+    }
+}
+
+impl PhotonConfig {
+    /// The tracer's configuration: `--faithful` takes the random-number texture.
+    pub fn trace(&self) -> TraceConfig {
+        TraceConfig {
+            random: if self.faithful {
+                RandomSource::Texture
+            } else {
+                RandomSource::Hash
+            },
+            stop_when_dead: !self.all_bounces,
+            projection_maps: self.projection_maps,
+        }
+    }
+
+    /// How records reach stencil routing: `--faithful` reads them back.
+    pub fn feed(&self) -> VertexFeed {
+        if self.faithful {
+            VertexFeed::Readback
+        } else {
+            self.feed
+        }
+    }
+}
+
+/// A photon map and what it took to make it.
+pub struct BuiltMap {
+    pub map: PhotonMap,
+    pub trace: TraceReport,
+    /// Photon frames traced (emission + bounces; fewer than max_bounces + 1
+    /// when tracing stopped with no photon alive).
+    pub frames_traced: u32,
+    /// The power each kept photon carries relative to one of all traced.
+    pub power_scale: f32,
+    pub grid: Grid,
+    /// Whether the grid's bounds were fitted to the photons (the scene fixes none).
+    pub grid_fitted: bool,
+    /// The build's own stages (keys or compaction, sort, search, gather; or
+    /// pattern, route, count, redistribute).
+    pub build_stages: Timings,
+}
+
+/// Traces the scene's photons and builds its map, adding the stages "trace
+/// photons" and "build map" (GPU time and wall clock) to `timings`.
+pub fn build_map(
+    gpu: &Gpu,
+    scene: &Scene,
+    textures: &SceneTextures,
+    config: &PhotonConfig,
+    seed: u32,
+    timings: &mut Timings,
+) -> Result<BuiltMap> {
+    let tracer = PhotonTracer::with_config(gpu, config.trace())?;
+    gpu.finish();
+    let t0 = std::time::Instant::now();
+    let (frames, trace) = tracer.trace_to_stored(scene, textures, seed)?;
+    gpu.finish();
+    // Wall time covers every attempt at the stored count; GPU time the kept trace.
+    timings.add_both(
+        "trace photons",
+        trace.gpu_seconds,
+        t0.elapsed().as_secs_f64(),
+        frames.frames as usize,
+    );
+    // The scene's grid bounds, or (when it fixes none) the box of the photons.
+    let grid = fit::grid_for(gpu, scene, &frames)?;
+    let mut build_stages = Timings::default();
+    let t0 = std::time::Instant::now();
+    let map = match config.build {
+        BuildMethod::Bitonic => {
+            PhotonMap::Sorted(BitonicBuild::with_addressing(gpu, config.faithful)?.build(
+                &frames,
+                &grid,
+                &mut build_stages,
+            )?)
+        }
+        BuildMethod::Stencil => PhotonMap::Routed(StencilRouting::new(gpu)?.build(
+            &frames,
+            &grid,
+            config.stencil_block,
+            config.feed(),
+            &mut build_stages,
+        )?),
+    };
+    gpu.finish();
+    timings.add_both(
+        "build map",
+        build_stages.gpu_total(),
+        t0.elapsed().as_secs_f64(),
+        build_stages.stages.iter().map(|s| s.passes).sum(),
+    );
+    Ok(BuiltMap {
+        map,
+        trace,
+        frames_traced: frames.frames,
+        power_scale: frames.power_scale,
+        grid,
+        grid_fitted: scene.photon_map.grid_bounds.is_none(),
+        build_stages,
+    })
+}

@@ -1,0 +1,206 @@
+//! `--explain`: every pass a render ran or skipped, and why, written after the
+//! render from its plan and the stages' reports.
+
+use crate::scene::Scene;
+
+use super::{EstimateMode, RenderOptions, RenderOutput};
+
+/// One line of `--explain`: a stage's passes, run or skipped, and why.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ExplainLine {
+    pub stage: String,
+    pub passes: usize,
+    pub ran: bool,
+    pub why: String,
+}
+
+fn line(stage: &str, passes: usize, ran: bool, why: String) -> ExplainLine {
+    ExplainLine {
+        stage: stage.into(),
+        passes,
+        ran,
+        why,
+    }
+}
+
+impl std::fmt::Display for EstimateMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EstimateMode::Tiled { tile } => {
+                write!(f, "{tile} x {tile} tiles stopped by occlusion query")
+            }
+            EstimateMode::FullScreen => write!(f, "full screen"),
+            EstimateMode::Masked { every } => write!(
+                f,
+                "full screen behind a stencil mask refreshed every {every} passes"
+            ),
+        }
+    }
+}
+
+fn xyz(v: glam::Vec3) -> String {
+    format!("({}, {}, {})", v.x, v.y, v.z)
+}
+
+impl RenderOutput {
+    /// The passes this render ran and skipped, with why.
+    pub fn explain(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
+        let mut lines = self.ray_tracing_lines(scene);
+        match (&options.global, &self.photons) {
+            (Some(gi), Some(p)) => {
+                lines.extend(self.photon_lines(scene, p));
+                let (k, r) = (scene.photon_map.k, scene.photon_map.max_radius);
+                let pixels = options.width as u64 * options.height as u64;
+                let many = self.estimates.len() > 1;
+                for (i, s) in self.estimates.iter().enumerate() {
+                    lines.push(line(
+                        "radiance estimate",
+                        s.passes as usize,
+                        true,
+                        format!(
+                            "kNN-grid, k = {k}, max radius {r}, {} steps per pixel per pass, {}; {} of {pixels} pixels have a diffuse hit, {} tile draws{}",
+                            gi.estimate.budget,
+                            gi.estimate.mode,
+                            s.query_pixels,
+                            s.tile_draws,
+                            if many { format!(" (run {} of {})", i + 1, self.estimates.len()) } else { String::new() }
+                        ),
+                    ));
+                }
+            }
+            _ => lines.push(line(
+                "photons, map, estimate",
+                0,
+                false,
+                "skipped: direct light only".into(),
+            )),
+        }
+        lines
+    }
+
+    fn ray_tracing_lines(&self, scene: &Scene) -> Vec<ExplainLine> {
+        let p = &self.plan;
+        let views = (self.estimates.len() as u32 / p.spp).max(1);
+        let runs = (p.spp * views) as usize;
+        vec![
+            line(
+                "eye rays",
+                runs,
+                true,
+                if p.spp == 1 {
+                    "one ray per pixel centre".into()
+                } else {
+                    format!(
+                        "{} stratified, jittered samples per pixel, one pass each",
+                        p.spp
+                    )
+                },
+            ),
+            line(
+                "intersect",
+                p.depths as usize * runs,
+                true,
+                if p.specular {
+                    format!(
+                        "one per specular depth 0..={} per sample",
+                        scene.render.max_specular_depth
+                    )
+                } else {
+                    "depth 0 only: the scene has no mirror or glass".into()
+                },
+            ),
+            line(
+                "shadow rays",
+                (p.depths * p.direct_passes) as usize * runs,
+                true,
+                if p.has_area {
+                    format!(
+                        "{} samples per area light in batches of {} at each depth",
+                        p.shadow_rays, p.shadow_batch
+                    )
+                } else {
+                    "one ray per point light at each depth".into()
+                },
+            ),
+            line(
+                "specular",
+                (p.depths - 1) as usize * runs,
+                p.specular,
+                if p.specular {
+                    "reflect or refract at mirror and glass hits".into()
+                } else {
+                    "skipped: no specular surface".into()
+                },
+            ),
+        ]
+    }
+
+    fn photon_lines(&self, scene: &Scene, p: &super::PhotonReport) -> Vec<ExplainLine> {
+        let t = &p.trace;
+        let bounces = scene.photon_map.max_bounces + 1;
+        let mut lines = vec![
+            line(
+                "trace photons",
+                p.frames_traced as usize,
+                true,
+                format!(
+                    "emission + {} bounces{}; {} photons traced ({} attempts), the first {} kept: {} stored",
+                    p.frames_traced - 1,
+                    if p.frames_traced < bounces {
+                        format!(" (stopped: no photon alive; {} more skipped)", bounces - p.frames_traced)
+                    } else {
+                        String::new()
+                    },
+                    t.emitted,
+                    t.attempts.len(),
+                    t.photons_used,
+                    t.stored
+                ),
+            ),
+            line(
+                "projection maps",
+                0,
+                t.projection.is_some(),
+                match (&t.projection, scene.photon_map.caustics_only) {
+                    (Some(m), _) => format!(
+                        "caustics only: photons leave through {} of {} emission cells ({}x{} a light) that can reach a mirror or glass shape, {:.2}% of the lights' power",
+                        m.kept_cells, m.cells, m.resolution, m.resolution, 100.0 * m.kept_power_fraction
+                    ),
+                    (None, true) => "skipped: switched off (--no-projection-map); photons leave in every direction and only caustic paths are stored".into(),
+                    (None, false) => "skipped: the map stores indirect diffuse light too, which any emitted direction may carry (caustics_only = true aims photons at specular shapes)".into(),
+                },
+            ),
+            line(
+                "grid bounds",
+                0,
+                true,
+                format!(
+                    "{} x {} x {} cells over {}..{}, {}",
+                    p.grid.resolution[0],
+                    p.grid.resolution[1],
+                    p.grid.resolution[2],
+                    xyz(p.grid.min),
+                    xyz(p.grid.max),
+                    if p.grid_fitted {
+                        "fitted to the stored photons"
+                    } else {
+                        "as the scene fixes them"
+                    }
+                ),
+            ),
+        ];
+        let build = match p.config.build {
+            crate::photon::BuildMethod::Bitonic => "bitonic sort + binary search",
+            crate::photon::BuildMethod::Stencil => "stencil routing",
+        };
+        for st in &p.build_stages.stages {
+            lines.push(line(
+                &format!("build map: {}", st.name),
+                st.passes,
+                true,
+                build.into(),
+            ));
+        }
+        lines
+    }
+}

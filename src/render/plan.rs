@@ -1,0 +1,68 @@
+//! The ray tracer's passes for a scene, derived once from it and the options:
+//! what every eye sample runs, what the scene lets it skip, and the counts
+//! `--explain` and the progress bar report.
+
+use crate::scene::{Light, Scene};
+
+use super::RenderOptions;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassPlan {
+    pub width: u32,
+    pub height: u32,
+    /// Eye samples per pixel (at least 1).
+    pub spp: u32,
+    /// The scene has a mirror or glass: eye paths continue past their first hit.
+    pub specular: bool,
+    /// The scene has an area light: shadow rays are stratified samples in batches.
+    pub has_area: bool,
+    pub max_specular_depth: u32,
+    /// Intersect passes per eye sample: one per specular depth.
+    pub depths: u32,
+    /// Shadow samples per area light, and how many go in one pass.
+    pub shadow_rays: u32,
+    pub shadow_batch: u32,
+    /// Shadow-ray passes per depth: batches of area-light samples, or one.
+    pub direct_passes: u32,
+}
+
+impl PassPlan {
+    pub fn new(scene: &Scene, options: &RenderOptions) -> Self {
+        let specular = scene.has_specular();
+        let has_area = scene.lights.iter().any(|l| matches!(l, Light::Area { .. }));
+        let shadow_batch = options.shadow_batch.max(1);
+        Self {
+            width: options.width,
+            height: options.height,
+            spp: options.spp.max(1),
+            specular,
+            has_area,
+            max_specular_depth: scene.render.max_specular_depth,
+            // With nothing specular, an eye path ends at its first hit.
+            depths: if specular {
+                scene.render.max_specular_depth + 1
+            } else {
+                1
+            },
+            shadow_rays: scene.render.shadow_rays,
+            shadow_batch,
+            direct_passes: if has_area {
+                scene.render.shadow_rays.div_ceil(shadow_batch)
+            } else {
+                1
+            },
+        }
+    }
+
+    /// The shadow samples of batch `b`.
+    pub fn shadow_batch(&self, b: u32) -> std::ops::Range<u32> {
+        let begin = b * self.shadow_batch;
+        begin..((b + 1) * self.shadow_batch).min(self.shadow_rays)
+    }
+
+    /// Ray-tracing passes of one eye sample: eye rays, then per depth an
+    /// intersect and the shadow batches, and a specular pass between depths.
+    pub fn passes_per_sample(&self) -> u32 {
+        1 + self.depths * (1 + self.direct_passes) + (self.depths - 1)
+    }
+}

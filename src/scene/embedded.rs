@@ -1,0 +1,64 @@
+//! The scenes of scenes/, compiled into the binary: `photonmap render ring`
+//! renders a paper scene by name from any folder, `photonmap scenes` lists
+//! them, and the stress suite and `tables` never look for the source tree.
+
+use std::path::Path;
+
+use super::{load_scene, load_scene_str, Scene, SceneError};
+
+include!(concat!(env!("OUT_DIR"), "/scene_sources.rs"));
+
+/// The three scenes of the paper, by the names they are embedded under.
+pub const PAPER_SCENES: [&str; 3] = ["glass_ball", "ring", "cornell_box"];
+
+/// Names of the embedded scenes (paths under scenes/ without `.toml`), in
+/// order: `glass_ball`, `variants/furnace_64_bounces`, ...
+pub fn names() -> impl Iterator<Item = &'static str> {
+    SCENE_SOURCES.iter().filter_map(|(path, text)| {
+        // Camera paths live beside the scenes but are not scenes.
+        (path.ends_with(".toml") && text.contains("[camera]"))
+            .then(|| path.trim_end_matches(".toml"))
+    })
+}
+
+/// The TOML text of an embedded scene.
+pub fn source(name: &str) -> Option<&'static str> {
+    let file = format!("{}.toml", name.trim_end_matches(".toml"));
+    SCENE_SOURCES
+        .iter()
+        .find(|(path, _)| *path == file)
+        .map(|(_, text)| *text)
+}
+
+/// An embedded scene by name; errors name it as `scenes/<name>.toml`.
+pub fn load(name: &str) -> Result<Scene, SceneError> {
+    let file = format!("scenes/{}.toml", name.trim_end_matches(".toml"));
+    match source(name) {
+        Some(text) => load_scene_str(text, Path::new(&file)),
+        None => Err(SceneError {
+            file: file.into(),
+            line: 0,
+            field: "(file)".into(),
+            message: format!(
+                "no such embedded scene (embedded: {})",
+                names().collect::<Vec<_>>().join(", ")
+            ),
+        }),
+    }
+}
+
+/// A scene file, or, when no file of that name exists, the embedded scene of
+/// that name (`ring`, `scenes/ring.toml` and `variants/furnace_64_bounces` all
+/// work from any folder).
+pub fn load_path_or_name(arg: &Path) -> Result<Scene, SceneError> {
+    if arg.exists() {
+        return load_scene(arg);
+    }
+    let text = arg.to_string_lossy();
+    let name = text.strip_prefix("scenes/").unwrap_or(&text);
+    match source(name) {
+        Some(_) => load(name),
+        // Neither: the file's own error ("cannot read the scene file").
+        None => load_scene(arg),
+    }
+}
