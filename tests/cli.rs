@@ -756,3 +756,96 @@ fn projection_maps_are_reported_and_can_be_switched_off() {
         "{err}"
     );
 }
+
+/// The installed binary, away from its source tree: a paper scene renders by
+/// name, `scenes` lists the embedded scenes, and the quick stress suite runs
+/// every one of its cases (none may be skipped or fail to run).
+#[test]
+fn the_binary_alone_renders_by_name_lists_scenes_and_runs_the_stress_suite() {
+    let d = tmp("alone");
+    let bin = d.join("photonmap");
+    std::fs::copy(env!("CARGO_BIN_EXE_photonmap"), &bin).unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(&bin)
+            .args(args)
+            .current_dir(&d)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    };
+    run(&[
+        "render", "ring", "-o", "ring.png", "--quiet", "--width", "64", "--height", "48",
+    ]);
+    assert_eq!(image::open(d.join("ring.png")).unwrap().width(), 64);
+    let listed = String::from_utf8_lossy(&run(&["scenes"]).stdout).to_string();
+    for name in [
+        "glass_ball",
+        "ring",
+        "cornell_box",
+        "variants/furnace_64_bounces",
+    ] {
+        assert!(listed.contains(name), "{listed}");
+    }
+    let out = run(&["bench", "stress", "--quick", "--json", "--quiet"]);
+    let cases: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert!(cases.len() >= 15, "{} cases", cases.len());
+    for c in &cases {
+        assert_ne!(c["outcome"], "fail", "{c}");
+        assert!(
+            !c["message"].as_str().unwrap().contains("could not run"),
+            "{c}"
+        );
+    }
+    // A name that is neither a file nor an embedded scene is refused clearly.
+    let bad = Command::new(&bin)
+        .args(["render", "no_such_scene", "-o", "x.png"])
+        .current_dir(&d)
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("no_such_scene"));
+}
+
+/// `--mask 0` is refused with the range (it used to become 1 silently), and a
+/// fly-through reports no made-up output file.
+#[test]
+fn mask_zero_is_refused_and_camera_paths_need_no_output_image() {
+    let d = tmp("mask0");
+    let out = photonmap()
+        .args(["render", "--quiet", "--mask", "0"])
+        .arg(scene("ring"))
+        .arg("-o")
+        .arg(d.join("x.png"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1..=100000"));
+    let frames = d.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let out = photonmap()
+        .args(["render", "--width", "32", "--height", "24"])
+        .arg(scene("glass_ball"))
+        .arg("--camera-path")
+        .arg(common::root().join("scenes/paths/glass_ball_orbit.toml"))
+        .arg("--out")
+        .arg(&frames)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("frames.png"), "{err}");
+    assert!(!frames.join("frames.png").exists());
+    assert!(frames.join("frame_0000.png").is_file());
+}

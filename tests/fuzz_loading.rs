@@ -5,23 +5,13 @@
 //! PHOTONMAP_FUZZ_SEED the mutations.
 //! Inputs that once broke the loader live in tests/fuzz_corpus/regressions/.
 
+mod common;
+
+use common::Rng;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use photonmap::scene::{load_scene, load_scene_str, Geometry, Light, Scene};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 /// A scene whose one shape is the mesh `fuzz.obj` beside it.
 const MESH_SCENE: &str = "[camera]\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"fuzz.obj\"\nmaterial = \"m\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";

@@ -280,3 +280,80 @@ fn capabilities_report_what_later_stages_rely_on() {
     );
     assert!(caps.point_size_range[1] >= 16.0, "{caps:?}");
 }
+
+/// A uniform renamed in GLSL only must not fail silently (the estimate would
+/// read 0 and go dark): setting a name the program does not declare makes the
+/// draw fail, naming the program and the uniform.
+#[test]
+fn a_uniform_the_program_does_not_declare_is_an_error() {
+    let gpu = common::gpu();
+    let renamed = |n: &str| {
+        glsl_files().find(|(f, _)| *f == n).map(|(_, s)| {
+            if n == "render/knn_search.frag" {
+                s.replace("u_max_radius", "u_max_radius_renamed")
+            } else {
+                s.to_string()
+            }
+        })
+    };
+    let program = Program::from_lookup(
+        &gpu,
+        &renamed,
+        "common/fullscreen.vert",
+        "render/knn_search.frag",
+        &[],
+    )
+    .unwrap();
+    let tex = Texture::new(&gpu, 4, 4, TexFormat::Rgba32F).unwrap();
+    let target = Target::new(&gpu, &[&tex]).unwrap();
+    let err = program
+        .bind()
+        .int("u_k", 8)
+        .float("u_max_radius", 0.25)
+        .draw_fullscreen(&target, &DrawState::PLAIN)
+        .unwrap_err();
+    match &err {
+        Error::UndeclaredUniform { program, name } => {
+            assert_eq!(
+                (program.as_str(), name.as_str()),
+                ("render/knn_search.frag", "u_max_radius")
+            );
+        }
+        other => panic!("expected UndeclaredUniform, got {other}"),
+    }
+    // The declared name draws.
+    program
+        .bind()
+        .float("u_max_radius_renamed", 0.25)
+        .draw_fullscreen(&target, &DrawState::PLAIN)
+        .unwrap();
+}
+
+/// Layout constants are defined once, in src/layout.rs: every program sees
+/// them as #defines, and no shader spells one itself.
+#[test]
+fn layout_constants_reach_every_program_and_no_shader_redefines_them() {
+    use photonmap::gpu::program::preprocessed_source;
+    let text = preprocessed_source("render/direct.frag", &[]).unwrap();
+    for (name, value) in photonmap::layout::glsl_defines() {
+        assert!(
+            text.contains(&format!("#define {name} {value}\n")),
+            "{name}"
+        );
+    }
+    assert!(text.contains(&format!(
+        "#define LIGHT_TEXELS {}\n",
+        photonmap::layout::LIGHT_TEXELS
+    )));
+    for (file, src) in glsl_files() {
+        for (name, _) in photonmap::layout::glsl_defines() {
+            for form in [
+                format!("const int {name} "),
+                format!("const float {name} "),
+                format!("#define {name} "),
+            ] {
+                assert!(!src.contains(&form), "glsl/{file} defines {name} itself");
+            }
+        }
+    }
+}

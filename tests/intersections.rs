@@ -3,34 +3,13 @@
 
 mod common;
 
+use common::Rng;
+
 use glam::{DVec3, Vec3};
 use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};
 use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn unit(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(
-                self.next() * 2.0 - 1.0,
-                self.next() * 2.0 - 1.0,
-                self.next() * 2.0 - 1.0,
-            );
-            let l = v.length();
-            if l > 1e-3 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-}
 
 fn one_shape_scene(g: Geometry) -> Scene {
     let light_at = match g {
@@ -105,11 +84,11 @@ fn surface_sample(g: &Geometry, rng: &mut Rng, boundary: bool) -> DVec3 {
             let a = axis.as_dvec3();
             let side = a.any_orthonormal_vector();
             let other = a.cross(side);
-            let phi = rng.next() * std::f64::consts::TAU;
+            let phi = rng.f64() * std::f64::consts::TAU;
             let h = if boundary {
-                (rng.next() < 0.5) as i32 as f64 * height as f64
+                (rng.f64() < 0.5) as i32 as f64 * height as f64
             } else {
-                rng.next() * height as f64
+                rng.f64() * height as f64
             };
             base.as_dvec3() + a * h + (side * phi.cos() + other * phi.sin()) * radius as f64
         }
@@ -118,9 +97,9 @@ fn surface_sample(g: &Geometry, rng: &mut Rng, boundary: bool) -> DVec3 {
             edge1,
             edge2,
         } => {
-            let (mut u, mut v) = (rng.next(), rng.next());
+            let (mut u, mut v) = (rng.f64(), rng.f64());
             if boundary {
-                if rng.next() < 0.5 {
+                if rng.f64() < 0.5 {
                     u = (u > 0.5) as i32 as f64
                 } else {
                     v = (v > 0.5) as i32 as f64
@@ -129,12 +108,12 @@ fn surface_sample(g: &Geometry, rng: &mut Rng, boundary: bool) -> DVec3 {
             corner.as_dvec3() + u * edge1.as_dvec3() + v * edge2.as_dvec3()
         }
         Geometry::Triangle { v0, v1, v2 } => {
-            let (mut u, mut v) = (rng.next(), rng.next());
+            let (mut u, mut v) = (rng.f64(), rng.f64());
             if u + v > 1.0 {
                 (u, v) = (1.0 - u, 1.0 - v);
             }
             if boundary {
-                match (rng.next() * 3.0) as i32 {
+                match (rng.f64() * 3.0) as i32 {
                     0 => u = 0.0,
                     1 => v = 0.0,
                     _ => v = 1.0 - u,
@@ -189,7 +168,7 @@ fn glsl_intersections_match_their_rust_twins() {
         let mut rng = Rng(0x1234_5678 ^ name.len() as u64);
         let (mut origins, mut dirs) = (Vec::new(), Vec::new());
         for i in 0..6000 {
-            let o = rng.unit() * (1.5 + 3.0 * rng.next());
+            let o = rng.unit() * (1.5 + 3.0 * rng.f64());
             let d = match i % 3 {
                 0 => (surface_sample(&g, &mut rng, false) - o).normalize(), // aimed at the surface
                 1 => (surface_sample(&g, &mut rng, true) - o).normalize(),  // grazing the boundary

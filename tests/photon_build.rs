@@ -4,21 +4,13 @@
 
 mod common;
 
+use common::Rng;
+
 use photonmap::gpu::{Gpu, TexFormat, Texture};
 use photonmap::photon::bitonic::{pass_count, sort_texture_size, BitonicBuild, INVALID_KEY};
 use photonmap::photon::{Grid, PhotonFrames, StencilRouting, VertexFeed};
 use photonmap::reference::photon::route;
 use photonmap::render::Timings;
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-}
 
 /// Sorts on the GPU in RG32I (what the build uses) or RGBA32I.
 fn sort_on_gpu(
@@ -58,7 +50,7 @@ fn bitonic_sort_equals_a_cpu_sort_for_every_power_of_two_to_2_pow_16() {
             (
                 "random with duplicates",
                 (0..n)
-                    .map(|_| (rng.next() % (n as u64 / 4 + 1)) as i32)
+                    .map(|_| (rng.next_u64() % (n as u64 / 4 + 1)) as i32)
                     .collect(),
             ),
             ("all equal", vec![7; n]),
@@ -71,7 +63,7 @@ fn bitonic_sort_equals_a_cpu_sort_for_every_power_of_two_to_2_pow_16() {
                         if i % 3 == 0 {
                             INVALID_KEY
                         } else {
-                            (rng.next() % 1000) as i32
+                            (rng.next_u64() % 1000) as i32
                         }
                     })
                     .collect(),
@@ -116,7 +108,7 @@ fn binary_search_equals_a_cpu_lower_bound_with_empty_cells() {
                 if i % 5 == 0 {
                     INVALID_KEY
                 } else {
-                    (rng.next() % cells as u64) as i32
+                    (rng.next_u64() % cells as u64) as i32
                 }
             })
             .collect();
@@ -289,7 +281,7 @@ fn stencil_routing_equals_a_cpu_simulation_of_the_draw_order() {
     let mut rng = Rng(7);
     let mut points: Vec<[f32; 3]> = (0..3000)
         .map(|_| {
-            let u = |r: &mut Rng| (r.next() % 100_000) as f32 / 100_000.0;
+            let u = |r: &mut Rng| (r.next_u64() % 100_000) as f32 / 100_000.0;
             [u(&mut rng), u(&mut rng) * 0.5, u(&mut rng)]
         })
         .collect();
@@ -347,9 +339,9 @@ fn routed_power_equals_destined_power_when_photons_are_alike() {
     let points: Vec<[f32; 3]> = (0..5000)
         .map(|_| {
             [
-                (rng.next() % 1000) as f32 / 1000.0,
+                (rng.next_u64() % 1000) as f32 / 1000.0,
                 0.5,
-                (rng.next() % 1000) as f32 / 1000.0,
+                (rng.next_u64() % 1000) as f32 / 1000.0,
             ]
         })
         .collect();
@@ -459,7 +451,12 @@ fn float_addressing_refuses_sorts_past_2_pow_24() {
     let build = BitonicBuild::with_addressing(&gpu, true).unwrap();
     // 2^25 pairs: float indices would no longer be exact.
     let big = Texture::new(&gpu, 8192, 4096, TexFormat::Rg32I).unwrap();
-    let err = build.sort(big).err().expect("must refuse").to_string();
+    let err = build.sort(big).err().expect("must refuse");
+    assert!(
+        matches!(err, photonmap::Error::FloatAddressLimit { texels, .. } if texels == 1 << 25),
+        "{err}"
+    );
+    let err = err.to_string();
     assert!(err.contains("2^24") && err.contains("--faithful"), "{err}");
     // Below the limit it sorts like the integer version.
     let keys: Vec<i32> = (0..4096).map(|i| i * 7919 % 1000).collect();

@@ -467,7 +467,10 @@ radiance = [10.0, 10.0, 10.0]
     let tracer = PhotonTracer::new(&gpu).unwrap();
     let err = match tracer.trace_to_stored(&scene, &textures, 1) {
         Ok(_) => panic!("a mirror no photon can reach was accepted"),
-        Err(e) => e.to_string(),
+        Err(e) => {
+            assert!(matches!(e, photonmap::Error::NoCausticPath), "{e}");
+            e.to_string()
+        }
     };
     assert!(
         err.contains("no light can send a photon towards a mirror or glass shape"),

@@ -267,7 +267,7 @@ impl Program {
     /// optimised it away); an error for a name neither source declares.
     pub(super) fn uniform(&self, name: &str) -> Result<Option<glow::UniformLocation>> {
         if let Some(l) = self.uniforms.borrow().get(name) {
-            return Ok(l.clone());
+            return Ok(*l);
         }
         if !self.declared.contains(name) {
             return Err(Error::UndeclaredUniform {
@@ -279,7 +279,7 @@ impl Program {
         let location = unsafe { self.gpu.gl().get_uniform_location(self.raw, name) };
         self.uniforms
             .borrow_mut()
-            .insert(name.to_string(), location.clone());
+            .insert(name.to_string(), location);
         Ok(location)
     }
 }

@@ -265,7 +265,7 @@ impl RadianceEstimate {
     ) -> Result<u64> {
         let state = match mode {
             EstimateMode::Masked { every } => {
-                if pass % every.max(1) == 0 {
+                if pass.is_multiple_of(every.max(1)) {
                     // Stencil := 1 where the search is done.
                     self.mask
                         .bind()

@@ -14,11 +14,11 @@ pub const PAPER_SCENES: [&str; 3] = ["glass_ball", "ring", "cornell_box"];
 /// Names of the embedded scenes (paths under scenes/ without `.toml`), in
 /// order: `glass_ball`, `variants/furnace_64_bounces`, ...
 pub fn names() -> impl Iterator<Item = &'static str> {
-    SCENE_SOURCES.iter().filter_map(|(path, text)| {
+    SCENE_SOURCES
+        .iter()
         // Camera paths live beside the scenes but are not scenes.
-        (path.ends_with(".toml") && text.contains("[camera]"))
-            .then(|| path.trim_end_matches(".toml"))
-    })
+        .filter(|(path, text)| path.ends_with(".toml") && text.contains("[camera]"))
+        .map(|(path, _)| path.trim_end_matches(".toml"))
 }
 
 /// The TOML text of an embedded scene.
