@@ -3,8 +3,6 @@
 
 use std::path::PathBuf;
 
-pub use crate::scene::SceneError;
-
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// A shader that did not compile or link, located in its glsl/ file.
@@ -15,6 +13,17 @@ pub struct ShaderError {
     pub line: u32,
     pub message: String,
     pub log: String,
+}
+
+/// A scene that could not be loaded: where, which field, and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}:{line}: {field}: {message}", file.display())]
+pub struct SceneError {
+    pub file: PathBuf,
+    pub line: usize,
+    /// Dotted path of the offending field, e.g. `shape[2].radius`.
+    pub field: String,
+    pub message: String,
 }
 
 #[derive(Debug, thiserror::Error)]

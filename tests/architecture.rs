@@ -95,11 +95,6 @@ fn dependencies_run_one_way() {
     let mut wrong = Vec::new();
     for (m, used) in imports() {
         for u in used {
-            // error names the scene's error type, which it wraps: the one
-            // upward name, and a type only.
-            if m == "error" && u == "scene" {
-                continue;
-            }
             if rank(&u) >= rank(&m) {
                 wrong.push(format!("{m} uses {u}"));
             }

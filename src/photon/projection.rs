@@ -14,10 +14,13 @@ use glam::{Vec3, Vec4};
 use crate::sampling::{basis_around, sample_cosine, sample_sphere};
 use crate::scene::{Geometry, Light, Scene};
 
-pub const DEFAULT_RESOLUTION: u32 = 64;
-pub const MIN_RESOLUTION: u32 = 4;
-/// 128² cells, 4 a texel, fit a 4,097-texel row on any GL 4.5 driver.
-pub const MAX_RESOLUTION: u32 = 128;
+/// Cells per side: the scene format's default and limits, defined with the
+/// format's others in `scene::defaults` (128² cells, 4 a texel, fit a
+/// 4,097-texel row on any GL 4.5 driver).
+pub use crate::scene::defaults::{
+    DEFAULT_PROJECTION_RESOLUTION as DEFAULT_RESOLUTION,
+    MAX_PROJECTION_RESOLUTION as MAX_RESOLUTION, MIN_PROJECTION_RESOLUTION as MIN_RESOLUTION,
+};
 
 /// Directions sampled per cell side to bound a cell's cone.
 const CELL_SAMPLES: usize = 9;

@@ -2,13 +2,14 @@
 //! paper's per-scene parameters, loaded from TOML (+ OBJ) and validated.
 
 pub mod camera_path;
+pub mod defaults;
 pub mod embedded;
 pub mod load;
 pub mod pack;
 
 use glam::Vec3;
 
-pub use load::{load_scene, load_scene_str, SceneError};
+pub use load::{load_scene, load_scene_str, load_scene_str_with_overrides, SceneError};
 
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -194,103 +195,36 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// A scene of these shapes and lights with neutral camera and parameters
-    /// (for measuring geometry, and for tests).
+    /// A scene of these shapes and lights with a neutral camera and the scene
+    /// file's default parameters (`defaults`), for measuring geometry, and
+    /// for tests.
     pub fn with_shapes(shapes: Vec<Shape>, materials: Vec<Material>, lights: Vec<Light>) -> Self {
         Scene {
             name: String::new(),
             camera: Camera {
                 position: Vec3::Z,
                 look_at: Vec3::ZERO,
-                up: Vec3::Y,
+                up: defaults::DEFAULT_UP,
                 vfov_degrees: 40.0,
                 width: 1,
                 height: 1,
             },
+            render: RenderParams::default(),
+            photon_map: PhotonMapParams::defaults_for(&shapes),
             materials,
             shapes,
             lights,
-            render: RenderParams {
-                shadow_rays: 1,
-                max_specular_depth: 1,
-            },
-            photon_map: PhotonMapParams {
-                photons_stored: 1,
-                grid_resolution: [1; 3],
-                grid_bounds: None,
-                k: 1,
-                max_radius: 1.0,
-                max_bounces: 1,
-                store_direct: false,
-                caustics_only: false,
-                projection_resolution: crate::photon::projection::DEFAULT_RESOLUTION,
-            },
         }
     }
 
-    /// Axis-aligned bounds of every shape (area lights included).
+    /// Axis-aligned bounds of every shape (area lights included) and point light.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        let mut add = |p: Vec3| {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        };
-        for s in &self.shapes {
-            match s.geometry {
-                Geometry::Sphere { center, radius } => {
-                    add(center - Vec3::splat(radius));
-                    add(center + Vec3::splat(radius));
-                }
-                Geometry::Cylinder {
-                    base,
-                    axis,
-                    radius,
-                    height,
-                } => {
-                    for end in [base, base + axis * height] {
-                        add(end - Vec3::splat(radius));
-                        add(end + Vec3::splat(radius));
-                    }
-                }
-                Geometry::Parallelogram {
-                    corner,
-                    edge1,
-                    edge2,
-                } => {
-                    for p in [
-                        corner,
-                        corner + edge1,
-                        corner + edge2,
-                        corner + edge1 + edge2,
-                    ] {
-                        add(p);
-                    }
-                }
-                Geometry::Triangle { v0, v1, v2 } => {
-                    add(v0);
-                    add(v1);
-                    add(v2);
-                }
-            }
-        }
-        for l in &self.lights {
-            if let Light::Point { position, .. } = l {
-                add(*position);
-            }
-        }
-        (lo, hi)
+        bounds_of(&self.shapes, &self.lights)
     }
 
     /// The longest side of the scene's bounds: its size, wherever it stands.
     pub fn size(&self) -> f32 {
-        let (lo, hi) = self.bounds();
-        let s = (hi - lo).max_element();
-        if s.is_finite() && s > 0.0 {
-            s
-        } else {
-            1.0
-        }
+        bounds_size(&self.shapes, &self.lights)
     }
 
     /// The largest coordinate magnitude over the scene's size: past ~1e3, f32
@@ -310,5 +244,71 @@ impl Scene {
         self.shapes
             .iter()
             .any(|s| self.materials[s.material].is_specular())
+    }
+}
+
+/// Axis-aligned bounds of these shapes (area lights included) and point lights.
+fn bounds_of(shapes: &[Shape], lights: &[Light]) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    let mut add = |p: Vec3| {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    };
+    for s in shapes {
+        match s.geometry {
+            Geometry::Sphere { center, radius } => {
+                add(center - Vec3::splat(radius));
+                add(center + Vec3::splat(radius));
+            }
+            Geometry::Cylinder {
+                base,
+                axis,
+                radius,
+                height,
+            } => {
+                for end in [base, base + axis * height] {
+                    add(end - Vec3::splat(radius));
+                    add(end + Vec3::splat(radius));
+                }
+            }
+            Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            } => {
+                for p in [
+                    corner,
+                    corner + edge1,
+                    corner + edge2,
+                    corner + edge1 + edge2,
+                ] {
+                    add(p);
+                }
+            }
+            Geometry::Triangle { v0, v1, v2 } => {
+                add(v0);
+                add(v1);
+                add(v2);
+            }
+        }
+    }
+    for l in lights {
+        if let Light::Point { position, .. } = l {
+            add(*position);
+        }
+    }
+    (lo, hi)
+}
+
+/// The longest side of the bounds of these shapes and point lights (1 when
+/// they have none): the scene's size, wherever it stands.
+fn bounds_size(shapes: &[Shape], lights: &[Light]) -> f32 {
+    let (lo, hi) = bounds_of(shapes, lights);
+    let s = (hi - lo).max_element();
+    if s.is_finite() && s > 0.0 {
+        s
+    } else {
+        1.0
     }
 }
