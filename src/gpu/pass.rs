@@ -110,11 +110,7 @@ impl Bindings<'_> {
 
     /// One full-screen triangle (3 vertices from gl_VertexID, no buffers).
     pub fn draw_fullscreen(&mut self, target: &Target, state: &DrawState) -> Result<()> {
-        self.draw_region(
-            target,
-            state,
-            [0, 0, target.width as i32, target.height as i32],
-        )
+        self.draw_region(target, state, whole(target))
     }
 
     /// A full-screen triangle clipped to the viewport (x, y, w, h) of
@@ -143,11 +139,7 @@ impl Bindings<'_> {
         first: i32,
         count: i32,
     ) -> Result<()> {
-        self.prepare(
-            target,
-            state,
-            [0, 0, target.width as i32, target.height as i32],
-        )?;
+        self.prepare(target, state, whole(target))?;
         self.program.gpu().bind_empty_vertex_array();
         // SAFETY: as for draw_region.
         unsafe { self.gl.draw_arrays(glow::POINTS, first, count) };
@@ -161,11 +153,7 @@ impl Bindings<'_> {
         state: &DrawState,
         vertices: &VertexBuffer,
     ) -> Result<()> {
-        self.prepare(
-            target,
-            state,
-            [0, 0, target.width as i32, target.height as i32],
-        )?;
+        self.prepare(target, state, whole(target))?;
         // SAFETY: gpu module doc; the vertex array is the buffer's own and
         // describes `count` vertices.
         unsafe {
@@ -174,4 +162,9 @@ impl Bindings<'_> {
         }
         Ok(())
     }
+}
+
+/// The viewport over all of `target`.
+fn whole(target: &Target) -> [i32; 4] {
+    [0, 0, target.width as i32, target.height as i32]
 }

@@ -175,13 +175,8 @@ impl BitonicBuild {
             let target = Target::for_level(&self.gpu, &pyramid, 0)?;
             let mut b = self.pyramid_base.bind();
             grid.bind(&mut b);
-            b.texture("u_position", &frames.position)
-                .texture("u_power", &frames.power)
-                .int("u_level_width", w as i32)
-                .int("u_record_width", frames.width as i32)
-                .int("u_record_count", frames.record_count() as i32)
-                .int("u_frame_height", frames.frame_height as i32)
-                .int("u_photons_used", frames.photons_used as i32)
+            frames.bind_records(&mut b);
+            b.int("u_level_width", w as i32)
                 .draw_fullscreen(&target, &DrawState::PLAIN)?;
         }
         for level in 1..levels {
@@ -236,13 +231,8 @@ impl BitonicBuild {
             query.begin();
             let mut b = self.keys.bind();
             grid.bind(&mut b);
-            b.texture("u_position", &frames.position)
-                .texture("u_power", &frames.power)
-                .int("u_sort_width", w as i32)
-                .int("u_record_width", frames.width as i32)
-                .int("u_record_count", frames.record_count() as i32)
-                .int("u_frame_height", frames.frame_height as i32)
-                .int("u_photons_used", frames.photons_used as i32)
+            frames.bind_records(&mut b);
+            b.int("u_sort_width", w as i32)
                 .draw_fullscreen(&target, &DrawState::PLAIN)?;
             query.end();
             timings.add("keys", query.seconds(), 1);

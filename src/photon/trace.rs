@@ -63,6 +63,17 @@ impl PhotonFrames {
         })
     }
 
+    /// The records as a build pass reads them: position and power textures,
+    /// their layout, and how many photons count.
+    pub fn bind_records(&self, b: &mut crate::gpu::Bindings<'_>) {
+        b.texture("u_position", &self.position)
+            .texture("u_power", &self.power)
+            .int("u_record_width", self.width as i32)
+            .int("u_record_count", self.record_count() as i32)
+            .int("u_frame_height", self.frame_height as i32)
+            .int("u_photons_used", self.photons_used as i32);
+    }
+
     /// Texels in all frames: the records a photon-map build reads.
     pub fn record_count(&self) -> u32 {
         self.width * self.frame_height * self.frames
