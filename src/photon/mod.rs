@@ -19,7 +19,7 @@ pub use bitonic::{BitonicBuild, SortedPhotonMap};
 pub use build::{build_map, BuiltMap, PhotonConfig};
 pub use projection::ProjectionMaps;
 pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
-pub use trace::{PhotonFrames, PhotonTracer, RandomSource, TraceConfig, TraceReport};
+pub use trace::{PhotonBatch, PhotonFrames, PhotonTracer, RandomSource, TraceConfig, TraceReport};
 
 /// The uniform grid photons are sorted or routed into.
 #[derive(Clone, Copy, Debug, PartialEq)]

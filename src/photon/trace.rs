@@ -207,12 +207,14 @@ struct Aim {
     texture: Texture,
 }
 
-/// Per-frame state of one trace: the frames' textures, the random numbers,
-/// and the queries that time passes and probe for live photons.
-struct Trace<'a> {
-    frames: PhotonFrames,
-    random: Option<Texture>,
-    aim: Option<&'a Aim>,
+/// A batch of photons traced into frames that are made once and traced into
+/// again with a new seed (SPPM's iterations): the frames' textures, the random
+/// numbers, the projection maps, and the queries that time passes and probe
+/// for live photons.
+pub struct PhotonBatch {
+    pub frames: PhotonFrames,
+    random: Option<(u32, Texture)>,
+    aim: Option<std::rc::Rc<Aim>>,
     timer: Query,
     alive: Query,
     probe: Option<(Texture, Target)>,
@@ -285,56 +287,72 @@ impl PhotonTracer {
         seed: u32,
         emitted: u32,
     ) -> Result<PhotonFrames> {
-        let aim = self.aim_for(scene)?;
-        self.trace_aimed(scene, textures, aim.as_ref(), seed, emitted)
+        let mut batch = self.batch(scene, emitted)?;
+        self.trace_batch(scene, textures, &mut batch, seed)?;
+        Ok(batch.frames)
     }
 
-    /// `trace` with the projection maps already made (once per scene, not per attempt).
-    fn trace_aimed(
+    /// Frames for `emitted` photons (and the scene's projection maps), to be
+    /// traced into by `trace_batch` as often as wanted.
+    pub fn batch(&self, scene: &Scene, emitted: u32) -> Result<PhotonBatch> {
+        let aim = self.aim_for(scene)?.map(std::rc::Rc::new);
+        self.batch_aimed(scene, aim, emitted)
+    }
+
+    fn batch_aimed(
         &self,
         scene: &Scene,
-        textures: &SceneTextures,
-        aim: Option<&Aim>,
-        seed: u32,
+        aim: Option<std::rc::Rc<Aim>>,
         emitted: u32,
-    ) -> Result<PhotonFrames> {
+    ) -> Result<PhotonBatch> {
         let frames = scene.photon_map.max_bounces + 1;
         let (width, frame_height) = frame_layout(emitted, frames, self.gpu.max_texture_size())?;
         let height = frame_height * frames;
         let t = || Texture::new(&self.gpu, width, height, TexFormat::Rgba32F);
         // No clear: emission and every bounce write each texel of their frame.
-        let mut pass = Trace {
-            frames: PhotonFrames::assemble(
-                &self.gpu,
-                [t()?, t()?, t()?, t()?],
-                frame_height,
-                frames,
-            )?,
-            random: match self.config.random {
-                RandomSource::Hash => None,
-                RandomSource::Texture => {
-                    Some(self.random_texture(seed, width, frame_height, frames)?)
-                }
-            },
+        let mut frames = PhotonFrames::assemble(&self.gpu, [t()?, t()?, t()?, t()?], frame_height, frames)?;
+        frames.emitted = emitted;
+        frames.photons_used = emitted;
+        frames.projection = aim.as_ref().map(|a| a.maps.clone());
+        Ok(PhotonBatch {
+            frames,
+            random: None,
             aim,
             timer: Query::timer(&self.gpu)?,
             alive: Query::occlusion(&self.gpu)?,
             probe: None,
-        };
-        pass.frames.emitted = emitted;
-        pass.frames.photons_used = emitted;
+        })
+    }
+
+    /// Traces the batch's photons anew with `seed`: emission, then one pass per
+    /// bounce (stopping early when no photon is alive, if configured).
+    pub fn trace_batch(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        batch: &mut PhotonBatch,
+        seed: u32,
+    ) -> Result<()> {
+        let frames = scene.photon_map.max_bounces + 1;
+        if self.config.random == RandomSource::Texture
+            && batch.random.as_ref().map(|r| r.0) != Some(seed)
+        {
+            let f = &batch.frames;
+            let texture = self.random_texture(seed, f.width, f.frame_height, frames)?;
+            batch.random = Some((seed, texture));
+        }
         // Each pass timed alone: a timer query spanning the probes' occlusion
         // read-backs reads nonsense on llvmpipe.
         let mut gpu_seconds = 0.0;
         self.gpu.finish();
         let wall = std::time::Instant::now();
-        gpu_seconds += self.emit_pass(scene, textures, &pass, seed)?;
+        gpu_seconds += self.emit_pass(scene, textures, batch, seed)?;
         let mut frames_used = frames;
         for bounce in 1..frames {
-            gpu_seconds += self.bounce_pass(scene, textures, &pass, seed, bounce)?;
+            gpu_seconds += self.bounce_pass(scene, textures, batch, seed, bounce)?;
             if self.config.stop_when_dead
                 && bounce + 1 < frames
-                && self.live_photons(&mut pass, bounce)? == 0
+                && self.live_photons(batch, bounce)? == 0
             {
                 // No photon of this frame goes on: the rest is dark.
                 frames_used = bounce + 1;
@@ -347,11 +365,9 @@ impl PhotonTracer {
         // longer than the wall clock cannot be, so keep the wall clock then.
         let wall = wall.elapsed().as_secs_f64();
         self.gpu.check("photon tracing")?;
-        let mut frames = pass.frames;
-        frames.frames = frames_used;
-        frames.gpu_seconds = gpu_seconds.min(wall);
-        frames.projection = aim.map(|a| a.maps.clone());
-        Ok(frames)
+        batch.frames.frames = frames_used;
+        batch.frames.gpu_seconds = gpu_seconds.min(wall);
+        Ok(())
     }
 
     /// Emission into frame 0; returns its GPU seconds.
@@ -359,7 +375,7 @@ impl PhotonTracer {
         &self,
         scene: &Scene,
         textures: &SceneTextures,
-        pass: &Trace<'_>,
+        pass: &PhotonBatch,
         seed: u32,
     ) -> Result<f64> {
         let f = &pass.frames;
@@ -369,10 +385,10 @@ impl PhotonTracer {
         };
         let mut b = emit.bind();
         textures.bind(&mut b);
-        if let Some(r) = &pass.random {
+        if let Some((_, r)) = &pass.random {
             b.texture("u_random_numbers", r);
         }
-        if let Some(aim) = pass.aim {
+        if let Some(aim) = &pass.aim {
             b.texture("u_projection", &aim.texture).int(
                 "u_projection_resolution",
                 scene.photon_map.projection_resolution as i32,
@@ -397,7 +413,7 @@ impl PhotonTracer {
         &self,
         scene: &Scene,
         textures: &SceneTextures,
-        pass: &Trace<'_>,
+        pass: &PhotonBatch,
         seed: u32,
         bounce: u32,
     ) -> Result<f64> {
@@ -406,7 +422,7 @@ impl PhotonTracer {
         self.gpu.texture_barrier();
         let mut b = self.bounce.bind();
         textures.bind(&mut b);
-        if let Some(r) = &pass.random {
+        if let Some((_, r)) = &pass.random {
             b.texture("u_random_numbers", r);
         }
         let fh = f.frame_height as i32;
@@ -431,7 +447,7 @@ impl PhotonTracer {
     }
 
     /// How many photons of frame `bounce` go on (an occlusion query).
-    fn live_photons(&self, pass: &mut Trace<'_>, bounce: u32) -> Result<u64> {
+    fn live_photons(&self, pass: &mut PhotonBatch, bounce: u32) -> Result<u64> {
         self.gpu.texture_barrier();
         let (width, frame_height) = (pass.frames.width, pass.frames.frame_height);
         if pass.probe.is_none() {
@@ -520,7 +536,7 @@ impl PhotonTracer {
             // Whole rows per frame of the widest frame.
             ((max / frames as u64) * max).min(u32::MAX as u64 / 2) as u32
         };
-        let aim = self.aim_for(scene)?;
+        let aim = self.aim_for(scene)?.map(std::rc::Rc::new);
         // store_direct would store more, but caustics-only scenes cannot have it.
         let remedy = if scene.photon_map.caustics_only {
             ", or store all paths (caustics_only = false)"
@@ -531,7 +547,9 @@ impl PhotonTracer {
         let mut attempts = Vec::new();
         let mut all_seconds = 0.0;
         loop {
-            let mut frames = self.trace_aimed(scene, textures, aim.as_ref(), seed, emitted)?;
+            let mut batch = self.batch_aimed(scene, aim.clone(), emitted)?;
+            self.trace_batch(scene, textures, &mut batch, seed)?;
+            let mut frames = batch.frames;
             attempts.push(emitted);
             all_seconds += frames.gpu_seconds;
             let counts = self.stored_per_photon(&frames)?;
