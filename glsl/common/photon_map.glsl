@@ -5,7 +5,7 @@
 #include "common/addressing.glsl"
 
 uniform sampler2D u_map_position;  // xyz, w = 1 valid
-uniform sampler2D u_map_power;     // rgb
+uniform sampler2D u_map_power;     // rgb (stencil routing: redistributed)
 #ifdef ROUTED
 uniform sampler2D u_map_counts;    // photons destined to each cell (x)
 uniform int u_count_width;
@@ -26,6 +26,18 @@ int cell_photon_count(int cell, out int base) {
 #else
     base = texelFetch(u_grid_first, texel_of_index(cell, u_grid_width), 0).x;
     return texelFetch(u_grid_first, texel_of_index(cell + 1, u_grid_width), 0).x - base;
+#endif
+}
+
+// How many photons each stored photon of `cell` stands for: 1 in the sorted
+// map; destined / kept in stencil routing, whose redistributed power already
+// carries it (progressive gathers count photons with it too).
+float cell_photon_weight(int cell) {
+#ifdef ROUTED
+    float destined = texelFetch(u_map_counts, texel_of_index(cell, u_count_width), 0).x;
+    return destined / max(1.0, min(destined, float(u_block * u_block)));
+#else
+    return 1.0;
 #endif
 }
 

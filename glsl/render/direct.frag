@@ -18,6 +18,7 @@ uniform int u_shadow_rays;   // N per area light
 uniform int u_strata_x;      // N = strata_x * strata_y
 uniform int u_sample_begin;  // this batch: samples [begin, end)
 uniform int u_sample_end;
+uniform int u_light_sampling; // 0: no shadow rays (direct light comes from photons)
 
 layout(location = 0) out vec4 o_radiance;
 layout(location = 1) out vec4 o_diffuse_position;   // xyz, w = 1 where recorded
@@ -56,7 +57,7 @@ void main() {
     vec3 sum = vec3(0.0);
     int strata_y = u_shadow_rays / u_strata_x;
 
-    for (int l = 0; l < u_light_count; ++l) {
+    for (int l = 0; l < (u_light_sampling != 0 ? u_light_count : 0); ++l) {
         vec4 head = light_texel(l, 0);
         vec3 a = light_texel(l, 1).xyz;
         vec3 emitted = light_texel(l, 4).rgb;

@@ -4,6 +4,7 @@
 use clap::Args;
 
 use photonmap::photon::{BuildMethod, PhotonConfig, VertexFeed};
+use photonmap::render::sppm::{DirectLighting, SppmOptions};
 use photonmap::render::{EstimateMode, EstimateOptions};
 
 /// A parser for a whole number in lo..=hi whose error names the range.
@@ -86,6 +87,75 @@ impl From<&EstimateArgs> for EstimateOptions {
             },
             budget: a.budget,
             ..EstimateOptions::default()
+        }
+    }
+}
+
+/// Which global-illumination method renders.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// The paper's: one photon map, the kNN-grid radiance estimate.
+    Paper,
+    /// Stochastic progressive photon mapping: converges to the exact image.
+    Sppm,
+}
+
+/// A positive finite number.
+fn positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("{s}: give a positive number")),
+    }
+}
+
+/// A number strictly between 0 and 1.
+fn fraction(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!("{s}: the allowed range is (0, 1)")),
+    }
+}
+
+/// Stochastic progressive photon mapping (`--method sppm`).
+#[derive(Args, Clone, Debug)]
+pub struct SppmArgs {
+    /// SPPM: iterations (1..=1000000).
+    #[arg(long, default_value_t = 64, value_parser = in_range(1, 1_000_000))]
+    pub iterations: u32,
+    /// SPPM: stop after this many seconds instead (whichever comes first).
+    #[arg(long, value_name = "SECONDS", value_parser = positive)]
+    pub time: Option<f64>,
+    /// SPPM: the fraction of new photons kept, in (0, 1).
+    #[arg(long, default_value_t = 0.7, value_parser = fraction)]
+    pub alpha: f32,
+    /// SPPM: photons emitted per iteration (64..=4194304).
+    #[arg(long, default_value_t = 16384, value_parser = in_range(64, 1 << 22))]
+    pub photons_per_iteration: u32,
+    /// SPPM: every pixel's first radius (default: the scene's max_radius).
+    #[arg(long, value_parser = positive)]
+    pub radius: Option<f64>,
+    /// SPPM: photon bounces (1..=64); Russian roulette ends most far sooner.
+    #[arg(long, default_value_t = 32, value_parser = in_range(1, 64))]
+    pub photon_bounces: u32,
+    /// SPPM: direct light by shadow rays at each visible point, or by photons.
+    #[arg(long, value_enum, default_value_t = DirectLighting::ShadowRays)]
+    pub sppm_direct: DirectLighting,
+    /// SPPM: shadow rays per area light per iteration (1..=1024).
+    #[arg(long, default_value_t = 1, value_parser = in_range(1, 1024))]
+    pub sppm_shadow_rays: u32,
+}
+
+impl From<&SppmArgs> for SppmOptions {
+    fn from(a: &SppmArgs) -> Self {
+        SppmOptions {
+            iterations: a.iterations,
+            seconds: a.time,
+            alpha: a.alpha,
+            photons_per_iteration: a.photons_per_iteration,
+            initial_radius: a.radius.map(|r| r as f32),
+            max_bounces: a.photon_bounces,
+            direct: a.sppm_direct,
+            shadow_rays: a.sppm_shadow_rays,
         }
     }
 }

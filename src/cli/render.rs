@@ -12,7 +12,7 @@ use photonmap::render::{
 };
 use photonmap::scene::{embedded, Scene};
 
-use super::args::{in_range, EstimateArgs, PhotonMapArgs};
+use super::args::{in_range, EstimateArgs, Method, PhotonMapArgs, SppmArgs};
 
 /// Render a scene to a PNG (sRGB) and optionally an EXR (linear float RGB).
 #[derive(Args)]
@@ -51,6 +51,12 @@ pub struct RenderArgs {
     /// Direct light and specular paths only: no photons, no radiance estimate.
     #[arg(long)]
     pub direct_only: bool,
+    /// Global illumination: the paper's one-shot photon map, or stochastic
+    /// progressive photon mapping (which converges to the exact image).
+    #[arg(long, value_enum, default_value_t = Method::Paper)]
+    pub method: Method,
+    #[command(flatten)]
+    pub sppm: SppmArgs,
     #[command(flatten)]
     pub photons: PhotonMapArgs,
     #[command(flatten)]
@@ -156,6 +162,9 @@ impl RenderArgs {
 }
 
 pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
+    if args.method == Method::Sppm {
+        return run_sppm(args, platform);
+    }
     let outputs = args.outputs()?;
     let scene = embedded::load_path_or_name(&args.scene)?;
     warn_far_from_origin(&scene, args.quiet);
@@ -186,6 +195,52 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     }
     if !args.quiet {
         print_summary(&out, &options, &written);
+    }
+    Ok(())
+}
+
+/// `--method sppm`: one view, iterations until --iterations or --time.
+fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
+    if args.camera_path.is_some() || args.direct_only || args.reference_software.is_some() || args.spp > 1 {
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software and --spp");
+    }
+    let outputs = args.outputs()?;
+    let scene = embedded::load_path_or_name(&args.scene)?;
+    warn_far_from_origin(&scene, args.quiet);
+    let options = args.options(&scene);
+    let gpu = super::gpu(platform)?;
+    let mut observer = CliObserver::new(args, &scene, &options, &outputs);
+    let out = render::sppm::render_sppm(&gpu, &scene, &options, &(&args.sppm).into(), &mut observer)?;
+    observer.finish()?;
+    if out.image.has_non_finite() {
+        bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
+    }
+    let written = write_image(&out.image, &outputs)?;
+    if args.json {
+        super::print_json(&serde_json::json!({
+            "method": "sppm",
+            "iterations": out.iterations,
+            "photons_emitted": out.photons_emitted,
+            "initial_radius": out.initial_radius,
+            "final_largest_radius": out.final_largest_radius,
+            "timings": out.timings,
+        }))?;
+    }
+    if args.explain {
+        for l in &out.explain {
+            let what = if l.ran { "run " } else { "skip" };
+            eprintln!("{what} {:<34} {:>6} passes  {}", l.stage, l.passes, l.why);
+        }
+    }
+    if !args.quiet {
+        eprint!("{}", out.timings.table());
+        eprintln!(
+            "SPPM: {} iterations, {} photons emitted, radius {} -> {:.5} (largest)",
+            out.iterations, out.photons_emitted, out.initial_radius, out.final_largest_radius
+        );
+        for p in &written {
+            eprintln!("wrote {}", p.display());
+        }
     }
     Ok(())
 }

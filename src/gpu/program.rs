@@ -39,36 +39,68 @@ fn with_layout<'a>(defines: &[(&'a str, String)]) -> Vec<(&'a str, String)> {
 }
 
 /// Uniform names a preprocessed source declares (`uniform <type> <name>[...];`,
-/// several names per line allowed). Both branches of an #ifdef count: a name in
-/// neither is a misspelling.
+/// several names per line allowed), in the branches of `#ifdef` / `#ifndef` /
+/// `#else` that its `#define`s make active: a name set in no active branch is
+/// a misspelling, or a binding meant for another variant of the program.
 fn declared_uniforms(text: &str) -> HashSet<String> {
     let mut names = HashSet::new();
+    let mut defined = HashSet::new();
+    // One entry per open conditional: whether its current branch is active.
+    let mut active: Vec<bool> = Vec::new();
     for line in text.lines() {
         let line = line.trim_start();
-        let Some(rest) = line
-            .strip_prefix("uniform ")
-            .or_else(|| line.split_once(") uniform ").map(|(_, r)| r))
-        else {
-            continue;
+        let word = |prefix: &str| {
+            line.strip_prefix(prefix)
+                .map(|r| r.split_whitespace().next().unwrap_or("").to_string())
         };
-        let decl = rest.split(';').next().unwrap_or("");
-        // Skip the type (and any precision qualifier): names follow the last type word.
-        let mut words = decl.splitn(2, char::is_whitespace);
-        let mut ty = words.next().unwrap_or("");
-        let mut list = words.next().unwrap_or("").trim_start();
-        while matches!(ty, "highp" | "mediump" | "lowp") {
-            let mut w = list.splitn(2, char::is_whitespace);
-            ty = w.next().unwrap_or("");
-            list = w.next().unwrap_or("").trim_start();
-        }
-        for name in list.split(',') {
-            let name = name.split(['[', '=']).next().unwrap_or("").trim();
-            if !name.is_empty() {
-                names.insert(name.to_string());
+        let live = active.iter().all(|&a| a);
+        if let Some(name) = word("#define ") {
+            if live {
+                defined.insert(name);
             }
+        } else if let Some(name) = word("#ifdef ") {
+            active.push(defined.contains(&name));
+        } else if let Some(name) = word("#ifndef ") {
+            active.push(!defined.contains(&name));
+        } else if line.starts_with("#if") {
+            active.push(true); // an expression: assume the branch is taken
+        } else if line.starts_with("#else") {
+            if let Some(a) = active.last_mut() {
+                *a = !*a;
+            }
+        } else if line.starts_with("#endif") {
+            active.pop();
+        } else if live {
+            declare(line, &mut names);
         }
     }
     names
+}
+
+/// The names a `uniform` declaration line declares, added to `names`.
+fn declare(line: &str, names: &mut HashSet<String>) {
+    let Some(rest) = line
+        .strip_prefix("uniform ")
+        .or_else(|| line.split_once(") uniform ").map(|(_, r)| r))
+    else {
+        return;
+    };
+    let decl = rest.split(';').next().unwrap_or("");
+    // Skip the type (and any precision qualifier): names follow the last type word.
+    let mut words = decl.splitn(2, char::is_whitespace);
+    let mut ty = words.next().unwrap_or("");
+    let mut list = words.next().unwrap_or("").trim_start();
+    while matches!(ty, "highp" | "mediump" | "lowp") {
+        let mut w = list.splitn(2, char::is_whitespace);
+        ty = w.next().unwrap_or("");
+        list = w.next().unwrap_or("").trim_start();
+    }
+    for name in list.split(',') {
+        let name = name.split(['[', '=']).next().unwrap_or("").trim();
+        if !name.is_empty() {
+            names.insert(name.to_string());
+        }
+    }
 }
 
 /// Source after `#include` resolution. Each file's lines are numbered
@@ -350,6 +382,13 @@ mod tests {
         let mut names: Vec<_> = names.into_iter().collect();
         names.sort();
         assert_eq!(names, ["u_a", "u_b", "u_c", "u_d"]);
+        // Only the branches the defines make active.
+        let names = declared_uniforms(
+            "#version 450 core\n#define A 1\n#ifdef A\nuniform int u_a;\n#else\nuniform int u_not_a;\n#endif\n#ifdef B\nuniform int u_b;\n#endif\n#ifndef B\nuniform int u_not_b;\n#endif\n",
+        );
+        let mut names: Vec<_> = names.into_iter().collect();
+        names.sort();
+        assert_eq!(names, ["u_a", "u_not_b"]);
     }
 
     #[test]

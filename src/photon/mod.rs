@@ -45,6 +45,30 @@ impl Grid {
         }
     }
 
+    /// A grid over the whole scene (its box padded by a thousandth of its
+    /// size, whatever bounds the scene fixes for the paper's estimate) with
+    /// cells of about `cell` on every axis, at most 512 a side and
+    /// `max_cells` in all (cells grow until they fit).
+    pub fn over_scene(scene: &Scene, cell: f32, max_cells: u64) -> Self {
+        let (lo, hi) = scene.bounds();
+        let pad = Vec3::splat(1e-3 * scene.size());
+        let (min, max) = (lo - pad, hi + pad);
+        let extent = max - min;
+        let mut cell = cell.max(extent.max_element() / 512.0);
+        loop {
+            let resolution: [u32; 3] =
+                std::array::from_fn(|a| ((extent[a] / cell).ceil() as u32).clamp(1, 512));
+            if resolution.iter().map(|&r| r as u64).product::<u64>() <= max_cells {
+                return Self {
+                    min,
+                    max,
+                    resolution,
+                };
+            }
+            cell *= 1.25;
+        }
+    }
+
     pub fn cell_count(&self) -> u32 {
         self.resolution.iter().product()
     }

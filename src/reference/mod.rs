@@ -2,6 +2,8 @@
 
 pub mod intersect;
 pub mod knn;
+pub mod path_trace;
 pub mod photon;
 pub mod random;
 pub mod ray_trace;
+pub mod sppm;

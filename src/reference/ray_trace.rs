@@ -61,7 +61,7 @@ pub fn offset_scale(p: Vec3, offset_floor: f32) -> f32 {
     OFFSET_RELATIVE * p.abs().max_element() + offset_floor
 }
 
-fn occluded(scene: &Scene, o: Vec3, d: Vec3, t_max: f32) -> bool {
+pub fn occluded(scene: &Scene, o: Vec3, d: Vec3, t_max: f32) -> bool {
     scene
         .shapes
         .iter()

@@ -49,7 +49,8 @@ impl DirectLight {
         self.target.clear([0.0; 4]);
     }
 
-    /// Adds shadow samples `samples` (of `shadow_rays` per area light) for the hits of `depth`.
+    /// Adds shadow samples `samples` (of `shadow_rays` per area light) for the
+    /// hits of `depth` (with `light_sampling` off, only emitters seen).
     pub fn shade(
         &self,
         scene: &SceneTextures,
@@ -58,6 +59,7 @@ impl DirectLight {
         samples: std::ops::Range<u32>,
         depth: u32,
         seed: u32,
+        light_sampling: bool,
     ) -> Result<()> {
         let (nx, _) = strata(shadow_rays);
         let mut b = self.program.bind();
@@ -69,6 +71,7 @@ impl DirectLight {
             .int("u_strata_x", nx as i32)
             .int("u_sample_begin", samples.start as i32)
             .int("u_sample_end", samples.end as i32)
+            .int("u_light_sampling", light_sampling as i32)
             .draw_fullscreen(&self.target, &DrawState::ADDITIVE)
     }
 

@@ -10,6 +10,7 @@ pub mod plan;
 pub mod radiance_estimate;
 pub mod ray_trace;
 pub mod software;
+pub mod sppm;
 
 use crate::error::Error;
 use crate::gpu::{Gpu, Result};
@@ -289,17 +290,17 @@ pub struct At {
 }
 
 /// One eye sample of one view.
-struct EyeSample<'a> {
-    camera: &'a Camera,
-    sample: u32,
-    seed: u32,
+pub(crate) struct EyeSample<'a> {
+    pub camera: &'a Camera,
+    pub sample: u32,
+    pub seed: u32,
 }
 
 /// The ray tracer's passes for one eye sample: eye rays, then per specular
 /// depth the closest hits, shadow rays and the specular continuation. Each
 /// pass is timed by timer query and by wall clock (glFinish on both sides).
 #[allow(clippy::too_many_arguments)]
-fn trace_eye_paths(
+pub(crate) fn trace_eye_paths(
     gpu: &Gpu,
     plan: &PassPlan,
     textures: &SceneTextures,
@@ -343,6 +344,7 @@ fn trace_eye_paths(
                     samples.clone(),
                     depth,
                     eye.seed,
+                    plan.light_sampling,
                 )
             })?;
         }

@@ -12,6 +12,9 @@ pub struct PassPlan {
     pub height: u32,
     /// Eye samples per pixel (at least 1).
     pub spp: u32,
+    /// Eye rays through a jittered point of their stratum (more than one
+    /// sample per pixel, or a progressive method), else the pixel centre.
+    pub jitter: bool,
     /// The scene has a mirror or glass: eye paths continue past their first hit.
     pub specular: bool,
     /// The scene has an area light: shadow rays are stratified samples in batches.
@@ -24,6 +27,8 @@ pub struct PassPlan {
     pub shadow_batch: u32,
     /// Shadow-ray passes per depth: batches of area-light samples, or one.
     pub direct_passes: u32,
+    /// Shadow rays sample the lights (off when photons carry direct light).
+    pub light_sampling: bool,
 }
 
 impl PassPlan {
@@ -35,6 +40,7 @@ impl PassPlan {
             width: options.width,
             height: options.height,
             spp: options.spp.max(1),
+            jitter: options.spp > 1,
             specular,
             has_area,
             max_specular_depth: scene.render.max_specular_depth,
@@ -51,6 +57,7 @@ impl PassPlan {
             } else {
                 1
             },
+            light_sampling: true,
         }
     }
 

@@ -100,7 +100,7 @@ impl RayTracer {
             .vec3("u_camera_backward", w.to_array())
             .vec2("u_tan_half_fov", [tan_v * aspect, tan_v])
             .vec2("u_image_size", [plan.width as f32, plan.height as f32])
-            .int("u_jitter", (plan.spp > 1) as i32)
+            .int("u_jitter", plan.jitter as i32)
             .int("u_sample", sample as i32)
             .ivec2("u_strata", [strata_x as i32, strata_y as i32])
             .uint("u_seed", seed)

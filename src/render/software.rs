@@ -12,40 +12,31 @@ use super::{Image, RenderState};
 /// A photon map read back from the GPU: per cell, its photons in the GPU's order.
 pub struct CpuPhotonMap {
     pub grid: Grid,
+    /// Per cell: (position, power) of each photon.
     pub cells: Vec<Vec<(Vec3, Vec3)>>,
+    /// Per cell: each photon's direction of arrival, in the same order.
+    pub incoming: Vec<Vec<Vec3>>,
+    /// Per cell: how many photons each stored one stands for (1 in the sorted
+    /// map; destined / kept in stencil routing).
+    pub weights: Vec<f32>,
 }
 
 impl CpuPhotonMap {
     pub fn from_gpu(map: &PhotonMap) -> Self {
-        match map {
+        let (pos, pow, inc, texels, weights) = match map {
             PhotonMap::Sorted(m) => {
-                let pos = m.position.read_f32();
-                let pow = m.power.read_f32();
                 let first: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
-                let cells = (0..m.grid.cell_count() as usize)
-                    .map(|c| {
-                        (first[c]..first[c + 1])
-                            .map(|i| {
-                                let i = i as usize * 4;
-                                (
-                                    Vec3::from_slice(&pos[i..i + 3]),
-                                    Vec3::from_slice(&pow[i..i + 3]),
-                                )
-                            })
-                            .collect()
-                    })
+                let texels: Vec<Vec<usize>> = (0..m.grid.cell_count() as usize)
+                    .map(|c| (first[c]..first[c + 1]).map(|i| i as usize).collect())
                     .collect();
-                Self {
-                    grid: m.grid,
-                    cells,
-                }
+                let weights = vec![1.0; texels.len()];
+                (&m.position, &m.power, &m.incoming, texels, weights)
             }
             PhotonMap::Routed(m) => {
-                let pos = m.position.read_f32();
-                let pow = m.power.read_f32();
                 let counts = m.counts.read_f32();
                 let (b, w) = (m.block as usize, m.position.width as usize);
-                let cells = (0..m.grid.cell_count() as usize)
+                let cells = m.grid.cell_count() as usize;
+                let texels = (0..cells)
                     .map(|c| {
                         let n = (counts[4 * c] as usize).min(b * b);
                         let (bx, by) =
@@ -53,20 +44,33 @@ impl CpuPhotonMap {
                         (0..n)
                             .map(|k| {
                                 let slot = b * b - 1 - k;
-                                let texel = ((by * b + slot / b) * w + bx * b + slot % b) * 4;
-                                (
-                                    Vec3::from_slice(&pos[texel..texel + 3]),
-                                    Vec3::from_slice(&pow[texel..texel + 3]),
-                                )
+                                (by * b + slot / b) * w + bx * b + slot % b
                             })
                             .collect()
                     })
                     .collect();
-                Self {
-                    grid: m.grid,
-                    cells,
-                }
+                let weights = (0..cells)
+                    .map(|c| {
+                        let destined = counts[4 * c];
+                        destined / destined.min((b * b) as f32).max(1.0)
+                    })
+                    .collect();
+                (&m.position, &m.power, &m.incoming, texels, weights)
             }
+        };
+        let (pos, pow, inc) = (pos.read_f32(), pow.read_f32(), inc.read_f32());
+        let v = |d: &[f32], i: usize| Vec3::from_slice(&d[4 * i..4 * i + 3]);
+        Self {
+            grid: *map.grid(),
+            cells: texels
+                .iter()
+                .map(|c| c.iter().map(|&i| (v(&pos, i), v(&pow, i))).collect())
+                .collect(),
+            incoming: texels
+                .iter()
+                .map(|c| c.iter().map(|&i| v(&inc, i)).collect())
+                .collect(),
+            weights,
         }
     }
 

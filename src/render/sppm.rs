@@ -1,0 +1,513 @@
+//! Stochastic progressive photon mapping (Hachisuka and Jensen 2009) on the
+//! paper's passes: each iteration re-jitters every pixel's eye path (the
+//! existing ray tracer, so antialiasing and the random glass choice average
+//! out), traces a fresh photon batch (the existing photon passes), builds a map
+//! (bitonic or stencil, unchanged) and gathers at each pixel's visible point
+//! with the pixel's own radius, updating its radius, photon count and flux in
+//! place (`glsl/render/sppm_update.frag`). It converges to the exact image:
+//! the radius shrinks to zero while the photons gathered grow without bound.
+//!
+//! Direct light comes from shadow rays at the visible point, as in the paper's
+//! split; photons are stored from their second hit on, so nothing is counted
+//! twice: light -> visible point by shadow rays (point lights exactly, with
+//! sharp shadows), light -> (specular or diffuse)+ -> visible point by photons
+//! (caustics through glass, which blocks shadow rays, included), emitters seen
+//! along the eye path by the ray tracer. `DirectLighting::Photons` stores first
+//! hits instead (a test of the photon half alone).
+
+use crate::error::Error;
+use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
+use crate::photon::{
+    BitonicBuild, BuildMethod, Grid, PhotonBatch, PhotonMap, PhotonTracer,
+    StencilRouting, TraceConfig,
+};
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+use crate::timing::Timings;
+
+use super::{
+    trace_eye_paths, At, DirectLight, EstimatePass, EyeSample, ExplainLine, Image, PassPlan,
+    Progress, RayTracer, RenderObserver, RenderOptions,
+};
+
+/// Where direct light comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum DirectLighting {
+    /// Shadow rays at each visible point (the paper's split; exact for point lights).
+    ShadowRays,
+    /// Photons stored at their first hit too, and no shadow rays.
+    Photons,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SppmOptions {
+    /// Iterations to run (the render also stops at `seconds`, if given).
+    pub iterations: u32,
+    pub seconds: Option<f64>,
+    /// The fraction of new photons kept (Hachisuka and Jensen's alpha).
+    pub alpha: f32,
+    /// Photons emitted per iteration (the same every iteration).
+    pub photons_per_iteration: u32,
+    /// First radius of every pixel (default: the scene's max_radius).
+    pub initial_radius: Option<f32>,
+    /// Photon bounces (Russian roulette ends most photons long before).
+    pub max_bounces: u32,
+    pub direct: DirectLighting,
+    /// Shadow rays per area light per iteration.
+    pub shadow_rays: u32,
+}
+
+impl Default for SppmOptions {
+    fn default() -> Self {
+        Self {
+            iterations: 64,
+            seconds: None,
+            alpha: 0.7,
+            photons_per_iteration: 1 << 14,
+            initial_radius: None,
+            max_bounces: 32,
+            direct: DirectLighting::ShadowRays,
+            shadow_rays: 1,
+        }
+    }
+}
+
+/// Cells per grid at most, by build: the sorted map's cell table, and stencil
+/// routing's m x m slots a cell.
+const MAX_CELLS_SORTED: u64 = 1 << 22;
+const MAX_CELLS_ROUTED: u64 = 1 << 18;
+
+/// Iterations after which the largest radius is read back to size the grid:
+/// powers of two, then every 64th (a 4-byte read; radii only shrink, so a
+/// stale maximum is still an upper bound).
+fn reads_radius(iteration: u32) -> bool {
+    iteration.is_power_of_two() || iteration.is_multiple_of(64)
+}
+
+/// Per-pixel SPPM state, updated in place.
+pub struct SppmState {
+    /// tau.rgb (flux already weighted by BRDF and path), w = R^2.
+    pub flux: Texture,
+    /// Sum of direct light .rgb, w = N (photons gathered, alpha-weighted).
+    pub sums: Texture,
+    target: Target,
+}
+
+enum Builder {
+    Bitonic(BitonicBuild),
+    Stencil(StencilRouting, u32),
+}
+
+/// A progressive render in progress: call `iterate` as often as wanted.
+pub struct Sppm {
+    gpu: Gpu,
+    /// The scene as SPPM traces it (bounces, shadow rays, first-hit storage).
+    scene: Scene,
+    options: SppmOptions,
+    seed: u32,
+    plan: PassPlan,
+    textures: SceneTextures,
+    tracer: RayTracer,
+    pub direct: DirectLight,
+    photons: PhotonTracer,
+    batch: PhotonBatch,
+    builder: Builder,
+    pub state: SppmState,
+    update: Program,
+    compose: Program,
+    radius: Program,
+    reduce: Program,
+    image: Texture,
+    image_target: Target,
+    pub iteration: u32,
+    pub initial_radius: f32,
+    /// The grid cell size in use: at least the largest radius of a pixel that
+    /// has gathered photons, and no less than a quarter of the first radius.
+    pub cell: f32,
+    /// The last iteration's photon map and grid (for tests and `--explain`).
+    pub map: Option<PhotonMap>,
+    pub grid: Option<Grid>,
+}
+
+impl Sppm {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        options: &RenderOptions,
+        sppm: &SppmOptions,
+    ) -> Result<Self> {
+        let config = options.global.clone().unwrap_or_default().photons;
+        let scene = sppm_scene(scene, sppm)?;
+        let (w, h) = (options.width, options.height);
+        let mut plan = PassPlan::new(&scene, options);
+        plan.jitter = true;
+        plan.spp = 1;
+        plan.light_sampling = sppm.direct == DirectLighting::ShadowRays;
+        let textures = SceneTextures::new(gpu, &scene)?;
+        let photons = PhotonTracer::with_config(
+            gpu,
+            TraceConfig {
+                // No read-back per bounce: every frame is traced.
+                stop_when_dead: false,
+                ..config.trace()
+            },
+        )?;
+        let batch = photons.batch(&scene, sppm.photons_per_iteration)?;
+        let builder = match config.build {
+            BuildMethod::Bitonic => Builder::Bitonic(BitonicBuild::with_addressing(gpu, config.faithful)?),
+            BuildMethod::Stencil => Builder::Stencil(StencilRouting::new(gpu)?, config.stencil_block),
+        };
+        let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
+        let (flux, sums) = (t()?, t()?);
+        let initial_radius = sppm.initial_radius.unwrap_or(scene.photon_map.max_radius);
+        if !(initial_radius > 0.0 && initial_radius.is_finite()) {
+            return Err(Error::InvalidOption(format!(
+                "--radius {initial_radius}: the first radius must be a positive number"
+            )));
+        }
+        let state_target = Target::new(gpu, &[&flux, &sums])?;
+        flux.upload(&[0.0, 0.0, 0.0, initial_radius * initial_radius].repeat((w * h) as usize))?;
+        sums.upload(&vec![0f32; (w * h * 4) as usize])?;
+        let image = t()?;
+        let image_target = Target::new(gpu, &[&image])?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            options: sppm.clone(),
+            seed: options.seed,
+            plan,
+            tracer: RayTracer::new(gpu, w, h)?,
+            direct: DirectLight::new(gpu, w, h)?,
+            photons,
+            batch,
+            builder,
+            state: SppmState {
+                flux,
+                sums,
+                target: state_target,
+            },
+            update: Program::fullscreen_with(gpu, "render/sppm_update.frag", &match config.build {
+                BuildMethod::Bitonic => vec![],
+                BuildMethod::Stencil => vec![("ROUTED", "1".to_string())],
+            })?,
+            compose: Program::fullscreen(gpu, "render/sppm_compose.frag")?,
+            radius: Program::fullscreen(gpu, "render/sppm_radius.frag")?,
+            reduce: Program::fullscreen(gpu, "common/max_reduce.frag")?,
+            image,
+            image_target,
+            iteration: 0,
+            initial_radius,
+            cell: initial_radius,
+            map: None,
+            grid: None,
+            textures,
+            scene,
+        })
+    }
+
+    /// The scene as SPPM traces it.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// One iteration: eye paths, a photon batch, its map, the gather and update.
+    pub fn iterate(&mut self, timings: &mut Timings, observer: &mut dyn RenderObserver) -> Result<()> {
+        let i = self.iteration + 1;
+        let seed = crate::random::sample_seed(self.seed, i);
+        let at = At { view: 0, views: 1, sample: i - 1, samples: self.options.iterations };
+        let eye = EyeSample { camera: &self.scene.camera, sample: 0, seed };
+        trace_eye_paths(
+            &self.gpu,
+            &self.plan,
+            &self.textures,
+            &self.tracer,
+            &self.direct,
+            &eye,
+            timings,
+            observer,
+            at,
+        )?;
+        let wall = std::time::Instant::now();
+        self.photons.trace_batch(&self.scene, &self.textures, &mut self.batch, seed)?;
+        let frames = &self.batch.frames;
+        timings.add_both("trace photons", frames.gpu_seconds, wall.elapsed().as_secs_f64(), frames.frames as usize);
+        let wall = std::time::Instant::now();
+        let grid = Grid::over_scene(&self.scene, self.cell, self.max_cells());
+        let mut stages = Timings::default();
+        let map = match &self.builder {
+            Builder::Bitonic(b) => PhotonMap::Sorted(b.build(frames, &grid, &mut stages)?),
+            Builder::Stencil(s, m) => PhotonMap::Routed(s.build(
+                frames,
+                &grid,
+                *m,
+                crate::photon::VertexFeed::VertexFetch,
+                &mut stages,
+            )?),
+        };
+        self.gpu.finish();
+        let passes = stages.stages.iter().map(|s| s.passes).sum();
+        timings.add_both("build map", stages.gpu_total(), wall.elapsed().as_secs_f64(), passes);
+        let wall = std::time::Instant::now();
+        self.gather_and_update(&map, &grid)?;
+        self.gpu.finish();
+        timings.add_both("gather + update", 0.0, wall.elapsed().as_secs_f64(), 1);
+        self.iteration = i;
+        if reads_radius(i) {
+            let wall = std::time::Instant::now();
+            let largest = self.largest_radius()?;
+            self.cell = largest.max(0.25 * self.initial_radius).min(self.cell);
+            timings.add_both("largest radius", 0.0, wall.elapsed().as_secs_f64(), 1);
+        }
+        self.map = Some(map);
+        self.grid = Some(grid);
+        self.gpu.check("SPPM iteration")
+    }
+
+    fn max_cells(&self) -> u64 {
+        match self.builder {
+            Builder::Bitonic(_) => MAX_CELLS_SORTED,
+            Builder::Stencil(..) => MAX_CELLS_ROUTED,
+        }
+    }
+
+    /// The gather at each visible point and the in-place update.
+    fn gather_and_update(&self, map: &PhotonMap, grid: &Grid) -> Result<()> {
+        let mut b = self.update.bind();
+        self.textures.bind(&mut b);
+        match map {
+            PhotonMap::Sorted(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_incoming", &m.incoming)
+                    .texture("u_grid_first", &m.grid_first)
+                    .int("u_grid_width", m.grid_width as i32)
+                    .int("u_sorted_width", m.position.width as i32);
+            }
+            PhotonMap::Routed(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_incoming", &m.incoming)
+                    .texture("u_map_counts", &m.counts)
+                    .int("u_count_width", m.count_width as i32)
+                    .int("u_block", m.block as i32)
+                    .int("u_blocks_per_row", m.blocks_per_row as i32);
+            }
+        }
+        grid.bind(&mut b);
+        let d = &self.direct;
+        b.texture("u_state_flux", &self.state.flux)
+            .texture("u_state_direct", &self.state.sums)
+            .texture("u_direct", &d.radiance)
+            .texture("u_diffuse_position", &d.diffuse_position)
+            .texture("u_diffuse_normal", &d.diffuse_normal)
+            .texture("u_diffuse_throughput", &d.diffuse_throughput)
+            .float("u_alpha", self.options.alpha)
+            .float("u_first_radius2", self.cell * self.cell)
+            .int("u_gather", 1)
+            .draw_fullscreen(&self.state.target, &DrawState::PLAIN)?;
+        // The next iteration reads what this one wrote.
+        self.gpu.texture_barrier();
+        Ok(())
+    }
+
+    /// The largest radius among pixels that have gathered photons (a max
+    /// reduction on the GPU, one float read back); 0 if none has.
+    pub fn largest_radius(&self) -> Result<f32> {
+        let (mut w, mut h) = (self.state.flux.width, self.state.flux.height);
+        let mut level = Texture::new(&self.gpu, w, h, TexFormat::R32F)?;
+        self.radius
+            .bind()
+            .texture("u_state_flux", &self.state.flux)
+            .texture("u_state_direct", &self.state.sums)
+            .draw_fullscreen(&Target::new(&self.gpu, &[&level])?, &DrawState::PLAIN)?;
+        while w > 1 || h > 1 {
+            (w, h) = (w.div_ceil(2), h.div_ceil(2));
+            let next = Texture::new(&self.gpu, w, h, TexFormat::R32F)?;
+            self.reduce
+                .bind()
+                .texture("u_below", &level)
+                .draw_fullscreen(&Target::new(&self.gpu, &[&next])?, &DrawState::PLAIN)?;
+            level = next;
+        }
+        Ok(level.read_f32()[0].max(0.0).sqrt())
+    }
+
+    /// The image after the iterations so far (direct and photon halves as chosen).
+    pub fn image_parts(&self, include_direct: bool, include_indirect: bool) -> Result<Image> {
+        self.compose
+            .bind()
+            .texture("u_state_flux", &self.state.flux)
+            .texture("u_state_direct", &self.state.sums)
+            .float("u_iterations", self.iteration.max(1) as f32)
+            .int("u_include_direct", include_direct as i32)
+            .int("u_include_indirect", include_indirect as i32)
+            .draw_fullscreen(&self.image_target, &DrawState::PLAIN)?;
+        Ok(Image::from_gl_rgba(
+            self.image.width,
+            self.image.height,
+            &self.image.read_f32(),
+        ))
+    }
+
+    pub fn image(&self) -> Result<Image> {
+        self.image_parts(true, true)
+    }
+}
+
+/// The scene as SPPM traces it: its photons bounce up to `max_bounces`, direct
+/// light is sampled by `shadow_rays` per iteration, and first hits are stored
+/// only when photons carry direct light.
+fn sppm_scene(scene: &Scene, o: &SppmOptions) -> Result<Scene> {
+    if !(0.0 < o.alpha && o.alpha < 1.0) {
+        return Err(Error::InvalidOption(format!(
+            "--alpha {}: the allowed range is (0, 1)",
+            o.alpha
+        )));
+    }
+    if o.direct == DirectLighting::Photons && scene.photon_map.caustics_only {
+        return Err(Error::InvalidOption(
+            "--sppm-direct photons needs every photon path, but the scene stores caustics only (caustics_only = true)".into(),
+        ));
+    }
+    let mut s = scene.clone();
+    s.photon_map.max_bounces = o.max_bounces.max(1);
+    s.render.shadow_rays = o.shadow_rays.max(1);
+    s.photon_map.store_direct = o.direct == DirectLighting::Photons;
+    Ok(s)
+}
+
+/// What a progressive render did.
+pub struct SppmOutput {
+    pub image: Image,
+    pub timings: Timings,
+    pub iterations: u32,
+    pub photons_emitted: u64,
+    pub initial_radius: f32,
+    /// The largest radius among pixels that gathered photons, at the end.
+    pub final_largest_radius: f32,
+    pub explain: Vec<ExplainLine>,
+}
+
+/// Renders `scene` by SPPM: iterations until `sppm.iterations` or
+/// `sppm.seconds`, whichever comes first. The observer sees each iteration as
+/// an estimate pass (snapshots), and the final image.
+pub fn render_sppm(
+    gpu: &Gpu,
+    scene: &Scene,
+    options: &RenderOptions,
+    sppm: &SppmOptions,
+    observer: &mut dyn RenderObserver,
+) -> Result<SppmOutput> {
+    let mut run = Sppm::new(gpu, scene, options, sppm)?;
+    let mut timings = Timings::default();
+    let wall = std::time::Instant::now();
+    let mut observed = 0.0;
+    while run.iteration < sppm.iterations {
+        if sppm
+            .seconds
+            .is_some_and(|s| run.iteration > 0 && wall.elapsed().as_secs_f64() - observed >= s)
+        {
+            break;
+        }
+        run.iterate(&mut timings, observer)?;
+        let t0 = std::time::Instant::now();
+        observer.progress(&Progress::stage("SPPM iterations", run.iteration as u64, sppm.iterations as u64));
+        observer.estimate_pass(&EstimatePass {
+            at: At { view: 0, views: 1, sample: 0, samples: 1 },
+            pass: run.iteration - 1,
+            searching: 0,
+            query_pixels: 0,
+            seconds: wall.elapsed().as_secs_f64() - observed,
+            finished: false,
+            image: &|| run.image(),
+        })?;
+        observed += t0.elapsed().as_secs_f64();
+    }
+    let image = run.image()?;
+    timings.wall_seconds = wall.elapsed().as_secs_f64();
+    observer.estimate_pass(&EstimatePass {
+        at: At { view: 0, views: 1, sample: 0, samples: 1 },
+        pass: run.iteration,
+        searching: 0,
+        query_pixels: 0,
+        seconds: timings.wall_seconds - observed,
+        finished: true,
+        image: &|| Ok(image.clone()),
+    })?;
+    observer.frame(0, &image)?;
+    let final_largest_radius = run.largest_radius()?;
+    let explain = explain(&run, sppm);
+    Ok(SppmOutput {
+        image,
+        timings,
+        iterations: run.iteration,
+        photons_emitted: run.iteration as u64 * sppm.photons_per_iteration as u64,
+        initial_radius: run.initial_radius,
+        final_largest_radius,
+        explain,
+    })
+}
+
+fn explain(run: &Sppm, o: &SppmOptions) -> Vec<ExplainLine> {
+    let line = |stage: &str, passes: usize, why: String| ExplainLine {
+        stage: stage.into(),
+        passes,
+        ran: true,
+        why,
+    };
+    let i = run.iteration as usize;
+    let s = &run.scene;
+    let mut lines = vec![
+        line(
+            "eye paths",
+            i * run.plan.passes_per_sample() as usize,
+            format!(
+                "one jittered eye path per pixel per iteration, {} specular depths, {}",
+                run.plan.depths,
+                match o.direct {
+                    DirectLighting::ShadowRays => format!(
+                        "{} shadow ray(s) per area light at the visible point",
+                        o.shadow_rays.max(1)
+                    ),
+                    DirectLighting::Photons => "no shadow rays: photons carry direct light".into(),
+                }
+            ),
+        ),
+        line(
+            "trace photons",
+            i * (s.photon_map.max_bounces as usize + 1),
+            format!(
+                "{} photons emitted per iteration, {} bounces, every frame traced (no read-back), stored from their {} hit",
+                o.photons_per_iteration,
+                s.photon_map.max_bounces,
+                if s.photon_map.store_direct { "first" } else { "second" }
+            ),
+        ),
+    ];
+    if s.photon_map.caustics_only {
+        lines.push(line(
+            "caustics only",
+            0,
+            "the scene stores caustic photons only (caustics_only = true): SPPM converges to direct light plus caustics, which is the whole image only where, as in RING, no light reaches a diffuse surface by another diffuse one".into(),
+        ));
+    }
+    if let Some(g) = &run.grid {
+        lines.push(line(
+            "build map",
+            i,
+            format!(
+                "every iteration, over the whole scene: {} x {} x {} cells of about {:.4} (the largest radius that has gathered photons, read back after iterations 1, 2, 4, ... and every 64th)",
+                g.resolution[0], g.resolution[1], g.resolution[2], run.cell
+            ),
+        ));
+    }
+    lines.push(line(
+        "gather + update",
+        i,
+        format!(
+            "each pixel gathers photons arriving on its visible side within its own radius (first {}, alpha {}), in one pass, in place",
+            run.initial_radius, o.alpha
+        ),
+    ));
+    lines
+}
