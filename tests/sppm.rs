@@ -52,8 +52,13 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
             photons_per_iteration: 1 << 15,
             ..SppmOptions::default()
         };
-        let mut run =
-            Sppm::new(&gpu, &scene, &options(&scene, 64, 48, 5, build), &sppm_options).unwrap();
+        let mut run = Sppm::new(
+            &gpu,
+            &scene,
+            &options(&scene, 64, 48, 5, build),
+            &sppm_options,
+        )
+        .unwrap();
         let mut timings = Timings::default();
         run.iterate(&mut timings, &mut ()).unwrap();
         let (flux0, sums0) = (texels(&run.state.flux), texels(&run.state.sums));
@@ -107,8 +112,385 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
             "{name} ({build:?}): {gathering} of {} pixels gathered photons; counts differ at {count_differs}; largest relative difference {worst:.2e}",
             flux0.len()
         );
-        assert!(gathering > flux0.len() / 4, "{name}: too few pixels gathered");
-        assert!(count_differs * 200 <= flux0.len(), "{name}: {count_differs} counts differ");
+        assert!(
+            gathering > flux0.len() / 4,
+            "{name}: too few pixels gathered"
+        );
+        assert!(
+            count_differs * 200 <= flux0.len(),
+            "{name}: {count_differs} counts differ"
+        );
         assert!(worst < 1e-4, "{name}: {worst}");
     }
+}
+
+fn sppm_image(scene: &Scene, w: u32, h: u32, seed: u32, o: &SppmOptions) -> Image {
+    let gpu = common::gpu();
+    render_sppm(
+        &gpu,
+        scene,
+        &options(scene, w, h, seed, BuildMethod::Bitonic),
+        o,
+        &mut (),
+    )
+    .unwrap()
+    .image
+}
+
+fn mean_of(img: &Image) -> f64 {
+    img.mean().iter().sum::<f64>() / 3.0
+}
+
+/// The furnace: a closed diffuse sphere (albedo rho, radius R) with a point
+/// light of intensity I at its centre has L = rho I / (pi R^2 (1 - rho))
+/// everywhere: half by shadow rays, half by photons. By Archimedes' hat-box
+/// theorem the gather disc on the sphere has area exactly pi R^2, so SPPM is
+/// unbiased here at every iteration and all its error is noise.
+#[test]
+fn the_furnace_converges_to_its_analytic_value() {
+    let scene = load_scene_str(
+        photonmap::stress::FURNACE,
+        std::path::Path::new("furnace.toml"),
+    )
+    .unwrap();
+    let o = SppmOptions {
+        iterations: 64,
+        photons_per_iteration: 1 << 14,
+        initial_radius: Some(0.1),
+        ..SppmOptions::default()
+    };
+    let img = sppm_image(&scene, 32, 32, 3, &o);
+    let expected = 0.5 / (std::f64::consts::PI * 0.5);
+    let mean = mean_of(&img);
+    eprintln!(
+        "furnace: SPPM mean {mean:.5} against {expected:.5} ({:+.3}%)",
+        100.0 * (mean / expected - 1.0)
+    );
+    assert!((mean / expected - 1.0).abs() < 0.01, "{mean} vs {expected}");
+}
+
+/// The form factor from a differential area to a parallel rectangle of sides
+/// a x b whose corner lies above it at height h (the classic closed form).
+fn corner_form_factor(a: f64, b: f64, h: f64) -> f64 {
+    let (x, y) = (a / h, b / h);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+}
+
+/// Irradiance at (x, z) on the floor under the light [-s, s]^2 at height h of radiance le.
+fn plane_irradiance(x: f64, z: f64, s: f64, h: f64, le: f64) -> f64 {
+    let mut f = 0.0;
+    for (dx, dz) in [
+        (s - x, s - z),
+        (s + x, s - z),
+        (s - x, s + z),
+        (s + x, s + z),
+    ] {
+        f += corner_form_factor(dx, dz, h);
+    }
+    std::f64::consts::PI * le * f
+}
+
+/// A floor (albedo 0.5) under a parallel square area light 20 x 20 at height
+/// 1: the photon half alone (direct light by photons, no shadow rays) must
+/// give the closed-form irradiance, pixel by pixel averaged over the view.
+#[test]
+fn a_uniformly_lit_plane_gives_its_analytic_irradiance() {
+    let text = r#"
+[camera]
+position = [0.0, 0.95, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+vfov = 120.0
+width = 32
+height = 32
+[photon_map]
+max_radius = 0.2
+[materials]
+floor = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
+[[shape]]
+type = "parallelogram"
+corner = [-10.0, 0.0, -10.0]
+edge1 = [20.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 20.0]
+material = "floor"
+[[light]]
+type = "area"
+corner = [-10.0, 1.0, -10.0]
+edge1 = [20.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 20.0]
+radiance = [1.0, 1.0, 1.0]
+"#;
+    let scene = load_scene_str(text, std::path::Path::new("lit_plane.toml")).unwrap();
+    let o = SppmOptions {
+        iterations: 32,
+        photons_per_iteration: 1 << 15,
+        direct: photonmap::render::sppm::DirectLighting::Photons,
+        ..SppmOptions::default()
+    };
+    // The expected image: L = rho E / pi at each pixel centre's floor point.
+    let mut expected = 0.0;
+    for y in 0..32 {
+        for x in 0..32 {
+            let (origin, d) = photonmap::reference::ray_trace::eye_ray(&scene, 32, 32, x, y);
+            let t = -origin.y / d.y;
+            let p = origin + t * d;
+            expected += 0.5 * plane_irradiance(p.x as f64, p.z as f64, 10.0, 1.0, 1.0)
+                / std::f64::consts::PI;
+        }
+    }
+    expected /= 1024.0;
+    // Four independent renders: their spread measures the noise of their mean.
+    let means: Vec<f64> = (1..=4)
+        .map(|seed| mean_of(&sppm_image(&scene, 32, 32, seed, &o)))
+        .collect();
+    let mean = means.iter().sum::<f64>() / 4.0;
+    let sd = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / 3.0).sqrt();
+    let sigma = sd / 2.0;
+    eprintln!(
+        "lit plane: SPPM (direct by photons) {mean:.5} +- {sigma:.5} against {expected:.5} ({:+.3}%; runs {means:.4?})",
+        100.0 * (mean / expected - 1.0)
+    );
+    assert!(
+        sigma < 0.005 * expected,
+        "the test lost its power: sigma {sigma}"
+    );
+    assert!(
+        (mean - expected).abs() < 4.0 * sigma,
+        "{mean} vs {expected} +- {sigma}"
+    );
+}
+
+/// A closed diffuse box (coloured walls) lit by a point light and a ceiling
+/// area light: SPPM and the independent CPU path tracer (next-event
+/// estimation) must agree block by block within their combined noise.
+const TWO_LIGHT_BOX: &str = r#"
+[camera]
+position = [0.5, 0.5, 1.45]
+look_at = [0.5, 0.45, 0.0]
+vfov = 60.0
+width = 32
+height = 32
+[photon_map]
+max_radius = 0.08
+[materials]
+white = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
+red = { type = "diffuse", albedo = [0.7, 0.2, 0.2] }
+green = { type = "diffuse", albedo = [0.2, 0.6, 0.3] }
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 1.5]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 1.0, 0.0]
+edge1 = [0.0, 0.0, 1.5]
+edge2 = [1.0, 0.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [0.0, 1.0, 0.0]
+edge2 = [1.0, 0.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 1.5]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 1.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [0.0, 0.0, 1.5]
+edge2 = [0.0, 1.0, 0.0]
+material = "red"
+[[shape]]
+type = "parallelogram"
+corner = [1.0, 0.0, 0.0]
+edge1 = [0.0, 1.0, 0.0]
+edge2 = [0.0, 0.0, 1.5]
+material = "green"
+[[light]]
+type = "point"
+position = [0.3, 0.7, 0.5]
+intensity = [0.3, 0.3, 0.3]
+[[light]]
+type = "area"
+corner = [0.6, 0.999, 0.4]
+edge1 = [0.2, 0.0, 0.0]
+edge2 = [0.0, 0.0, 0.2]
+radiance = [6.0, 6.0, 6.0]
+"#;
+
+#[test]
+fn sppm_agrees_with_an_independent_path_tracer() {
+    let scene = load_scene_str(TWO_LIGHT_BOX, std::path::Path::new("two_light_box.toml")).unwrap();
+    let t0 = std::time::Instant::now();
+    let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
+    let pt_seconds = t0.elapsed().as_secs_f64();
+    let o = SppmOptions {
+        iterations: 128,
+        photons_per_iteration: 1 << 12,
+        ..SppmOptions::default()
+    };
+    let t0 = std::time::Instant::now();
+    let runs = [
+        sppm_image(&scene, 32, 32, 1, &o),
+        sppm_image(&scene, 32, 32, 2, &o),
+    ];
+    let sppm_seconds = t0.elapsed().as_secs_f64();
+    // 8 x 8 blocks of 4 x 4 pixels; the outer ring of blocks (walls' edges and
+    // corners, where SPPM's disc bias is largest) left out.
+    let block = |f: &dyn Fn(usize) -> f64, bx: usize, by: usize| {
+        let mut s = 0.0;
+        for y in by * 4..by * 4 + 4 {
+            for x in bx * 4..bx * 4 + 4 {
+                s += f(y * 32 + x);
+            }
+        }
+        s / 16.0
+    };
+    let lum = |p: [f64; 3]| (p[0] + p[1] + p[2]) / 3.0;
+    let (mut worst, mut chi2, mut n) = (0f64, 0f64, 0);
+    for by in 1..7 {
+        for bx in 1..7 {
+            let pt_mean = block(&|i| lum(pt.mean[i]), bx, by);
+            let pt_var = block(&|i| lum(pt.variance_of_mean[i]), bx, by) / 16.0;
+            let a = block(
+                &|i| runs[0].pixels[i].iter().map(|&v| v as f64).sum::<f64>() / 3.0,
+                bx,
+                by,
+            );
+            let b = block(
+                &|i| runs[1].pixels[i].iter().map(|&v| v as f64).sum::<f64>() / 3.0,
+                bx,
+                by,
+            );
+            // Two independent runs: their mean's variance is (a - b)^2 / 4 in expectation.
+            let sppm_var = (a - b).powi(2) / 4.0;
+            let z = (0.5 * (a + b) - pt_mean) / (pt_var + sppm_var).sqrt().max(1e-9);
+            worst = worst.max((0.5 * (a + b) / pt_mean - 1.0).abs());
+            chi2 += z * z;
+            n += 1;
+        }
+    }
+    eprintln!(
+        "two-light box: {n} blocks, chi^2/n = {:.2}, largest relative difference {:.2}% (path tracer 1024 spp in {pt_seconds:.1} s, SPPM 2 x 128 iterations in {sppm_seconds:.1} s)",
+        chi2 / n as f64,
+        100.0 * worst
+    );
+    assert!(chi2 / (n as f64) < 3.0, "chi^2/n = {}", chi2 / n as f64);
+}
+
+/// Energy: inside a closed diffuse sphere (radius 1, albedo rho) with a point
+/// light of intensity I off its centre, the radiance integrated over the
+/// sphere is rho 4 pi I / (pi (1 - rho)) = 4 for rho = 1/2, I = 1, wherever
+/// the light is. Six 90-degree views from the centre cover the sphere; each
+/// pixel sees the area R^2 d(omega).
+#[test]
+fn the_radiance_of_a_closed_scene_integrates_to_the_lights_power() {
+    let base = photonmap::stress::FURNACE.replace(
+        "position = [0.0, 0.0, 0.0]\nintensity",
+        "position = [0.35, 0.2, -0.15]\nintensity",
+    );
+    assert_ne!(
+        base,
+        photonmap::stress::FURNACE,
+        "the light moved off centre"
+    );
+    let faces = [
+        (Vec3::X, Vec3::Y),
+        (-Vec3::X, Vec3::Y),
+        (Vec3::Y, Vec3::Z),
+        (-Vec3::Y, Vec3::Z),
+        (Vec3::Z, Vec3::Y),
+        (-Vec3::Z, Vec3::Y),
+    ];
+    let (w, iterations, photons) = (32u32, 32u32, 1u32 << 13);
+    let o = SppmOptions {
+        iterations,
+        photons_per_iteration: photons,
+        initial_radius: Some(0.15),
+        ..SppmOptions::default()
+    };
+    let mut total = 0.0;
+    for (i, (look, up)) in faces.iter().enumerate() {
+        let mut scene =
+            load_scene_str(&base, std::path::Path::new("off_centre_furnace.toml")).unwrap();
+        scene.camera.position = Vec3::ZERO;
+        scene.camera.look_at = *look;
+        scene.camera.up = *up;
+        scene.camera.vfov_degrees = 90.0;
+        let img = sppm_image(&scene, w, w, 1 + i as u32, &o);
+        for y in 0..w {
+            for x in 0..w {
+                let u = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
+                let v = (y as f64 + 0.5) / w as f64 * 2.0 - 1.0;
+                let d_omega = (2.0 / w as f64).powi(2) / (1.0 + u * u + v * v).powf(1.5);
+                let l = img.get(x, y).iter().map(|&c| c as f64).sum::<f64>() / 3.0;
+                total += l * d_omega;
+            }
+        }
+    }
+    // Noise: the photon half is the stored photons' power, and a photon of
+    // this grey furnace is stored on average rho/(1 - rho) = 1 time with
+    // variance rho/(1 - rho)^2 = 2; that sum's relative sd over every
+    // iteration's batch, on half of the total.
+    let sigma = 4.0 * 0.5 * (2.0f64 / (photons as f64 * iterations as f64)).sqrt();
+    eprintln!("closed sphere: integrated radiance {total:.4} against 4 (+- {sigma:.4})");
+    assert!((total - 4.0).abs() < 4.0 * sigma, "{total}");
+}
+
+/// The error falls with iterations as theory says: in the furnace SPPM is
+/// unbiased, so its error is noise, whose RMSE falls as i^(-alpha/2)
+/// (Knaus and Zwicker 2011): -0.35 for alpha = 0.7.
+#[test]
+fn the_error_falls_with_the_slope_theory_predicts() {
+    let gpu = common::gpu();
+    let scene = load_scene_str(
+        photonmap::stress::FURNACE,
+        std::path::Path::new("furnace.toml"),
+    )
+    .unwrap();
+    let o = SppmOptions {
+        photons_per_iteration: 1 << 11,
+        initial_radius: Some(0.25),
+        ..SppmOptions::default()
+    };
+    let expected = 1.0 / std::f32::consts::PI;
+    let mut points = Vec::new();
+    let mut run = Sppm::new(
+        &gpu,
+        &scene,
+        &options(&scene, 24, 24, 9, BuildMethod::Bitonic),
+        &o,
+    )
+    .unwrap();
+    let mut timings = Timings::default();
+    for k in 0..=8 {
+        while run.iteration < 1 << k {
+            run.iterate(&mut timings, &mut ()).unwrap();
+        }
+        let img = run.image().unwrap();
+        let se: f64 = img
+            .pixels
+            .iter()
+            .map(|p| ((p[0] + p[1] + p[2]) / 3.0 - expected) as f64)
+            .map(|e| e * e)
+            .sum();
+        points.push((run.iteration as f64, (se / img.pixels.len() as f64).sqrt()));
+    }
+    // Least squares over i = 4 .. 256 in log-log.
+    let fit: Vec<(f64, f64)> = points[2..].iter().map(|(i, e)| (i.ln(), e.ln())).collect();
+    let n = fit.len() as f64;
+    let (sx, sy) = fit.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let slope = fit.iter().map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
+        / fit.iter().map(|(x, _)| (x - mx).powi(2)).sum::<f64>();
+    eprintln!("furnace RMSE by iteration: {points:.4?}");
+    eprintln!("log-log slope of RMSE against iterations: {slope:.3} (theory -0.35)");
+    assert!((slope + 0.35).abs() < 0.1, "slope {slope}");
 }

@@ -201,7 +201,11 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
 
 /// `--method sppm`: one view, iterations until --iterations or --time.
 fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
-    if args.camera_path.is_some() || args.direct_only || args.reference_software.is_some() || args.spp > 1 {
+    if args.camera_path.is_some()
+        || args.direct_only
+        || args.reference_software.is_some()
+        || args.spp > 1
+    {
         bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software and --spp");
     }
     let outputs = args.outputs()?;
@@ -210,7 +214,8 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
     let options = args.options(&scene);
     let gpu = super::gpu(platform)?;
     let mut observer = CliObserver::new(args, &scene, &options, &outputs);
-    let out = render::sppm::render_sppm(&gpu, &scene, &options, &(&args.sppm).into(), &mut observer)?;
+    let out =
+        render::sppm::render_sppm(&gpu, &scene, &options, &(&args.sppm).into(), &mut observer)?;
     observer.finish()?;
     if out.image.has_non_finite() {
         bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");

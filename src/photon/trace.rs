@@ -310,7 +310,8 @@ impl PhotonTracer {
         let height = frame_height * frames;
         let t = || Texture::new(&self.gpu, width, height, TexFormat::Rgba32F);
         // No clear: emission and every bounce write each texel of their frame.
-        let mut frames = PhotonFrames::assemble(&self.gpu, [t()?, t()?, t()?, t()?], frame_height, frames)?;
+        let mut frames =
+            PhotonFrames::assemble(&self.gpu, [t()?, t()?, t()?, t()?], frame_height, frames)?;
         frames.emitted = emitted;
         frames.photons_used = emitted;
         frames.projection = aim.as_ref().map(|a| a.maps.clone());

@@ -13,8 +13,8 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::scene::{Light, Material, Scene};
 use crate::sampling::sample_cosine;
+use crate::scene::{Light, Material, Scene};
 
 use super::ray_trace::{closest_hit, eye_ray_at, occluded, offset_scale};
 
@@ -58,10 +58,18 @@ pub fn path_trace(scene: &Scene, width: u32, height: u32, spp: u32, seed: u64) -
         let mut out = Vec::new();
         for &y in rows {
             for x in 0..width {
-                let mut rng = Rng::new(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93));
+                let mut rng = Rng::new(
+                    seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93),
+                );
                 let (mut s, mut s2) = (DVec3::ZERO, DVec3::ZERO);
                 for _ in 0..spp {
-                    let (o, d) = eye_ray_at(scene, width, height, x as f32 + rng.next(), y as f32 + rng.next());
+                    let (o, d) = eye_ray_at(
+                        scene,
+                        width,
+                        height,
+                        x as f32 + rng.next(),
+                        y as f32 + rng.next(),
+                    );
                     let l = radiance(scene, o, d, &mut rng).as_dvec3();
                     s += l;
                     s2 += l * l;
@@ -151,7 +159,10 @@ fn direct(scene: &Scene, origin: Vec3, nf: Vec3, floor: f32, rng: &mut Rng) -> V
                 let dist = to.length();
                 let wi = to / dist;
                 let (c, cl) = (nf.dot(wi), -normal.dot(wi));
-                if c > 0.0 && cl > 0.0 && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor)) {
+                if c > 0.0
+                    && cl > 0.0
+                    && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor))
+                {
                     e += radiance * c * cl / (dist * dist) * edge1.cross(edge2).length();
                 }
             }

@@ -37,8 +37,14 @@ pub fn gather(map: &CpuPhotonMap, x: Vec3, normal: Vec3, radius2: f32) -> (Vec3,
     );
     let cell_size = (g.max - g.min) / res.as_vec3();
     let r = radius2.sqrt();
-    let lo = ((x - r - g.min) / cell_size).floor().as_ivec3().clamp(IVec3::ZERO, res - 1);
-    let hi = ((x + r - g.min) / cell_size).floor().as_ivec3().clamp(IVec3::ZERO, res - 1);
+    let lo = ((x - r - g.min) / cell_size)
+        .floor()
+        .as_ivec3()
+        .clamp(IVec3::ZERO, res - 1);
+    let hi = ((x + r - g.min) / cell_size)
+        .floor()
+        .as_ivec3()
+        .clamp(IVec3::ZERO, res - 1);
     let (mut power, mut m) = (Vec3::ZERO, 0.0f32);
     for cz in lo.z..=hi.z {
         for cy in lo.y..=hi.y {

@@ -49,18 +49,19 @@ impl DirectLight {
         self.target.clear([0.0; 4]);
     }
 
-    /// Adds shadow samples `samples` (of `shadow_rays` per area light) for the
-    /// hits of `depth` (with `light_sampling` off, only emitters seen).
+    /// Adds shadow samples `samples` (of the plan's `shadow_rays` per area
+    /// light) for the hits of `depth` (with the plan's `light_sampling` off,
+    /// only emitters seen).
     pub fn shade(
         &self,
         scene: &SceneTextures,
         hits: &HitBuffers,
-        shadow_rays: u32,
+        plan: &super::PassPlan,
         samples: std::ops::Range<u32>,
         depth: u32,
         seed: u32,
-        light_sampling: bool,
     ) -> Result<()> {
+        let (shadow_rays, light_sampling) = (plan.shadow_rays, plan.light_sampling);
         let (nx, _) = strata(shadow_rays);
         let mut b = self.program.bind();
         scene.bind(&mut b);

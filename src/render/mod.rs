@@ -340,11 +340,10 @@ pub(crate) fn trace_eye_paths(
                 direct.shade(
                     textures,
                     &tracer.hits,
-                    plan.shadow_rays,
+                    plan,
                     samples.clone(),
                     depth,
                     eye.seed,
-                    plan.light_sampling,
                 )
             })?;
         }

@@ -18,15 +18,15 @@
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::photon::{
-    BitonicBuild, BuildMethod, Grid, PhotonBatch, PhotonMap, PhotonTracer,
-    StencilRouting, TraceConfig,
+    BitonicBuild, BuildMethod, Grid, PhotonBatch, PhotonMap, PhotonTracer, StencilRouting,
+    TraceConfig,
 };
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 use crate::timing::Timings;
 
 use super::{
-    trace_eye_paths, At, DirectLight, EstimatePass, EyeSample, ExplainLine, Image, PassPlan,
+    trace_eye_paths, At, DirectLight, EstimatePass, ExplainLine, EyeSample, Image, PassPlan,
     Progress, RayTracer, RenderObserver, RenderOptions,
 };
 
@@ -148,15 +148,18 @@ impl Sppm {
         let photons = PhotonTracer::with_config(
             gpu,
             TraceConfig {
-                // No read-back per bounce: every frame is traced.
-                stop_when_dead: false,
+                stop_when_dead: true,
                 ..config.trace()
             },
         )?;
         let batch = photons.batch(&scene, sppm.photons_per_iteration)?;
         let builder = match config.build {
-            BuildMethod::Bitonic => Builder::Bitonic(BitonicBuild::with_addressing(gpu, config.faithful)?),
-            BuildMethod::Stencil => Builder::Stencil(StencilRouting::new(gpu)?, config.stencil_block),
+            BuildMethod::Bitonic => {
+                Builder::Bitonic(BitonicBuild::with_addressing(gpu, config.faithful)?)
+            }
+            BuildMethod::Stencil => {
+                Builder::Stencil(StencilRouting::new(gpu)?, config.stencil_block)
+            }
         };
         let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
         let (flux, sums) = (t()?, t()?);
@@ -186,10 +189,14 @@ impl Sppm {
                 sums,
                 target: state_target,
             },
-            update: Program::fullscreen_with(gpu, "render/sppm_update.frag", &match config.build {
-                BuildMethod::Bitonic => vec![],
-                BuildMethod::Stencil => vec![("ROUTED", "1".to_string())],
-            })?,
+            update: Program::fullscreen_with(
+                gpu,
+                "render/sppm_update.frag",
+                &match config.build {
+                    BuildMethod::Bitonic => vec![],
+                    BuildMethod::Stencil => vec![("ROUTED", "1".to_string())],
+                },
+            )?,
             compose: Program::fullscreen(gpu, "render/sppm_compose.frag")?,
             radius: Program::fullscreen(gpu, "render/sppm_radius.frag")?,
             reduce: Program::fullscreen(gpu, "common/max_reduce.frag")?,
@@ -211,11 +218,24 @@ impl Sppm {
     }
 
     /// One iteration: eye paths, a photon batch, its map, the gather and update.
-    pub fn iterate(&mut self, timings: &mut Timings, observer: &mut dyn RenderObserver) -> Result<()> {
+    pub fn iterate(
+        &mut self,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<()> {
         let i = self.iteration + 1;
         let seed = crate::random::sample_seed(self.seed, i);
-        let at = At { view: 0, views: 1, sample: i - 1, samples: self.options.iterations };
-        let eye = EyeSample { camera: &self.scene.camera, sample: 0, seed };
+        let at = At {
+            view: 0,
+            views: 1,
+            sample: i - 1,
+            samples: self.options.iterations,
+        };
+        let eye = EyeSample {
+            camera: &self.scene.camera,
+            sample: 0,
+            seed,
+        };
         trace_eye_paths(
             &self.gpu,
             &self.plan,
@@ -228,9 +248,15 @@ impl Sppm {
             at,
         )?;
         let wall = std::time::Instant::now();
-        self.photons.trace_batch(&self.scene, &self.textures, &mut self.batch, seed)?;
+        self.photons
+            .trace_batch(&self.scene, &self.textures, &mut self.batch, seed)?;
         let frames = &self.batch.frames;
-        timings.add_both("trace photons", frames.gpu_seconds, wall.elapsed().as_secs_f64(), frames.frames as usize);
+        timings.add_both(
+            "trace photons",
+            frames.gpu_seconds,
+            wall.elapsed().as_secs_f64(),
+            frames.frames as usize,
+        );
         let wall = std::time::Instant::now();
         let grid = Grid::over_scene(&self.scene, self.cell, self.max_cells());
         let mut stages = Timings::default();
@@ -246,7 +272,12 @@ impl Sppm {
         };
         self.gpu.finish();
         let passes = stages.stages.iter().map(|s| s.passes).sum();
-        timings.add_both("build map", stages.gpu_total(), wall.elapsed().as_secs_f64(), passes);
+        timings.add_both(
+            "build map",
+            stages.gpu_total(),
+            wall.elapsed().as_secs_f64(),
+            passes,
+        );
         let wall = std::time::Instant::now();
         self.gather_and_update(&map, &grid)?;
         self.gpu.finish();
@@ -411,9 +442,18 @@ pub fn render_sppm(
         }
         run.iterate(&mut timings, observer)?;
         let t0 = std::time::Instant::now();
-        observer.progress(&Progress::stage("SPPM iterations", run.iteration as u64, sppm.iterations as u64));
+        observer.progress(&Progress::stage(
+            "SPPM iterations",
+            run.iteration as u64,
+            sppm.iterations as u64,
+        ));
         observer.estimate_pass(&EstimatePass {
-            at: At { view: 0, views: 1, sample: 0, samples: 1 },
+            at: At {
+                view: 0,
+                views: 1,
+                sample: 0,
+                samples: 1,
+            },
             pass: run.iteration - 1,
             searching: 0,
             query_pixels: 0,
@@ -426,7 +466,12 @@ pub fn render_sppm(
     let image = run.image()?;
     timings.wall_seconds = wall.elapsed().as_secs_f64();
     observer.estimate_pass(&EstimatePass {
-        at: At { view: 0, views: 1, sample: 0, samples: 1 },
+        at: At {
+            view: 0,
+            views: 1,
+            sample: 0,
+            samples: 1,
+        },
         pass: run.iteration,
         searching: 0,
         query_pixels: 0,
