@@ -30,6 +30,10 @@ pub const INVALID_KEY: i32 = i32::MAX;
 /// texture: two RGBA texels side by side.
 pub const RANDOM_PER_PHOTON_FRAME: usize = 8;
 
+/// The kNN estimate's disc test (`LeakTest::Disc`): photons farther than this
+/// fraction of the maximum radius from the query's tangent plane are not its own.
+pub const DISC_THICKNESS: f32 = 0.1;
+
 /// pi as every shader writes it (the same f32 as `std::f32::consts::PI`).
 const PI_GLSL: &str = "3.14159265358979";
 
@@ -56,6 +60,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
             RANDOM_PER_PHOTON_FRAME.to_string(),
         ),
         ("PI", PI_GLSL.into()),
+        ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
     ]
 }
 

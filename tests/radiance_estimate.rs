@@ -266,6 +266,7 @@ intensity = [0.0, 0.0, 0.0]
     let est = photonmap::render::RadianceEstimate::new(&gpu, 48, 48).unwrap();
     let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
     est.run(
+        &out.state.textures,
         &map,
         &out.state.direct,
         k,
@@ -372,5 +373,59 @@ fn faithful_mode_renders_the_same_image() {
             images[0], images[1],
             "{build:?}: faithful and default differ"
         );
+    }
+}
+
+/// The leak tests (disc, visibility, both) on the GPU equal the CPU kNN-grid
+/// run with the same tests, pixel for pixel.
+#[test]
+fn gpu_leak_tests_equal_their_cpu_twins() {
+    use photonmap::reference::knn::{knn_grid_filtered, photon_visible};
+    use photonmap::render::radiance_estimate::LeakTest;
+    let gpu = common::gpu();
+    for (name, w, h) in [("ring", 64, 48), ("cornell_box", 48, 48)] {
+        let scene = common::paper_scene(name);
+        for leak in [
+            LeakTest::Disc,
+            LeakTest::Visibility,
+            LeakTest::DiscAndVisibility,
+        ] {
+            let mut o = RenderOptions::for_scene(&scene);
+            (o.width, o.height, o.seed) = (w, h, 3);
+            let gi = o.global.as_mut().unwrap();
+            gi.estimate.leak = leak;
+            gi.estimate.budget = 48;
+            let out = render(&gpu, &scene, &o, &mut ()).unwrap();
+            let cpu_map = CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap());
+            let normal = out.state.direct.diffuse_normal.read_f32();
+            let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
+            let thickness = photonmap::layout::DISC_THICKNESS * max_r;
+            let results = gpu_results(&out);
+            let mut mismatched = 0;
+            for (i, x, flux, r2, accepted) in &results {
+                let nf = Vec3::from_slice(&normal[4 * i..]);
+                let accept = |p: Vec3| {
+                    let disc = !matches!(leak, LeakTest::Disc | LeakTest::DiscAndVisibility)
+                        || (p - *x).dot(nf).abs() <= thickness;
+                    let seen = !matches!(leak, LeakTest::Visibility | LeakTest::DiscAndVisibility)
+                        || photon_visible(&scene, *x, nf, p);
+                    disc && seen
+                };
+                let cpu = knn_grid_filtered(&cpu_map, *x, k, max_r, &accept);
+                let same = cpu.accepted == *accepted
+                    && (cpu.radius2 - r2).abs() <= 1e-5 * r2.max(1e-12)
+                    && (cpu.flux - *flux).abs().max_element()
+                        <= 1e-4 * cpu.flux.max_element().max(1e-20);
+                mismatched += !same as usize;
+            }
+            eprintln!(
+                "{name} {leak:?}: {} query pixels, {mismatched} differ from the CPU twin",
+                results.len()
+            );
+            assert!(
+                mismatched * 100 <= results.len(),
+                "{name} {leak:?}: {mismatched} differ"
+            );
+        }
     }
 }

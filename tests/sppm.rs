@@ -43,22 +43,20 @@ fn v3(t: [f32; 4]) -> Vec3 {
 #[test]
 fn the_gather_and_update_kernel_equals_its_cpu_twin() {
     let gpu = common::gpu();
-    for (name, build) in [
-        ("glass_ball", BuildMethod::Bitonic),
-        ("cornell_box", BuildMethod::Stencil),
+    use photonmap::render::radiance_estimate::LeakTest;
+    for (name, build, leak) in [
+        ("glass_ball", BuildMethod::Bitonic, LeakTest::None),
+        ("cornell_box", BuildMethod::Stencil, LeakTest::None),
+        ("ring", BuildMethod::Bitonic, LeakTest::Visibility),
     ] {
         let scene = common::paper_scene(name);
         let sppm_options = SppmOptions {
             photons_per_iteration: 1 << 15,
             ..SppmOptions::default()
         };
-        let mut run = Sppm::new(
-            &gpu,
-            &scene,
-            &options(&scene, 64, 48, 5, build),
-            &sppm_options,
-        )
-        .unwrap();
+        let mut o = options(&scene, 64, 48, 5, build);
+        o.global.as_mut().unwrap().estimate.leak = leak;
+        let mut run = Sppm::new(&gpu, &scene, &o, &sppm_options).unwrap();
         let mut timings = Timings::default();
         run.iterate(&mut timings, &mut ()).unwrap();
         let (flux0, sums0) = (texels(&run.state.flux), texels(&run.state.sums));
@@ -93,7 +91,16 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
                 direct: v3(sums0[i]),
                 count: sums0[i][3],
             };
-            let cpu = update(&map, before, v3(direct[i]), vp, 0.7, first_radius2);
+            let accept = |vp: &VisiblePoint, p: Vec3| {
+                leak == LeakTest::None
+                    || photonmap::reference::knn::photon_visible(
+                        run.scene(),
+                        vp.position,
+                        vp.normal,
+                        p,
+                    )
+            };
+            let cpu = update(&map, before, v3(direct[i]), vp, 0.7, first_radius2, &accept);
             if sums1[i][3] > sums0[i][3] {
                 gathering += 1;
             }
@@ -109,7 +116,7 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
             worst = worst.max(rel(cpu.radius2, flux1[i][3]));
         }
         eprintln!(
-            "{name} ({build:?}): {gathering} of {} pixels gathered photons; counts differ at {count_differs}; largest relative difference {worst:.2e}",
+            "{name} ({build:?}, {leak:?}): {gathering} of {} pixels gathered photons; counts differ at {count_differs}; largest relative difference {worst:.2e}",
             flux0.len()
         );
         assert!(

@@ -16,9 +16,18 @@
 // (Elias; faces on the grid's boundary do not count): the search ends when k
 // are accepted and the radius is within d_min(r), when d_min(r) reaches the
 // maximum radius, or when the box covers the grid.
+// VISIBILITY_TEST accepts only photons nothing blocks from the query point (a
+// thin wall does not leak light), DISC_TEST only photons near its tangent
+// plane; the k nearest are then the k nearest that pass.
 #include "common/photon_map.glsl"
+#if defined(VISIBILITY_TEST)
+#include "common/visibility.glsl"
+#endif
 
 uniform sampler2D u_query_position;  // first diffuse hit, w = 1 valid
+#if defined(VISIBILITY_TEST) || defined(DISC_TEST)
+uniform sampler2D u_query_normal;    // facing the eye, w = material + 1
+#endif
 uniform sampler2D u_state_flux;      // rgb sum of accepted power, w = radius^2
 uniform isampler2D u_state_cursor;   // accepted, ring, cube cursor, photon cursor
 uniform isampler2D u_state_done;     // done, photons examined
@@ -40,6 +49,9 @@ void main() {
     vec4 flux = texelFetch(u_state_flux, px, 0);
     ivec4 cursor = texelFetch(u_state_cursor, px, 0);
     vec3 x = texelFetch(u_query_position, px, 0).xyz;
+#if defined(VISIBILITY_TEST) || defined(DISC_TEST)
+    vec3 nf = texelFetch(u_query_normal, px, 0).xyz;
+#endif
     int accepted = cursor.x, ring = cursor.y, j = cursor.z, p = cursor.w;
     int examined = done.y;
     float r2 = flux.w;
@@ -89,7 +101,16 @@ void main() {
         ivec2 t = photon_texel(base, p);
         vec3 offset = texelFetch(u_map_position, t, 0).xyz - x;
         float dist2 = dot(offset, offset);
-        if (dist2 <= max_r2 && (accepted < u_k || dist2 <= r2)) {
+        bool candidate = dist2 <= max_r2 && (accepted < u_k || dist2 <= r2);
+#ifdef DISC_TEST
+        // A disc, not a sphere: photons off the query's tangent plane (another
+        // wall at a corner) are not its photons.
+        candidate = candidate && abs(dot(offset, nf)) <= DISC_THICKNESS * u_max_radius;
+#endif
+#ifdef VISIBILITY_TEST
+        candidate = candidate && photon_visible(x, nf, x + offset);
+#endif
+        if (candidate) {
             flux.rgb += texelFetch(u_map_power, t, 0).rgb;
             if (accepted < u_k) r2 = max(r2, dist2);
             accepted += 1;

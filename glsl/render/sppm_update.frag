@@ -12,9 +12,14 @@
 // BRDF and path weight, since x moves every iteration. Direct light (shadow
 // rays at x, emitters along the path) is summed beside. The image is
 // L = direct sum / i + tau / (pi R^2 i): photon power is already per emitted
-// photon of one iteration's batch.
+// photon of one iteration's batch. The leak tests of the kNN estimate
+// (VISIBILITY_TEST, DISC_TEST) may restrict the gather too; as R shrinks to
+// zero they change nothing, so SPPM stays consistent with them.
 #include "common/scene.glsl"
 #include "common/photon_map.glsl"
+#ifdef VISIBILITY_TEST
+#include "common/visibility.glsl"
+#endif
 
 uniform sampler2D u_state_flux;         // tau.rgb, R^2
 uniform sampler2D u_state_direct;       // direct-light sum .rgb, N
@@ -31,6 +36,9 @@ uniform float u_alpha;
 // at most the grid's cell, so its gather stays within 2 cells per axis.
 uniform float u_first_radius2;
 uniform int u_gather;                   // 0: direct light only (the photon half off)
+#ifdef DISC_TEST
+uniform float u_disc_radius;            // the disc's thickness is relative to this
+#endif
 
 layout(location = 0) out vec4 o_flux;
 layout(location = 1) out vec4 o_direct;
@@ -70,6 +78,12 @@ void main() {
                     vec3 offset = texelFetch(u_map_position, t, 0).xyz - x;
                     if (dot(offset, offset) >= r2) continue;
                     if (dot(texelFetch(u_map_incoming, t, 0).xyz, nf) >= 0.0) continue;
+#ifdef DISC_TEST
+                    if (abs(dot(offset, nf)) > DISC_THICKNESS * u_disc_radius) continue;
+#endif
+#ifdef VISIBILITY_TEST
+                    if (!photon_visible(x, nf, x + offset)) continue;
+#endif
                     gathered += texelFetch(u_map_power, t, 0).rgb;
                     m += w;
                 }

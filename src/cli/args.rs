@@ -4,6 +4,7 @@
 use clap::Args;
 
 use photonmap::photon::{BuildMethod, PhotonConfig, VertexFeed};
+use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{DirectLighting, SppmOptions};
 use photonmap::render::{EstimateMode, EstimateOptions};
 
@@ -75,6 +76,11 @@ pub struct EstimateArgs {
     /// cell moved (1..=100000).
     #[arg(long, default_value_t = 64, value_parser = in_range(1, 100_000))]
     pub budget: u32,
+    /// Which photons in the search sphere may light a pixel: all (none, the
+    /// paper's; light leaks through walls thinner than the radius), those near
+    /// its tangent plane (disc), those nothing blocks (visibility), or both.
+    #[arg(long, value_enum, default_value_t = LeakTest::None)]
+    pub leak_test: LeakTest,
 }
 
 impl From<&EstimateArgs> for EstimateOptions {
@@ -86,6 +92,7 @@ impl From<&EstimateArgs> for EstimateOptions {
                 (None, tile) => EstimateMode::Tiled { tile },
             },
             budget: a.budget,
+            leak: a.leak_test,
             ..EstimateOptions::default()
         }
     }

@@ -9,6 +9,31 @@ pub use crate::render::software::{CpuPhotonMap, KdTree, KnnResult};
 
 /// The kNN-grid search of section 2.3, in the GPU's order.
 pub fn knn_grid(map: &CpuPhotonMap, x: Vec3, k: u32, max_radius: f32) -> KnnResult {
+    knn_grid_filtered(map, x, k, max_radius, &|_| true)
+}
+
+/// Whether a photon at `p` may light query point `x` (normal `nf`): the twin
+/// of glsl/common/visibility.glsl.
+pub fn photon_visible(scene: &crate::scene::Scene, x: Vec3, nf: Vec3, p: Vec3) -> bool {
+    use super::ray_trace::{occluded, offset_scale};
+    let floor = 1e-6 * scene.size();
+    let dist = x.distance(p);
+    let a = x + nf * (0.1 * dist + offset_scale(x, floor));
+    let b = p + nf * (0.1 * dist + offset_scale(p, floor));
+    let d = b - a;
+    let len = d.length();
+    len <= 0.0 || !occluded(scene, a, d / len, 0.999 * len)
+}
+
+/// The same search, taking only photons (positions) that `accept` lets
+/// through: the leak tests.
+pub fn knn_grid_filtered(
+    map: &CpuPhotonMap,
+    x: Vec3,
+    k: u32,
+    max_radius: f32,
+    accept: &dyn Fn(Vec3) -> bool,
+) -> KnnResult {
     let g = &map.grid;
     let res = [
         g.resolution[0] as i32,
@@ -46,7 +71,7 @@ pub fn knn_grid(map: &CpuPhotonMap, x: Vec3, k: u32, max_radius: f32) -> KnnResu
                     for (p, power) in &map.cells[cell] {
                         let o = *p - x;
                         let d2 = o.dot(o);
-                        if d2 <= max_r2 && (accepted < k || d2 <= r2) {
+                        if d2 <= max_r2 && (accepted < k || d2 <= r2) && accept(*p) {
                             flux += *power;
                             if accepted < k {
                                 r2 = r2.max(d2);

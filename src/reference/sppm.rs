@@ -26,9 +26,16 @@ pub struct VisiblePoint {
     pub throughput: Vec3,
 }
 
-/// Photons within `radius2` of the point that arrive on its visible side:
-/// (power summed, photons counted with their cell's weight).
-pub fn gather(map: &CpuPhotonMap, x: Vec3, normal: Vec3, radius2: f32) -> (Vec3, f32) {
+/// Photons within `radius2` of the point that arrive on its visible side and
+/// that `accept` (the leak tests) lets through: (power summed, photons
+/// counted with their cell's weight).
+pub fn gather(
+    map: &CpuPhotonMap,
+    x: Vec3,
+    normal: Vec3,
+    radius2: f32,
+    accept: &dyn Fn(Vec3) -> bool,
+) -> (Vec3, f32) {
     let g = &map.grid;
     let res = IVec3::new(
         g.resolution[0] as i32,
@@ -55,7 +62,7 @@ pub fn gather(map: &CpuPhotonMap, x: Vec3, normal: Vec3, radius2: f32) -> (Vec3,
                     if offset.dot(offset) >= radius2 {
                         continue;
                     }
-                    if map.incoming[cell][k].dot(normal) >= 0.0 {
+                    if map.incoming[cell][k].dot(normal) >= 0.0 || !accept(*p) {
                         continue;
                     }
                     power += *w;
@@ -70,6 +77,7 @@ pub fn gather(map: &CpuPhotonMap, x: Vec3, normal: Vec3, radius2: f32) -> (Vec3,
 /// One iteration at one pixel: add the iteration's direct light, gather at the
 /// visible point (if any) and update N, R^2 and tau with `alpha`. A pixel that
 /// has gathered nothing yet takes its radius as at most `first_radius2`.
+/// `accept` gets the visible point and a photon position (the leak tests).
 pub fn update(
     map: &CpuPhotonMap,
     state: PixelState,
@@ -77,6 +85,7 @@ pub fn update(
     vp: Option<VisiblePoint>,
     alpha: f32,
     first_radius2: f32,
+    accept: &dyn Fn(&VisiblePoint, Vec3) -> bool,
 ) -> PixelState {
     let mut s = state;
     s.direct += direct;
@@ -88,7 +97,7 @@ pub fn update(
     } else {
         s.radius2.min(first_radius2)
     };
-    let (power, m) = gather(map, vp.position, vp.normal, r2);
+    let (power, m) = gather(map, vp.position, vp.normal, r2, &|p| accept(&vp, p));
     if m > 0.0 {
         let phi = vp.throughput * (vp.albedo / std::f32::consts::PI) * power;
         let g = (s.count + alpha * m) / (s.count + m);

@@ -385,30 +385,36 @@ impl EstimateRun<'_> {
         };
         let mut observed = 0.0;
         let mut failure = None;
-        let stats =
-            self.estimate
-                .run(self.map, self.direct, k, max_radius, &options, &mut |r| {
-                    let t0 = std::time::Instant::now();
-                    observer.progress(&Progress::at(
-                        "radiance estimate",
-                        r.query_pixels - r.searching,
-                        r.query_pixels,
-                        self.at,
-                    ));
-                    let pass = EstimatePass {
-                        at: self.at,
-                        pass: r.pass,
-                        searching: r.searching,
-                        query_pixels: r.query_pixels,
-                        seconds: r.elapsed_seconds - observed,
-                        finished: false,
-                        image: &compose,
-                    };
-                    if failure.is_none() {
-                        failure = observer.estimate_pass(&pass).err();
-                    }
-                    observed += t0.elapsed().as_secs_f64();
-                })?;
+        let stats = self.estimate.run(
+            self.textures,
+            self.map,
+            self.direct,
+            k,
+            max_radius,
+            &options,
+            &mut |r| {
+                let t0 = std::time::Instant::now();
+                observer.progress(&Progress::at(
+                    "radiance estimate",
+                    r.query_pixels - r.searching,
+                    r.query_pixels,
+                    self.at,
+                ));
+                let pass = EstimatePass {
+                    at: self.at,
+                    pass: r.pass,
+                    searching: r.searching,
+                    query_pixels: r.query_pixels,
+                    seconds: r.elapsed_seconds - observed,
+                    finished: false,
+                    image: &compose,
+                };
+                if failure.is_none() {
+                    failure = observer.estimate_pass(&pass).err();
+                }
+                observed += t0.elapsed().as_secs_f64();
+            },
+        )?;
         if let Some(e) = failure {
             return Err(e);
         }

@@ -22,6 +22,35 @@ pub enum EstimateMode {
     Masked { every: u32 },
 }
 
+/// Which photons within the search sphere may light a query point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum LeakTest {
+    /// Every photon in the sphere (the paper's estimate): light leaks through
+    /// walls thinner than the radius.
+    None,
+    /// Only photons near the query's tangent plane (Jensen's disc).
+    Disc,
+    /// Only photons that nothing blocks from the query point.
+    Visibility,
+    /// Both.
+    DiscAndVisibility,
+}
+
+impl LeakTest {
+    /// The defines that switch the tests on in knn_search.frag and sppm_update.frag.
+    pub fn defines(self) -> Vec<(&'static str, String)> {
+        let mut d = Vec::new();
+        if matches!(self, LeakTest::Disc | LeakTest::DiscAndVisibility) {
+            d.push(("DISC_TEST", "1".into()));
+        }
+        if matches!(self, LeakTest::Visibility | LeakTest::DiscAndVisibility) {
+            d.push(("VISIBILITY_TEST", "1".into()));
+        }
+        d
+    }
+}
+
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct EstimateOptions {
     pub mode: EstimateMode,
@@ -31,6 +60,8 @@ pub struct EstimateOptions {
     pub max_passes: u32,
     /// The paper's float convert1dto2d for photon addresses (`--faithful`).
     pub float_addressing: bool,
+    /// Which photons in the sphere may light the query point.
+    pub leak: LeakTest,
 }
 
 impl Default for EstimateOptions {
@@ -40,6 +71,7 @@ impl Default for EstimateOptions {
             budget: 64,
             max_passes: 100_000,
             float_addressing: false,
+            leak: LeakTest::None,
         }
     }
 }
@@ -79,16 +111,21 @@ pub struct RadianceEstimate {
     init: Program,
     mask: Program,
     compose: Program,
-    /// Search programs by (routed map, tiles, float addressing), compiled on
-    /// first use: a render with several eye samples or camera views runs the
-    /// search many times and must not compile it each time.
-    search: std::cell::RefCell<std::collections::HashMap<(bool, bool, bool), std::rc::Rc<Program>>>,
+    /// Search programs by (routed map, tiles, float addressing, leak test),
+    /// compiled on first use: a render with several eye samples or camera
+    /// views runs the search many times and must not compile it each time.
+    search: std::cell::RefCell<std::collections::HashMap<SearchKey, std::rc::Rc<Program>>>,
     width: u32,
     height: u32,
 }
 
-/// The search program for a map kind and a way of drawing.
-fn search_program(gpu: &Gpu, routed: bool, tiles: bool, float_addressing: bool) -> Result<Program> {
+type SearchKey = (bool, bool, bool, LeakTest);
+
+/// The search program for a map kind, a way of drawing and a leak test.
+fn search_program(
+    gpu: &Gpu,
+    (routed, tiles, float_addressing, leak): SearchKey,
+) -> Result<Program> {
     let mut defines: Vec<(&str, String)> = if routed {
         vec![("ROUTED", "1".into())]
     } else {
@@ -97,6 +134,7 @@ fn search_program(gpu: &Gpu, routed: bool, tiles: bool, float_addressing: bool) 
     if float_addressing {
         defines.push(("FLOAT_ADDRESSING", "1".into()));
     }
+    defines.extend(leak.defines());
     let vertex = if tiles {
         "render/tile.vert"
     } else {
@@ -138,16 +176,11 @@ impl RadianceEstimate {
     ) -> Result<std::rc::Rc<Program>> {
         let routed = matches!(map, PhotonMap::Routed(_));
         let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
-        let key = (routed, tiled, options.float_addressing);
+        let key = (routed, tiled, options.float_addressing, options.leak);
         if let Some(p) = self.search.borrow().get(&key) {
             return Ok(p.clone());
         }
-        let p = std::rc::Rc::new(search_program(
-            &self.gpu,
-            routed,
-            tiled,
-            options.float_addressing,
-        )?);
+        let p = std::rc::Rc::new(search_program(&self.gpu, key)?);
         self.search.borrow_mut().insert(key, p.clone());
         Ok(p)
     }
@@ -156,6 +189,7 @@ impl RadianceEstimate {
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
+        scene: &SceneTextures,
         map: &PhotonMap,
         direct: &DirectLight,
         k: u32,
@@ -175,6 +209,8 @@ impl RadianceEstimate {
         self.target.clear_depth_stencil(1.0, 0);
         self.gpu.texture_barrier();
         let query = SearchQuery {
+            scene,
+            leak: options.leak,
             map,
             direct,
             k,
@@ -244,6 +280,12 @@ impl RadianceEstimate {
             }
         }
         grid.bind(b);
+        if q.leak != LeakTest::None {
+            b.texture("u_query_normal", &q.direct.diffuse_normal);
+        }
+        if matches!(q.leak, LeakTest::Visibility | LeakTest::DiscAndVisibility) {
+            q.scene.bind(b);
+        }
         b.texture("u_query_position", &q.direct.diffuse_position)
             .texture("u_state_flux", &self.flux)
             .texture("u_state_cursor", &self.cursor)
@@ -318,6 +360,8 @@ impl RadianceEstimate {
 
 /// What one search looks for: in which map, from which first hits, how far.
 struct SearchQuery<'a> {
+    scene: &'a SceneTextures,
+    leak: LeakTest,
     map: &'a PhotonMap,
     direct: &'a DirectLight,
     k: u32,

@@ -25,6 +25,7 @@ use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 use crate::timing::Timings;
 
+use super::radiance_estimate::LeakTest;
 use super::{
     trace_eye_paths, At, DirectLight, EstimatePass, ExplainLine, EyeSample, Image, PassPlan,
     Progress, RayTracer, RenderObserver, RenderOptions,
@@ -128,6 +129,8 @@ pub struct Sppm {
     /// The last iteration's photon map and grid (for tests and `--explain`).
     pub map: Option<PhotonMap>,
     pub grid: Option<Grid>,
+    /// The leak tests the gather applies.
+    pub leak: LeakTest,
 }
 
 impl Sppm {
@@ -137,7 +140,8 @@ impl Sppm {
         options: &RenderOptions,
         sppm: &SppmOptions,
     ) -> Result<Self> {
-        let config = options.global.clone().unwrap_or_default().photons;
+        let global = options.global.clone().unwrap_or_default();
+        let (config, leak) = (global.photons, global.estimate.leak);
         let scene = sppm_scene(scene, sppm)?;
         let (w, h) = (options.width, options.height);
         let mut plan = PassPlan::new(&scene, options);
@@ -189,14 +193,13 @@ impl Sppm {
                 sums,
                 target: state_target,
             },
-            update: Program::fullscreen_with(
-                gpu,
-                "render/sppm_update.frag",
-                &match config.build {
-                    BuildMethod::Bitonic => vec![],
-                    BuildMethod::Stencil => vec![("ROUTED", "1".to_string())],
-                },
-            )?,
+            update: Program::fullscreen_with(gpu, "render/sppm_update.frag", &{
+                let mut d = leak.defines();
+                if config.build == BuildMethod::Stencil {
+                    d.push(("ROUTED", "1".to_string()));
+                }
+                d
+            })?,
             compose: Program::fullscreen(gpu, "render/sppm_compose.frag")?,
             radius: Program::fullscreen(gpu, "render/sppm_radius.frag")?,
             reduce: Program::fullscreen(gpu, "common/max_reduce.frag")?,
@@ -207,6 +210,7 @@ impl Sppm {
             cell: initial_radius,
             map: None,
             grid: None,
+            leak,
             textures,
             scene,
         })
@@ -334,8 +338,11 @@ impl Sppm {
             .texture("u_diffuse_throughput", &d.diffuse_throughput)
             .float("u_alpha", self.options.alpha)
             .float("u_first_radius2", self.cell * self.cell)
-            .int("u_gather", 1)
-            .draw_fullscreen(&self.state.target, &DrawState::PLAIN)?;
+            .int("u_gather", 1);
+        if matches!(self.leak, LeakTest::Disc | LeakTest::DiscAndVisibility) {
+            b.float("u_disc_radius", self.initial_radius);
+        }
+        b.draw_fullscreen(&self.state.target, &DrawState::PLAIN)?;
         // The next iteration reads what this one wrote.
         self.gpu.texture_barrier();
         Ok(())
