@@ -26,7 +26,7 @@ enum Command {
     Render(cli::render::RenderArgs),
     Photons(cli::photons::PhotonsArgs),
     Compare(cli::compare::CompareArgs),
-    Reference(cli::accuracy::ReferenceArgs),
+    Reference(cli::reference::ReferenceArgs),
     Tables(cli::tables::TablesArgs),
     #[command(subcommand)]
     Bench(cli::bench::BenchCommand),
@@ -41,7 +41,7 @@ fn main() -> ExitCode {
         Command::Render(a) => cli::render::run(&a, p),
         Command::Photons(a) => cli::photons::run(&a, p),
         Command::Compare(a) => cli::compare::run(&a),
-        Command::Reference(a) => cli::accuracy::run_reference(&a, p),
+        Command::Reference(a) => cli::reference::run(&a, p),
         Command::Tables(a) => cli::tables::run(&a, p),
         Command::Bench(b) => cli::bench::run(b, p),
         Command::Info(a) => cli::info::run(&a, p),

@@ -504,18 +504,17 @@ fn compare_prints_metrics_writes_a_difference_image_and_checks_its_inputs() {
 #[test]
 fn reference_and_accuracy_bench_write_their_results() {
     let d = tmp("accuracy");
-    let reference = d.join("gb.converged.exr");
+    let reference = d.join("gb.sppm.exr");
     let out = photonmap()
         .args([
             "reference",
             "--scale",
             "8",
-            "--seeds",
-            "2",
-            "--spp",
-            "1",
-            "--photons-factor",
-            "2",
+            "--iterations",
+            "8",
+            "--photons-per-iteration",
+            "4096",
+            "--quiet",
             "--out",
         ])
         .arg(&reference)
@@ -532,12 +531,13 @@ fn reference_and_accuracy_bench_write_their_results() {
     assert_eq!(
         (
             info["width"].as_u64(),
-            info["photons_stored"].as_u64(),
-            info["seeds"].as_u64()
+            info["iterations"].as_u64(),
+            info["method"].as_str()
         ),
-        (Some(64), Some(10000), Some(2))
+        (Some(64), Some(8), Some("sppm"))
     );
-    assert!(info["residual_rmse"].as_f64().unwrap() > 0.0);
+    assert!(info["residual_noise_rmse"].as_f64().unwrap() > 0.0);
+    assert!(info["residual_bias_rmse"].as_f64().unwrap() >= 0.0);
     assert!(info["command"]
         .as_str()
         .unwrap()
@@ -563,10 +563,17 @@ fn reference_and_accuracy_bench_write_their_results() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let runs = v["runs"].as_array().unwrap();
     assert!(runs.len() >= 10, "{} runs", runs.len());
-    assert!(runs
-        .iter()
-        .all(|r| r["total_seconds"].as_f64().unwrap() > 0.0
-            && r["metrics"]["rel_mse"].as_f64().unwrap() >= 0.0));
+    let num = |r: &serde_json::Value, f: &str| r[f].as_f64().unwrap();
+    for r in runs {
+        assert!(num(r, "seconds") > 0.0 && num(r, "rmse") > 0.0, "{r}");
+        // Bias and noise split one render's error: neither exceeds it by much.
+        assert!(
+            num(r, "bias_rmse") >= 0.0 && num(r, "noise_rmse") > 0.0,
+            "{r}"
+        );
+    }
+    assert!(runs.iter().any(|r| r["method"] == "sppm"));
+    assert!(runs.iter().any(|r| r["method"] == "paper"));
     let front: Vec<&serde_json::Value> = runs
         .iter()
         .filter(|r| r["on_pareto_front"] == true)
@@ -574,14 +581,10 @@ fn reference_and_accuracy_bench_write_their_results() {
     assert!(!front.is_empty());
     // No run on the front is beaten on both time and error by another.
     for f in &front {
-        let (t, e) = (
-            f["total_seconds"].as_f64().unwrap(),
-            f["metrics"]["rel_mse"].as_f64().unwrap(),
-        );
-        assert!(
-            !runs.iter().any(|r| r["total_seconds"].as_f64().unwrap() < t
-                && r["metrics"]["rel_mse"].as_f64().unwrap() < e)
-        );
+        let (t, e) = (num(f, "seconds"), num(f, "rmse"));
+        assert!(!runs
+            .iter()
+            .any(|r| num(r, "seconds") < t && num(r, "rmse") < e));
     }
     assert!(runs.iter().any(|r| r["label"] == v["recommended"]));
     for f in [

@@ -1,72 +1,25 @@
-//! `photonmap reference` (a converged reference made by this project's own
-//! pipeline) and `photonmap bench accuracy` (run time against error around a
-//! scene's defaults, and the Pareto front).
+//! `photonmap bench accuracy`: run time against error around a scene's
+//! defaults, measured against an SPPM reference (truth, not the paper's
+//! estimator agreeing with itself). Each configuration renders several seeds,
+//! so its error splits into bias (what more seeds would not remove) and noise
+//! (what they would); SPPM runs sit on the same front.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::image::write_atomically;
-use photonmap::metrics::{compare, Metrics};
-use photonmap::photon::{BuildMethod, PhotonConfig};
-use photonmap::render::{render, EstimateMode, GlobalIllumination, Image, RenderOptions};
-use photonmap::scene::{embedded, Scene};
+use photonmap::metrics::compare;
+use photonmap::photon::BuildMethod;
+use photonmap::render::radiance_estimate::LeakTest;
+use photonmap::render::sppm::{render_sppm, SppmOptions};
+use photonmap::render::{render, EstimateMode, Image};
+use photonmap::scene::{embedded, Light, Scene};
 
-/// Render a converged reference of a scene (more photons, larger k, several
-/// eye samples, many seeds averaged) as EXR, with its command and residual noise.
-#[derive(Args)]
-pub struct ReferenceArgs {
-    /// Scene file, or the name of an embedded scene.
-    pub scene: PathBuf,
-    /// Output EXR (default: reference_images/<scene>.converged.exr under the
-    /// current folder; a .json goes beside it).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Render at 1/scale of the scene's resolution (1..=16).
-    #[arg(long, default_value_t = 2, value_parser = super::args::in_range(1, 16))]
-    pub scale: u32,
-    /// Photons stored x this; k x its square root (1..=64).
-    #[arg(long, default_value_t = 8, value_parser = super::args::in_range(1, 64))]
-    pub photons_factor: u32,
-    /// Renders averaged (2..=256).
-    #[arg(long, default_value_t = 8, value_parser = super::args::in_range(2, 256))]
-    pub seeds: u32,
-    /// Eye samples per pixel of each (1..=256).
-    #[arg(long, default_value_t = 4, value_parser = super::args::in_range(1, 256))]
-    pub spp: u32,
-}
-
-pub fn run_reference(a: &ReferenceArgs, platform: Platform) -> Result<()> {
-    let scene = embedded::load_path_or_name(&a.scene)?;
-    let out = a.out.clone().unwrap_or_else(|| default_reference(&a.scene));
-    super::check_output(&out, "exr", "--out")?;
-    let gpu = super::gpu(platform)?;
-    let command = format!(
-        "photonmap reference {} --scale {} --photons-factor {} --seeds {} --spp {}",
-        a.scene.display(),
-        a.scale,
-        a.photons_factor,
-        a.seeds,
-        a.spp
-    );
-    let options = ReferenceOptions {
-        scale: a.scale,
-        photons_factor: a.photons_factor,
-        seeds: a.seeds,
-        spp: a.spp,
-    };
-    let (img, info) = make_reference(&gpu, &scene, &options, command, &|m: &str| eprintln!("{m}"))?;
-    write_reference(&img, &info, &out)?;
-    eprintln!(
-        "wrote {} (residual RMSE {:.6})",
-        out.display(),
-        info.residual_rmse
-    );
-    Ok(())
-}
+use super::reference::{read_reference, reference_options, ReferenceInfo};
 
 /// `bench accuracy`'s options.
 #[derive(Args)]
@@ -74,48 +27,185 @@ pub struct AccuracyArgs {
     /// Scene file, or the name of an embedded scene.
     #[arg(long)]
     pub scene: PathBuf,
-    /// The converged reference (default: reference_images/<scene>.converged.exr
-    /// under the current folder).
+    /// The SPPM reference (`photonmap reference`; default:
+    /// photonmap-out/reference/<scene>.sppm.exr, then
+    /// reference_images/<scene>.sppm.exr, under the current folder).
     #[arg(long)]
     pub reference: Option<PathBuf>,
-    /// Output folder (default: results/<renderer>/accuracy/<scene>/).
+    /// Output folder (default: photonmap-out/accuracy/<scene>/).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// A small sweep.
+    /// A small sweep with two seeds a configuration.
     #[arg(long)]
     pub quick: bool,
+    /// Seeds per configuration (2..=64; default 4, or 2 with --quick).
+    #[arg(long, value_parser = super::args::in_range(2, 64))]
+    pub seeds: Option<u32>,
     #[arg(long)]
     pub json: bool,
     #[arg(long)]
     pub quiet: bool,
 }
 
+/// One configuration's renders against the reference.
+#[derive(Serialize, Clone, Debug)]
+pub struct AccuracyRun {
+    pub label: String,
+    /// "paper" (the one-shot kNN estimate) or "sppm".
+    pub method: String,
+    pub photons_stored: u32,
+    pub k: u32,
+    pub max_radius: f32,
+    pub leak: LeakTest,
+    pub shadow_rays: u32,
+    pub build: BuildMethod,
+    pub tile: u32,
+    pub spp: u32,
+    pub sppm_iterations: u32,
+    /// Wall seconds of one render (mean over the seeds).
+    pub seconds: f64,
+    /// RMSE of one render against the reference (mean over the seeds).
+    pub rmse: f64,
+    /// The part of it more seeds would not remove: the RMSE of the seeds'
+    /// mean, less its noise and the reference's.
+    pub bias_rmse: f64,
+    /// The part they would: the RMS over pixels of one render's standard deviation.
+    pub noise_rmse: f64,
+    pub rel_mse: f64,
+    pub ssim: f64,
+    pub on_pareto_front: bool,
+}
+
+#[derive(Serialize)]
+pub struct AccuracyReport {
+    pub scene: String,
+    pub reference: ReferenceInfo,
+    pub renderer: String,
+    pub seeds: u32,
+    pub runs: Vec<AccuracyRun>,
+    /// The front's fastest run within 10% of the least RMSE.
+    pub recommended: String,
+}
+
+#[derive(Clone)]
+struct Config {
+    run: AccuracyRun,
+}
+
+impl Config {
+    fn paper(scene: &Scene) -> Self {
+        Self {
+            run: AccuracyRun {
+                label: "scene defaults".into(),
+                method: "paper".into(),
+                photons_stored: scene.photon_map.photons_stored,
+                k: scene.photon_map.k,
+                max_radius: scene.photon_map.max_radius,
+                leak: LeakTest::Visibility,
+                shadow_rays: scene.render.shadow_rays,
+                build: BuildMethod::Bitonic,
+                tile: 16,
+                spp: 1,
+                sppm_iterations: 0,
+                seconds: 0.0,
+                rmse: 0.0,
+                bias_rmse: 0.0,
+                noise_rmse: 0.0,
+                rel_mse: 0.0,
+                ssim: 0.0,
+                on_pareto_front: false,
+            },
+        }
+    }
+
+    fn with(&self, label: String, f: impl FnOnce(&mut AccuracyRun)) -> Self {
+        let mut c = self.clone();
+        c.run.label = label;
+        f(&mut c.run);
+        c
+    }
+}
+
+/// The sweep: one parameter at a time around the scene's defaults, the leak
+/// tests, and SPPM at several iteration counts.
+fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
+    let base = Config::paper(scene);
+    let mut out = vec![base.clone()];
+    let factors: &[f32] = if quick {
+        &[0.5, 2.0]
+    } else {
+        &[0.25, 0.5, 2.0, 4.0]
+    };
+    for &f in factors {
+        out.push(base.with(format!("photons x{f}"), |r| {
+            r.photons_stored = ((r.photons_stored as f32 * f) as u32).max(16)
+        }));
+        out.push(base.with(format!("k x{f}"), |r| {
+            r.k = ((r.k as f32 * f) as u32).max(1)
+        }));
+        out.push(base.with(format!("max radius x{f}"), |r| r.max_radius *= f));
+    }
+    for leak in [LeakTest::None, LeakTest::Disc, LeakTest::DiscAndVisibility] {
+        out.push(
+            base.with(format!("leak test {leak:?}").to_lowercase(), |r| {
+                r.leak = leak
+            }),
+        );
+    }
+    if scene.lights.iter().any(|l| matches!(l, Light::Area { .. })) {
+        for s in if quick { vec![1] } else { vec![1, 16] } {
+            if s != base.run.shadow_rays {
+                out.push(base.with(format!("{s} shadow rays"), |r| r.shadow_rays = s));
+            }
+        }
+    }
+    if !quick {
+        out.push(base.with("stencil routing".into(), |r| r.build = BuildMethod::Stencil));
+        out.push(base.with("full screen".into(), |r| r.tile = 0));
+    }
+    for spp in if quick { vec![4] } else { vec![4, 16] } {
+        out.push(base.with(format!("{spp} spp"), |r| r.spp = spp));
+    }
+    for it in if quick {
+        vec![4, 16]
+    } else {
+        vec![4, 16, 64, 256]
+    } {
+        out.push(base.with(format!("SPPM {it} iterations"), |r| {
+            r.method = "sppm".into();
+            r.sppm_iterations = it;
+        }));
+    }
+    out
+}
+
 pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
     let scene = embedded::load_path_or_name(&a.scene)?;
-    let reference = a
-        .reference
-        .clone()
-        .unwrap_or_else(|| default_reference(&a.scene));
+    let reference = match &a.reference {
+        Some(r) => r.clone(),
+        None => default_reference(&a.scene),
+    };
     if !reference.is_file() {
         bail!(
-            "no converged reference at {}: make one with `photonmap reference {}`",
+            "no SPPM reference at {}: make one with `photonmap reference {}` (or give --reference)",
             reference.display(),
             a.scene.display()
         );
     }
     let gpu = super::gpu(platform)?;
+    let seeds = a.seeds.unwrap_or(if a.quick { 2 } else { 4 });
     let report = bench_accuracy(
         &gpu,
         &scene,
         &reference,
         a.quick,
+        seeds,
         &super::progress_lines(a.quiet),
     )?;
-    let dir = a.out.clone().unwrap_or_else(|| {
-        super::tables::default_out(&report.renderer)
-            .join("accuracy")
-            .join(stem(&a.scene))
-    });
+    let dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::out_dir("accuracy").join(stem(&a.scene)));
     std::fs::create_dir_all(&dir)?;
     let write = |name: &str, bytes: &[u8]| write_atomically(&dir.join(name), bytes);
     write("accuracy.csv", csv(&report).as_bytes())?;
@@ -126,23 +216,26 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
     write("accuracy.svg", svg_plot(&report).as_bytes())?;
     write("accuracy.png", &png_plot(&report))?;
     if a.json {
-        return super::print_json(&report);
-    }
-    println!(
-        "{:<18} {:>9} {:>11} {:>8} {:>7}",
-        "run", "seconds", "rel. MSE", "SSIM", "front"
-    );
-    for r in &report.runs {
+        super::print_json(&report)?;
+    } else {
         println!(
-            "{:<18} {:>9.3} {:>11.5} {:>8.4} {:>7}",
-            r.label,
-            r.total_seconds,
-            r.metrics.rel_mse,
-            r.metrics.ssim,
-            if r.on_pareto_front { "*" } else { "" }
+            "{:<26} {:>8} {:>9} {:>9} {:>9} {:>7} {:>5}",
+            "run", "seconds", "RMSE", "bias", "noise", "SSIM", "front"
         );
+        for r in &report.runs {
+            println!(
+                "{:<26} {:>8.3} {:>9.5} {:>9.5} {:>9.5} {:>7.4} {:>5}",
+                r.label,
+                r.seconds,
+                r.rmse,
+                r.bias_rmse,
+                r.noise_rmse,
+                r.ssim,
+                if r.on_pareto_front { "*" } else { "" }
+            );
+        }
+        println!("recommended: {}", report.recommended);
     }
-    println!("recommended: {}", report.recommended);
     eprintln!("wrote {}", dir.display());
     Ok(())
 }
@@ -154,197 +247,52 @@ fn stem(scene: &Path) -> String {
         .unwrap_or_default()
 }
 
-#[derive(Serialize, Deserialize, Debug, Clone)]
-pub struct ReferenceInfo {
-    pub scene: String,
-    pub width: u32,
-    pub height: u32,
-    pub photons_stored: u32,
-    pub k: u32,
-    pub max_radius: f32,
-    pub spp: u32,
-    pub seeds: u32,
-    /// RMSE between the means of the even and the odd seeds, halved: the
-    /// residual noise of the full mean.
-    pub residual_rmse: f64,
-    pub command: String,
-    pub renderer: String,
+/// The reference `bench accuracy` looks for: photonmap-out/reference/ first,
+/// then the committed reference_images/.
+pub fn default_reference(scene: &Path) -> PathBuf {
+    let name = format!("{}.sppm.exr", stem(scene));
+    let made = super::out_dir("reference").join(&name);
+    if made.is_file() {
+        made
+    } else {
+        PathBuf::from("reference_images").join(name)
+    }
 }
 
-pub struct ReferenceOptions {
-    pub scale: u32,
-    pub photons_factor: u32,
-    pub seeds: u32,
-    pub spp: u32,
-}
-
-/// Renders the converged reference: photons x factor, k x sqrt(factor) (the
-/// radius shrinks as the density grows, so bias falls with the noise), spp
-/// eye samples, `seeds` renders averaged.
-pub fn make_reference(
+/// One render of a configuration with `seed`: its image and wall seconds.
+fn render_config(
     gpu: &Gpu,
     scene: &Scene,
-    o: &ReferenceOptions,
-    command: String,
-    progress: &dyn Fn(&str),
-) -> Result<(Image, ReferenceInfo)> {
+    c: &AccuracyRun,
+    scale: u32,
+    seed: u32,
+) -> Result<(Image, f64)> {
     let mut s = scene.clone();
-    s.photon_map.photons_stored = scene
-        .photon_map
-        .photons_stored
-        .saturating_mul(o.photons_factor);
-    s.photon_map.k =
-        ((scene.photon_map.k as f64) * (o.photons_factor as f64).sqrt()).round() as u32;
-    let mut images = Vec::new();
-    for seed in 1..=o.seeds {
-        progress(&format!(
-            "reference {}: seed {seed}/{}",
-            scene.name, o.seeds
-        ));
-        let mut opts = RenderOptions::for_scene(&s);
-        opts.width = (scene.camera.width / o.scale).max(1);
-        opts.height = (scene.camera.height / o.scale).max(1);
-        opts.spp = o.spp;
-        opts.seed = 1000 + seed;
-        images.push(render(gpu, &s, &opts, &mut ())?.image);
-    }
-    let even: Vec<Image> = images.iter().step_by(2).cloned().collect();
-    let odd: Vec<Image> = images.iter().skip(1).step_by(2).cloned().collect();
-    let residual = compare(&Image::average(&even), &Image::average(&odd), None)?.rmse / 2.0;
-    let img = Image::average(&images);
-    let info = ReferenceInfo {
-        scene: scene.name.clone(),
-        width: img.width,
-        height: img.height,
-        photons_stored: s.photon_map.photons_stored,
-        k: s.photon_map.k,
-        max_radius: s.photon_map.max_radius,
-        spp: o.spp,
-        seeds: o.seeds,
-        residual_rmse: residual,
-        command,
-        renderer: gpu.capabilities().gl_renderer,
-    };
-    Ok((img, info))
-}
-
-pub fn write_reference(img: &Image, info: &ReferenceInfo, exr: &Path) -> Result<()> {
-    write_atomically(exr, &img.exr_bytes()?)?;
-    write_atomically(
-        &exr.with_extension("json"),
-        (serde_json::to_string_pretty(info)? + "\n").as_bytes(),
-    )?;
-    Ok(())
-}
-
-#[derive(Serialize, Clone, Debug)]
-pub struct AccuracyRun {
-    pub label: String,
-    pub photons_stored: u32,
-    pub k: u32,
-    pub max_radius: f32,
-    pub shadow_rays: u32,
-    pub build: BuildMethod,
-    pub tile: u32,
-    pub spp: u32,
-    pub trace_photons_seconds: f64,
-    pub build_map_seconds: f64,
-    pub trace_rays_seconds: f64,
-    pub radiance_estimate_seconds: f64,
-    pub total_seconds: f64,
-    pub metrics: Metrics,
-    pub on_pareto_front: bool,
-}
-
-#[derive(Serialize)]
-pub struct AccuracyReport {
-    pub scene: String,
-    pub reference: ReferenceInfo,
-    pub renderer: String,
-    pub runs: Vec<AccuracyRun>,
-    /// The front's run with the least relative MSE per second spent, or the fastest within 10% of the best error.
-    pub recommended: String,
-}
-
-#[derive(Clone)]
-struct Config {
-    label: String,
-    photons_stored: u32,
-    k: u32,
-    max_radius: f32,
-    shadow_rays: u32,
-    build: BuildMethod,
-    tile: u32,
-    spp: u32,
-}
-
-fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
-    let base = Config {
-        label: "scene defaults".into(),
-        photons_stored: scene.photon_map.photons_stored,
-        k: scene.photon_map.k,
-        max_radius: scene.photon_map.max_radius,
-        shadow_rays: scene.render.shadow_rays,
-        build: BuildMethod::Bitonic,
-        tile: 16,
-        spp: 1,
-    };
-    let mut out = vec![base.clone()];
-    let factors: &[f32] = if quick {
-        &[0.5, 2.0]
+    s.photon_map.photons_stored = c.photons_stored;
+    s.photon_map.k = c.k;
+    s.photon_map.max_radius = c.max_radius;
+    s.render.shadow_rays = c.shadow_rays;
+    let mut o = reference_options(&s, scale, seed);
+    o.spp = c.spp;
+    let gi = o.global.as_mut().expect("global illumination");
+    gi.photons.build = c.build;
+    gi.estimate.leak = c.leak;
+    gi.estimate.mode = if c.tile == 0 {
+        EstimateMode::FullScreen
     } else {
-        &[0.25, 0.5, 2.0, 4.0]
+        EstimateMode::Tiled { tile: c.tile }
     };
-    for &f in factors {
-        out.push(Config {
-            label: format!("photons x{f}"),
-            photons_stored: ((base.photons_stored as f32 * f) as u32).max(16),
-            ..base.clone()
-        });
-        out.push(Config {
-            label: format!("k x{f}"),
-            k: ((base.k as f32 * f) as u32).max(1),
-            ..base.clone()
-        });
-        out.push(Config {
-            label: format!("max radius x{f}"),
-            max_radius: base.max_radius * f,
-            ..base.clone()
-        });
-    }
-    let has_area = scene
-        .lights
-        .iter()
-        .any(|l| matches!(l, photonmap::scene::Light::Area { .. }));
-    if has_area {
-        for s in if quick { vec![1] } else { vec![1, 16] } {
-            if s != base.shadow_rays {
-                out.push(Config {
-                    label: format!("{s} shadow rays"),
-                    shadow_rays: s,
-                    ..base.clone()
-                });
-            }
-        }
-    }
-    out.push(Config {
-        label: "stencil routing".into(),
-        build: BuildMethod::Stencil,
-        ..base.clone()
-    });
-    out.push(Config {
-        label: "full screen".into(),
-        tile: 0,
-        ..base.clone()
-    });
-    for spp in if quick { vec![4] } else { vec![4, 16] } {
-        out.push(Config {
-            label: format!("{spp} spp"),
-            spp,
-            ..base.clone()
-        });
-    }
-    out
+    let wall = std::time::Instant::now();
+    let image = if c.method == "sppm" {
+        let sppm = SppmOptions {
+            iterations: c.sppm_iterations,
+            ..SppmOptions::default()
+        };
+        render_sppm(gpu, &s, &o, &sppm, &mut ())?.image
+    } else {
+        render(gpu, &s, &o, &mut ())?.image
+    };
+    Ok((image, wall.elapsed().as_secs_f64()))
 }
 
 pub fn bench_accuracy(
@@ -352,134 +300,133 @@ pub fn bench_accuracy(
     scene: &Scene,
     reference: &Path,
     quick: bool,
+    seeds: u32,
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
-    let reference_img = Image::read_exr(reference)?;
-    let info: ReferenceInfo = serde_json::from_str(
-        &std::fs::read_to_string(reference.with_extension("json"))
-            .with_context(|| format!("reading {}", reference.with_extension("json").display()))?,
-    )
-    .context("the reference's JSON")?;
+    let (reference_img, info) = read_reference(reference)?;
+    if reference_img.width == 0 || scene.camera.width % reference_img.width != 0 {
+        bail!(
+            "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
+            reference.display(),
+            reference_img.width,
+            reference_img.height,
+            scene.camera.width,
+            scene.camera.height
+        );
+    }
+    let scale = scene.camera.width / reference_img.width;
     let configs = sweep(scene, quick);
     let mut runs = Vec::new();
     for (i, c) in configs.iter().enumerate() {
-        progress(&format!("{} ({}/{})", c.label, i + 1, configs.len()));
-        let mut s = scene.clone();
-        s.photon_map.photons_stored = c.photons_stored;
-        s.photon_map.k = c.k;
-        s.photon_map.max_radius = c.max_radius;
-        s.render.shadow_rays = c.shadow_rays;
-        let mut o = RenderOptions::for_scene(&s);
-        (o.width, o.height, o.spp, o.seed) = (reference_img.width, reference_img.height, c.spp, 7);
-        let mut gi = GlobalIllumination {
-            photons: PhotonConfig {
-                build: c.build,
-                ..PhotonConfig::default()
-            },
-            ..GlobalIllumination::default()
-        };
-        gi.estimate.mode = if c.tile == 0 {
-            EstimateMode::FullScreen
-        } else {
-            EstimateMode::Tiled { tile: c.tile }
-        };
-        o.global = Some(gi);
-        let r = render(gpu, &s, &o, &mut ())?;
-        let stage = |names: &[&str]| {
-            r.timings
-                .stages
-                .iter()
-                .filter(|st| names.contains(&st.name.as_str()))
-                .map(|st| st.wall_seconds)
-                .sum::<f64>()
-        };
-        let metrics = compare(&r.image, &reference_img, None)?;
-        let (tp, bm, tr, re) = (
-            stage(&["trace photons"]),
-            stage(&["build map"]),
-            stage(&["eye rays", "intersect", "shadow rays", "specular"]),
-            stage(&["radiance estimate"]),
-        );
-        runs.push(AccuracyRun {
-            label: c.label.clone(),
-            photons_stored: c.photons_stored,
-            k: c.k,
-            max_radius: c.max_radius,
-            shadow_rays: c.shadow_rays,
-            build: c.build,
-            tile: c.tile,
-            spp: c.spp,
-            trace_photons_seconds: tp,
-            build_map_seconds: bm,
-            trace_rays_seconds: tr,
-            radiance_estimate_seconds: re,
-            total_seconds: tp + bm + tr + re,
-            metrics,
-            on_pareto_front: false,
-        });
+        progress(&format!("{} ({}/{})", c.run.label, i + 1, configs.len()));
+        let mut images = Vec::new();
+        let mut seconds = 0.0;
+        for seed in 0..seeds {
+            let (img, s) = render_config(gpu, scene, &c.run, scale, 7 + seed)?;
+            images.push(img);
+            seconds += s;
+        }
+        let split = bias_and_noise(&images, &reference_img, info.residual_noise_rmse)?;
+        let one: Vec<_> = images
+            .iter()
+            .map(|img| compare(img, &reference_img, None))
+            .collect::<Result<_, _>>()?;
+        let n = images.len() as f64;
+        let mut run = c.run.clone();
+        run.seconds = seconds / n;
+        run.rmse = one.iter().map(|m| m.rmse).sum::<f64>() / n;
+        run.rel_mse = one.iter().map(|m| m.rel_mse).sum::<f64>() / n;
+        run.ssim = one.iter().map(|m| m.ssim).sum::<f64>() / n;
+        (run.bias_rmse, run.noise_rmse) = split;
+        runs.push(run);
     }
-    // Pareto front on (total seconds, relative MSE): no other run is both faster and better.
-    for i in 0..runs.len() {
-        let dominated = runs.iter().enumerate().any(|(j, o)| {
-            j != i
-                && o.total_seconds <= runs[i].total_seconds
-                && o.metrics.rel_mse <= runs[i].metrics.rel_mse
-                && (o.total_seconds < runs[i].total_seconds
-                    || o.metrics.rel_mse < runs[i].metrics.rel_mse)
-        });
-        runs[i].on_pareto_front = !dominated;
-    }
-    let best = runs
-        .iter()
-        .map(|r| r.metrics.rel_mse)
-        .fold(f64::INFINITY, f64::min);
+    mark_front(&mut runs);
+    let best = runs.iter().map(|r| r.rmse).fold(f64::INFINITY, f64::min);
     let recommended = runs
         .iter()
-        .filter(|r| r.on_pareto_front && r.metrics.rel_mse <= best * 1.1)
-        .min_by(|a, b| a.total_seconds.total_cmp(&b.total_seconds))
+        .filter(|r| r.on_pareto_front && r.rmse <= best * 1.1)
+        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
         .map(|r| r.label.clone())
         .unwrap_or_default();
     Ok(AccuracyReport {
         scene: scene.name.clone(),
         reference: info,
         renderer: gpu.capabilities().gl_renderer,
+        seeds,
         runs,
         recommended,
     })
 }
 
+/// Bias and noise of one render, as RMS over pixels: noise from the per-pixel
+/// spread of the seeds, bias from the seeds' mean against the reference with
+/// the mean's own noise and the reference's removed.
+fn bias_and_noise(images: &[Image], reference: &Image, reference_noise: f64) -> Result<(f64, f64)> {
+    let n = images.len() as f64;
+    let mean = Image::average(images);
+    let mut variance = 0.0;
+    for (i, m) in mean.pixels.iter().enumerate() {
+        for c in 0..3 {
+            let v: f64 = images
+                .iter()
+                .map(|img| (img.pixels[i][c] as f64 - m[c] as f64).powi(2))
+                .sum::<f64>()
+                / (n - 1.0);
+            variance += v;
+        }
+    }
+    variance /= (mean.pixels.len() * 3) as f64;
+    let mean_error = photonmap::metrics::rmse(&mean, reference)?;
+    let bias2 = mean_error * mean_error - variance / n - reference_noise * reference_noise;
+    Ok((bias2.max(0.0).sqrt(), variance.sqrt()))
+}
+
+/// The Pareto front on (seconds, RMSE): no other run is both faster and better.
+fn mark_front(runs: &mut [AccuracyRun]) {
+    for i in 0..runs.len() {
+        let dominated = runs.iter().enumerate().any(|(j, o)| {
+            j != i
+                && o.seconds <= runs[i].seconds
+                && o.rmse <= runs[i].rmse
+                && (o.seconds < runs[i].seconds || o.rmse < runs[i].rmse)
+        });
+        runs[i].on_pareto_front = !dominated;
+    }
+}
+
 pub fn csv(r: &AccuracyReport) -> String {
-    let mut s = String::from("label,photons_stored,k,max_radius,shadow_rays,build,tile,spp,trace_photons_s,build_map_s,trace_rays_s,radiance_estimate_s,total_s,rmse,rel_mse,ssim,pareto\n");
+    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,tile,spp,sppm_iterations,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
     for x in &r.runs {
         s += &format!(
-            "{},{},{},{},{},{:?},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6},{:.6},{:.6},{}\n",
+            "{},{},{},{},{},{:?},{},{:?},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
             x.label,
+            x.method,
             x.photons_stored,
             x.k,
             x.max_radius,
+            x.leak,
             x.shadow_rays,
             x.build,
             x.tile,
             x.spp,
-            x.trace_photons_seconds,
-            x.build_map_seconds,
-            x.trace_rays_seconds,
-            x.radiance_estimate_seconds,
-            x.total_seconds,
-            x.metrics.rmse,
-            x.metrics.rel_mse,
-            x.metrics.ssim,
+            x.sppm_iterations,
+            x.seconds,
+            x.rmse,
+            x.bias_rmse,
+            x.noise_rmse,
+            x.rel_mse,
+            x.ssim,
             x.on_pareto_front
         );
     }
     s
 }
 
-/// Each run's log10 seconds and log10 relative MSE (floored above zero): the
-/// points both plots draw.
+/// Each run's log10 seconds and log10 RMSE (floored above zero): the points
+/// both plots draw.
 fn log_points(r: &AccuracyReport) -> (Vec<f64>, Vec<f64>) {
-    let xs = r.runs.iter().map(|x| x.total_seconds.max(1e-4).log10());
-    let ys = r.runs.iter().map(|x| x.metrics.rel_mse.max(1e-9).log10());
+    let xs = r.runs.iter().map(|x| x.seconds.max(1e-4).log10());
+    let ys = r.runs.iter().map(|x| x.rmse.max(1e-9).log10());
     (xs.collect(), ys.collect())
 }
 
@@ -503,7 +450,7 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
     let px = |x: f64| m + (x - x0) / (x1 - x0) * (w - 2.0 * m);
     let py = |y: f64| h - m - (y - y0) / (y1 - y0) * (h - 2.0 * m);
     let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n");
-    s += &format!("<text x=\"{}\" y=\"22\" font-size=\"15\" text-anchor=\"middle\">{}: relative MSE against run time (log-log)</text>\n", w / 2.0, r.scene);
+    s += &format!("<text x=\"{}\" y=\"22\" font-size=\"15\" text-anchor=\"middle\">{}: RMSE against the SPPM reference, by run time (log-log)</text>\n", w / 2.0, r.scene);
     s += &format!("<line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n<line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>\n", h - m, w - m, h - m, h - m);
     for d in x0 as i64..=x1 as i64 {
         let x = px(d as f64);
@@ -513,8 +460,12 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
         let y = py(d as f64);
         s += &format!("<line x1=\"{}\" y1=\"{y}\" x2=\"{m}\" y2=\"{y}\" stroke=\"black\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{d}</text>\n", m - 5.0, m - 8.0, y + 4.0);
     }
-    s += &format!("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">total seconds (trace photons + build map + trace rays + estimate)</text>\n", w / 2.0, h - 20.0);
-    s += &format!("<text x=\"18\" y=\"{}\" transform=\"rotate(-90 18 {})\" text-anchor=\"middle\">relative MSE against the converged reference</text>\n", h / 2.0, h / 2.0);
+    s += &format!(
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">seconds per render (wall clock)</text>\n",
+        w / 2.0,
+        h - 20.0
+    );
+    s += &format!("<text x=\"18\" y=\"{}\" transform=\"rotate(-90 18 {})\" text-anchor=\"middle\">RMSE of one render (bias and noise)</text>\n", h / 2.0, h / 2.0);
     let mut front: Vec<usize> = (0..r.runs.len())
         .filter(|&i| r.runs[i].on_pareto_front)
         .collect();
@@ -528,10 +479,10 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
         path.join(" ")
     );
     for (i, run) in r.runs.iter().enumerate() {
-        let colour = if run.on_pareto_front {
-            "#d62728"
-        } else {
-            "#1f77b4"
+        let colour = match (run.on_pareto_front, run.method.as_str()) {
+            (true, _) => "#d62728",
+            (false, "sppm") => "#2ca02c",
+            _ => "#1f77b4",
         };
         s += &format!(
             "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{colour}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"9\">{}</text>\n",
@@ -592,10 +543,10 @@ pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
         }
     }
     for (i, run) in r.runs.iter().enumerate() {
-        let c = if run.on_pareto_front {
-            [214, 39, 40]
-        } else {
-            [31, 119, 180]
+        let c = match (run.on_pareto_front, run.method.as_str()) {
+            (true, _) => [214, 39, 40],
+            (false, "sppm") => [44, 160, 44],
+            _ => [31, 119, 180],
         };
         for dy in -3..=3i64 {
             for dx in -3..=3i64 {
@@ -609,9 +560,4 @@ pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
     img.write_to(&mut out, image::ImageFormat::Png)
         .expect("encoding a PNG in memory");
     out.into_inner()
-}
-
-/// reference_images/<scene>.converged.exr under the current folder.
-pub fn default_reference(scene: &Path) -> PathBuf {
-    PathBuf::from("reference_images").join(format!("{}.converged.exr", stem(scene)))
 }

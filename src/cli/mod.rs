@@ -7,6 +7,7 @@ pub mod bench;
 pub mod compare;
 pub mod info;
 pub mod photons;
+pub mod reference;
 pub mod render;
 pub mod scenes;
 pub mod tables;
@@ -43,6 +44,13 @@ pub fn check_output(path: &Path, extension: &str, flag: &str) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Where a command writes when no `--out` is given: photonmap-out/<kind>/
+/// under the current folder (git ignores it in this repository), never the
+/// committed results or references.
+pub fn out_dir(kind: &str) -> std::path::PathBuf {
+    std::path::Path::new("photonmap-out").join(kind)
 }
 
 /// Prints `value` as pretty JSON on stdout.

@@ -148,7 +148,8 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// results/<first word of the renderer, lower case>/
+/// photonmap-out/tables/<first word of the renderer, lower case>/: the
+/// committed results/ change only when named with --out.
 pub fn default_out(renderer: &str) -> PathBuf {
     let word: String = renderer
         .split_whitespace()
@@ -158,7 +159,7 @@ pub fn default_out(renderer: &str) -> PathBuf {
         .filter(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
         .collect::<String>()
         .to_lowercase();
-    PathBuf::from("results").join(if word.is_empty() {
+    super::out_dir("tables").join(if word.is_empty() {
         "unknown".into()
     } else {
         word
