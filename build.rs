@@ -43,7 +43,24 @@ fn table(name: &str, folder: &str, extensions: &[&str]) -> String {
     code + "];\n"
 }
 
+/// The commit being built, when this is a git checkout with git at hand, for
+/// the provenance every output records.
+fn git_commit() {
+    println!("cargo:rerun-if-changed=.git/HEAD");
+    println!("cargo:rerun-if-changed=.git/refs/heads");
+    let head = std::process::Command::new("git")
+        .args(["rev-parse", "--short=12", "HEAD"])
+        .output();
+    if let Ok(out) = head {
+        let commit = String::from_utf8_lossy(&out.stdout).trim().to_string();
+        if out.status.success() && !commit.is_empty() {
+            println!("cargo:rustc-env=PHOTONMAP_GIT_COMMIT={commit}");
+        }
+    }
+}
+
 fn main() {
+    git_commit();
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     std::fs::write(
         out.join("glsl_sources.rs"),

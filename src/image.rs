@@ -119,11 +119,23 @@ impl Image {
 
     /// Linear float RGB OpenEXR, the same orientation as the PNG.
     pub fn exr_bytes(&self) -> Result<Vec<u8>> {
+        self.exr_bytes_with(&[])
+    }
+
+    /// The EXR with text attributes (provenance) in its header.
+    pub fn exr_bytes_with(&self, attributes: &[(String, String)]) -> Result<Vec<u8>> {
         use exr::prelude::*;
         let w = self.width as usize;
+        let mut layer_attributes = LayerAttributes::named("rgb");
+        for (k, v) in attributes {
+            // EXR text is Latin-1: anything else is left out rather than mangled.
+            if let (Some(k), Some(v)) = (Text::new_or_none(k), Text::new_or_none(v)) {
+                layer_attributes.other.insert(k, AttributeValue::Text(v));
+            }
+        }
         let layer = Layer::new(
             (w, self.height as usize),
-            LayerAttributes::named("rgb"),
+            layer_attributes,
             Encoding::SMALL_LOSSLESS,
             SpecificChannels::rgb(|pos: Vec2<usize>| {
                 let p = self.pixels[pos.y() * w + pos.x()];
@@ -136,6 +148,36 @@ impl Image {
             .to_buffered(&mut out)
             .map_err(|e| crate::error::Error::Image(format!("encoding an EXR: {e}")))?;
         Ok(out.into_inner())
+    }
+
+    /// Portable float map (PFM): linear RGB as little-endian f32, bottom row first.
+    pub fn pfm_bytes(&self) -> Vec<u8> {
+        let mut out = format!("PF\n{} {}\n-1.0\n", self.width, self.height).into_bytes();
+        for row in (0..self.height).rev() {
+            for x in 0..self.width {
+                for c in self.get(x, row) {
+                    out.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+        }
+        out
+    }
+
+    /// Text attributes of an EXR's first layer (the provenance of our own files).
+    pub fn exr_attributes(path: &Path) -> Result<Vec<(String, String)>> {
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| {
+            crate::error::Error::Image(format!("cannot read EXR {}: {e}", path.display()))
+        })?;
+        let mut out = Vec::new();
+        if let Some(h) = meta.headers.first() {
+            for (k, v) in &h.own_attributes.other {
+                if let exr::meta::attribute::AttributeValue::Text(t) = v {
+                    out.push((k.to_string(), t.to_string()));
+                }
+            }
+        }
+        out.sort();
+        Ok(out)
     }
 
     pub fn read_exr(path: &Path) -> Result<Self> {
@@ -167,34 +209,108 @@ impl Image {
     }
 }
 
-/// Writes `bytes` to `path` all or nothing: a temporary file beside it, then a
-/// rename, so a failure never leaves a partial image behind.
+/// Writes `bytes` to `path` all or nothing (see `write_all_atomically`).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_all_atomically(&[(path, bytes)])
+}
+
+/// Writes every file all or nothing: each into a temporary file beside it
+/// (so the rename stays on one file system), flushed to disk; only when every
+/// one is written are they renamed into place. A failure on the way (a full
+/// disk, a folder that vanished) removes the temporaries: no file appears and
+/// the files there before stay as they were.
+pub fn write_all_atomically(files: &[(&Path, &[u8])]) -> Result<()> {
+    write_all_with(files, &|file, bytes| {
+        use std::io::Write;
+        file.write_all(bytes)?;
+        file.sync_all()
+    })
+}
+
+/// `write_all_atomically` with the write itself given (tests make it fail).
+pub fn write_all_with(
+    files: &[(&Path, &[u8])],
+    write: &dyn Fn(&mut std::fs::File, &[u8]) -> std::io::Result<()>,
+) -> Result<()> {
+    let mut temporaries = Vec::with_capacity(files.len());
+    for &(path, bytes) in files {
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let name = path.file_name().ok_or_else(|| {
+            Error::io(
+                "write",
+                path,
+                std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
+            )
+        })?;
+        let mut tmp = tempfile::Builder::new()
+            .prefix(&format!(".{}.", name.to_string_lossy()))
+            .suffix(".partial")
+            .tempfile_in(dir)
+            .map_err(|e| Error::io("write", path, e))?;
+        // On an error the temporaries made so far drop here, and delete themselves.
+        write(tmp.as_file_mut(), bytes).map_err(|e| Error::io("write", path, e))?;
+        temporaries.push((tmp, path));
+    }
+    for (tmp, path) in temporaries {
+        tmp.persist(path)
+            .map_err(|e| Error::io("write", path, e.error))?;
+    }
+    Ok(())
+}
+
+/// Whether a file can be made at `path`: its folder exists and takes a new
+/// file (checked by making and removing a temporary there), before any work.
+pub fn check_writable(path: &Path) -> Result<()> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| {
-        Error::io(
+    if path.is_dir() {
+        return Err(Error::io(
             "write",
             path,
-            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
-        )
-    })?;
-    // Unique per process and call, so concurrent writers never share a temporary.
-    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let tmp = dir.join(format!(
-        ".{}.{}.{n}.partial",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    if let Err(e) = std::fs::write(&tmp, bytes) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(Error::io("write", path, e));
+            std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder is there"),
+        ));
     }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error::io("write", path, e)
-    })
+    tempfile::Builder::new()
+        .prefix(".photonmap-check.")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| Error::io("write", path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A write that fails halfway (as a full disk does) leaves no file and no
+    /// temporary, and the file there before intact; every file or none.
+    #[test]
+    fn a_failing_write_leaves_nothing_and_keeps_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.exr"));
+        std::fs::write(&b, b"before").unwrap();
+        let full_disk = |file: &mut std::fs::File, bytes: &[u8]| {
+            use std::io::Write;
+            file.write_all(&bytes[..bytes.len() / 2])?;
+            Err(std::io::Error::from_raw_os_error(28)) // ENOSPC
+        };
+        let err = write_all_with(&[(&a, b"0123456789"), (&b, b"after")], &full_disk).unwrap_err();
+        assert!(err.to_string().contains("No space left"), "{err}");
+        assert!(!a.exists());
+        assert_eq!(std::fs::read(&b).unwrap(), b"before");
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        assert_eq!(left.len(), 1, "{left:?}");
+        // And when every write works, every file appears.
+        write_all_atomically(&[(&a, b"0123456789"), (&b, b"after")]).unwrap();
+        assert_eq!(std::fs::read(&b).unwrap(), b"after");
+        assert!(a.exists());
+    }
 }

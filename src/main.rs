@@ -17,6 +17,10 @@ struct Cli {
     /// Headless GL platform: auto (a GPU's EGL device, else EGL surfaceless, else OSMesa).
     #[arg(long, value_enum, default_value_t = Platform::Auto, global = true)]
     platform: Platform,
+    /// llvmpipe's rendering threads (LP_NUM_THREADS; default: one per core;
+    /// ignored, with a note, on a GPU).
+    #[arg(long, global = true, value_parser = cli::args::in_range(1, 1024))]
+    threads: Option<u32>,
     #[command(subcommand)]
     command: Command,
 }
@@ -26,7 +30,9 @@ enum Command {
     Render(cli::render::RenderArgs),
     Photons(cli::photons::PhotonsArgs),
     Compare(cli::compare::CompareArgs),
+    Convert(cli::convert::ConvertArgs),
     Reference(cli::reference::ReferenceArgs),
+    Regress(cli::regress::RegressArgs),
     Tables(cli::tables::TablesArgs),
     #[command(subcommand)]
     Bench(cli::bench::BenchCommand),
@@ -36,22 +42,19 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    cli::set_threads(cli.threads);
     let p = cli.platform;
     let result = match cli.command {
         Command::Render(a) => cli::render::run(&a, p),
         Command::Photons(a) => cli::photons::run(&a, p),
         Command::Compare(a) => cli::compare::run(&a),
+        Command::Convert(a) => cli::convert::run(&a),
         Command::Reference(a) => cli::reference::run(&a, p),
+        Command::Regress(a) => cli::regress::run(&a, p),
         Command::Tables(a) => cli::tables::run(&a, p),
         Command::Bench(b) => cli::bench::run(b, p),
         Command::Info(a) => cli::info::run(&a, p),
         Command::Scenes(a) => cli::scenes::run(&a),
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    result.map_or_else(cli::fail, |()| ExitCode::SUCCESS)
 }

@@ -175,6 +175,38 @@ pub fn false_colour(a: &Image, b: &Image) -> Image {
     }
 }
 
+/// Mean LDR-FLIP (Andersson et al. 2020, NVIDIA's implementation through the
+/// nv-flip crate, as wgpu's tests use it) of the two images' sRGB 8-bit
+/// encodings, at FLIP's default 67 pixels per degree: 0 is identical, 1 the
+/// most different; `b` is the reference.
+pub fn flip(a: &Image, b: &Image) -> Result<f64> {
+    same_size(a, b)?;
+    let srgb = |img: &Image| -> Vec<u8> {
+        img.pixels
+            .iter()
+            .flat_map(|p| p.map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8))
+            .collect()
+    };
+    let (ta, tb) = (srgb(a), srgb(b));
+    let test = nv_flip::FlipImageRgb8::with_data(a.width, a.height, &ta);
+    let reference = nv_flip::FlipImageRgb8::with_data(b.width, b.height, &tb);
+    let map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    Ok(nv_flip::FlipPool::from_image(&map).mean() as f64)
+}
+
+/// The fraction of pixels with a channel differing by more than `threshold`
+/// (OpenImageIO idiff's --fail).
+pub fn fraction_beyond(a: &Image, b: &Image, threshold: f32) -> Result<f64> {
+    same_size(a, b)?;
+    let beyond = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > threshold))
+        .count();
+    Ok(beyond as f64 / a.pixels.len().max(1) as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,32 +14,15 @@ mod common;
 
 use std::path::PathBuf;
 
+use photonmap::regress::{make_reference, Reference, Tolerance};
 use photonmap::render::{render, Image, RenderOptions};
 use photonmap::scene::{Light, Scene};
 
 const SCENES: [&str; 3] = ["glass_ball", "ring", "cornell_box"];
 const SEEDS: u32 = 16;
-const Z_LIMIT: f32 = 4.0;
 /// Not among the seeds the reference averages.
 const TEST_SEED: u32 = 1000;
 const REDUCTION: u32 = 4;
-
-#[derive(serde::Serialize, serde::Deserialize, Debug)]
-struct Tolerance {
-    scene: String,
-    width: u32,
-    height: u32,
-    seeds: u32,
-    renderer: String,
-    /// Fraction of pixel channels beyond |z| = 4, each seed against the others.
-    loo_fail_mean: f64,
-    loo_fail_std: f64,
-    /// RMSE between SIMD widths 128 and default, same seed.
-    driver_rmse: f64,
-    /// The largest failing fraction a render may show.
-    tolerance: f64,
-    command: String,
-}
 
 fn reduced(scene: &Scene) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
@@ -54,40 +37,8 @@ fn render_seed(gpu: &photonmap::gpu::Gpu, scene: &Scene, seed: u32) -> Image {
     render(gpu, scene, &o, &mut ()).unwrap().image
 }
 
-fn paths(name: &str) -> (PathBuf, PathBuf, PathBuf) {
-    let dir = common::root().join("reference_images");
-    (
-        dir.join(format!("{name}.exr")),
-        dir.join(format!("{name}.var.exr")),
-        dir.join(format!("{name}.json")),
-    )
-}
-
-fn variance(images: &[Image], mean: &Image) -> Image {
-    let mut var = Image::new(mean.width, mean.height);
-    for img in images {
-        for ((v, p), m) in var.pixels.iter_mut().zip(&img.pixels).zip(&mean.pixels) {
-            for c in 0..3 {
-                v[c] += (p[c] - m[c]).powi(2) / (images.len() - 1) as f32;
-            }
-        }
-    }
-    var
-}
-
-/// Fraction of pixel channels with |z| > Z_LIMIT against a mean and variance of `n` seeds.
-fn failing_fraction(actual: &Image, mean: &Image, var: &Image, n: u32) -> f64 {
-    let mut failing = 0usize;
-    for ((x, m), v) in actual.pixels.iter().zip(&mean.pixels).zip(&var.pixels) {
-        for c in 0..3 {
-            let floor = 1e-3 * m[c].abs() + 1e-6;
-            let sd = (v[c] * (1.0 + 1.0 / n as f32) + floor * floor).sqrt();
-            if ((x[c] - m[c]) / sd).abs() > Z_LIMIT {
-                failing += 1;
-            }
-        }
-    }
-    failing as f64 / (actual.pixels.len() * 3) as f64
+fn dir() -> PathBuf {
+    common::root().join("reference_images")
 }
 
 /// The same render from the binary in a fresh process with another SIMD width.
@@ -123,56 +74,22 @@ fn regenerate(gpu: &photonmap::gpu::Gpu, name: &str) {
     let images: Vec<Image> = (1..=SEEDS).map(|s| render_seed(gpu, &scene, s)).collect();
     let o = reduced(&scene);
     let narrow = render_with_narrow_simd(name, &o, 1);
-    let driver_rmse = common::rmse(&images[0], &narrow);
-    let driver_var = |var: &mut Image| {
-        for ((v, a), b) in var
-            .pixels
-            .iter_mut()
-            .zip(&images[0].pixels)
-            .zip(&narrow.pixels)
-        {
-            for c in 0..3 {
-                v[c] += (a[c] - b[c]).powi(2);
-            }
-        }
-    };
-    let loo: Vec<f64> = (0..images.len())
-        .map(|i| {
-            let others: Vec<Image> = images
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, im)| im.clone())
-                .collect();
-            let m = Image::average(&others);
-            let mut v = variance(&others, &m);
-            driver_var(&mut v);
-            failing_fraction(&images[i], &m, &v, SEEDS - 1)
-        })
-        .collect();
-    let m = loo.iter().sum::<f64>() / loo.len() as f64;
-    let sd = (loo.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (loo.len() - 1) as f64).sqrt();
-    let mean = Image::average(&images);
-    let mut var = variance(&images, &mean);
-    driver_var(&mut var);
     let tol = Tolerance {
         scene: name.into(),
         width: o.width,
         height: o.height,
         seeds: SEEDS,
         renderer: gpu.capabilities().gl_renderer,
-        loo_fail_mean: m,
-        loo_fail_std: sd,
-        driver_rmse,
-        tolerance: m + 4.0 * sd,
+        loo_fail_mean: 0.0,
+        loo_fail_std: 0.0,
+        driver_rmse: 0.0,
+        tolerance: 0.0,
         command: "PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test reference_images"
             .into(),
     };
-    let (exr, var_exr, json) = paths(name);
-    common::write_exr(&exr, &mean);
-    common::write_exr(&var_exr, &var);
-    std::fs::write(json, serde_json::to_string_pretty(&tol).unwrap() + "\n").unwrap();
-    eprintln!("regenerated {name}: {tol:?}");
+    let r = make_reference(&images, &narrow, tol).unwrap();
+    r.write(&dir(), name).unwrap();
+    eprintln!("regenerated {name}: {:?}", r.tol);
 }
 
 /// Regenerates every reference once per process when asked, before anyone reads them.
@@ -187,19 +104,9 @@ fn ensure_references(gpu: &photonmap::gpu::Gpu) {
     *done = true;
 }
 
-struct Reference {
-    mean: Image,
-    var: Image,
-    tol: Tolerance,
-}
-
 fn load(name: &str) -> Reference {
-    let (exr, var, json) = paths(name);
     let hint = "regenerate with PHOTONMAP_REGENERATE_REFERENCES=1";
-    let mean = Image::read_exr(&exr).unwrap_or_else(|e| panic!("{e}: {hint}"));
-    let var = Image::read_exr(&var).unwrap_or_else(|e| panic!("{e}: {hint}"));
-    let tol: Tolerance = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
-    Reference { mean, var, tol }
+    Reference::load(&dir(), name).unwrap_or_else(|e| panic!("{e}: {hint}"))
 }
 
 /// Scores a render; the actual image and its |z| map go to target/ for a look.
@@ -214,7 +121,7 @@ fn score(label: &str, actual: &Image, r: &Reference) -> f64 {
         }
     }
     common::write_exr(&dir.join(format!("{label}.diff.exr")), &diff);
-    failing_fraction(actual, &r.mean, &r.var, r.tol.seeds)
+    r.failing_fraction(actual)
 }
 
 #[test]

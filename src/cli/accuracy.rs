@@ -304,7 +304,7 @@ pub fn bench_accuracy(
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
     let (reference_img, info) = read_reference(reference)?;
-    if reference_img.width == 0 || scene.camera.width % reference_img.width != 0 {
+    if reference_img.width == 0 || !scene.camera.width.is_multiple_of(reference_img.width) {
         bail!(
             "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
             reference.display(),
@@ -364,18 +364,10 @@ pub fn bench_accuracy(
 fn bias_and_noise(images: &[Image], reference: &Image, reference_noise: f64) -> Result<(f64, f64)> {
     let n = images.len() as f64;
     let mean = Image::average(images);
-    let mut variance = 0.0;
-    for (i, m) in mean.pixels.iter().enumerate() {
-        for c in 0..3 {
-            let v: f64 = images
-                .iter()
-                .map(|img| (img.pixels[i][c] as f64 - m[c] as f64).powi(2))
-                .sum::<f64>()
-                / (n - 1.0);
-            variance += v;
-        }
-    }
-    variance /= (mean.pixels.len() * 3) as f64;
+    // The per-pixel sample variance (photonmap::regress), averaged over channels.
+    let var = photonmap::regress::variance(images, &mean);
+    let variance =
+        var.pixels.iter().flatten().map(|&v| v as f64).sum::<f64>() / (var.pixels.len() * 3) as f64;
     let mean_error = photonmap::metrics::rmse(&mean, reference)?;
     let bias2 = mean_error * mean_error - variance / n - reference_noise * reference_noise;
     Ok((bias2.max(0.0).sqrt(), variance.sqrt()))

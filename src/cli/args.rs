@@ -166,3 +166,41 @@ impl From<&SppmArgs> for SppmOptions {
         }
     }
 }
+
+/// The scene a command renders, and overrides of its fields.
+#[derive(Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// Scene file (TOML; see README.md), or the name of an embedded scene
+    /// (`photonmap scenes` lists them: glass_ball, ring, cornell_box, ...).
+    pub scene: std::path::PathBuf,
+    /// Override a scene field by its path, validated like the file and
+    /// recorded in every output: --set photon_map.k=64, -D camera.width=256,
+    /// --set 'shape[1].radius=0.5' (repeatable; the value is TOML).
+    #[arg(long = "set", short = 'D', value_name = "KEY=VALUE", value_parser = key_value)]
+    pub set: Vec<(String, String)>,
+}
+
+fn key_value(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.trim().to_string())),
+        _ => Err(format!("{s}: give KEY=VALUE, as in photon_map.k=64")),
+    }
+}
+
+/// A loaded scene and what provenance needs of it.
+pub struct LoadedScene {
+    pub scene: photonmap::scene::Scene,
+    pub provenance: photonmap::provenance::Provenance,
+}
+
+impl SceneArgs {
+    pub fn load(&self) -> anyhow::Result<LoadedScene> {
+        let (scene, text) =
+            photonmap::scene::embedded::load_with_overrides(&self.scene, &self.set)?;
+        let mut provenance = photonmap::provenance::Provenance::program();
+        provenance.scene = self.scene.display().to_string();
+        provenance.scene_hash = format!("{:016x}", photonmap::provenance::fnv1a64(text.as_bytes()));
+        provenance.overrides = self.set.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        Ok(LoadedScene { scene, provenance })
+    }
+}

@@ -5,9 +5,12 @@ pub mod accuracy;
 pub mod args;
 pub mod bench;
 pub mod compare;
+pub mod convert;
 pub mod info;
 pub mod photons;
+pub mod progress;
 pub mod reference;
+pub mod regress;
 pub mod render;
 pub mod scenes;
 pub mod tables;
@@ -17,9 +20,39 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use photonmap::gpu::{Gpu, Platform};
 
+static THREADS: std::sync::OnceLock<Option<u32>> = std::sync::OnceLock::new();
+
+/// `--threads N`: llvmpipe reads LP_NUM_THREADS when a context is made, so it
+/// is set before any (main is still single-threaded here).
+pub fn set_threads(threads: Option<u32>) {
+    if let Some(n) = threads {
+        std::env::set_var("LP_NUM_THREADS", n.to_string());
+    }
+    let _ = THREADS.set(threads);
+}
+
 /// The GPU on the chosen platform.
 pub fn gpu(platform: Platform) -> Result<Gpu> {
-    Ok(Gpu::new(platform)?)
+    let gpu = Gpu::new(platform)?;
+    if let Some(Some(n)) = THREADS.get() {
+        let renderer = gpu.capabilities().gl_renderer;
+        if !renderer.contains("llvmpipe") {
+            eprintln!("note: --threads {n} is for llvmpipe; {renderer} ignores it");
+        }
+    }
+    Ok(gpu)
+}
+
+/// The provenance's driver part.
+pub fn with_driver(
+    mut p: photonmap::provenance::Provenance,
+    gpu: &Gpu,
+) -> photonmap::provenance::Provenance {
+    let caps = gpu.capabilities();
+    p.platform = caps.platform;
+    p.renderer = caps.gl_renderer;
+    p.gl_version = caps.gl_version;
+    p
 }
 
 /// Refuses an output path with the wrong extension or in a missing folder,
@@ -51,6 +84,12 @@ pub fn check_output(path: &Path, extension: &str, flag: &str) -> Result<()> {
 /// committed results or references.
 pub fn out_dir(kind: &str) -> std::path::PathBuf {
     std::path::Path::new("photonmap-out").join(kind)
+}
+
+/// The exit of a command that failed: its error and every cause, on stderr.
+pub fn fail(e: anyhow::Error) -> std::process::ExitCode {
+    eprintln!("error: {e:#}");
+    std::process::ExitCode::FAILURE
 }
 
 /// Prints `value` as pretty JSON on stdout.

@@ -8,15 +8,15 @@ use photonmap::gpu::{Gpu, Platform};
 use photonmap::photon::{build_map, BuildMethod, PhotonConfig, PhotonMap, TraceReport};
 use photonmap::render::Timings;
 use photonmap::scene::pack::SceneTextures;
-use photonmap::scene::{embedded, Scene};
+use photonmap::scene::Scene;
 
 use super::args::PhotonMapArgs;
 
 /// Trace a scene's photons and build its photon map; report counts, passes and times.
 #[derive(Args)]
 pub struct PhotonsArgs {
-    /// Scene file, or the name of an embedded scene.
-    pub scene: std::path::PathBuf,
+    #[command(flatten)]
+    pub scene: super::args::SceneArgs,
     #[command(flatten)]
     pub photons: PhotonMapArgs,
     #[arg(long, default_value_t = 1)]
@@ -27,9 +27,12 @@ pub struct PhotonsArgs {
 }
 
 pub fn run(args: &PhotonsArgs, platform: Platform) -> Result<()> {
-    let scene = embedded::load_path_or_name(&args.scene)?;
+    let loaded = args.scene.load()?;
     let gpu = super::gpu(platform)?;
-    let report = trace_and_build(&gpu, &scene, &(&args.photons).into(), args.seed)?;
+    let mut report = trace_and_build(&gpu, &loaded.scene, &(&args.photons).into(), args.seed)?;
+    let mut provenance = super::with_driver(loaded.provenance, &gpu);
+    (provenance.method, provenance.seed) = ("photons".into(), args.seed);
+    report.provenance = Some(provenance);
     if args.json {
         super::print_json(&report)
     } else {
@@ -40,6 +43,7 @@ pub fn run(args: &PhotonsArgs, platform: Platform) -> Result<()> {
 
 #[derive(serde::Serialize)]
 pub struct PhotonReport {
+    pub provenance: Option<photonmap::provenance::Provenance>,
     pub scene: String,
     pub seed: u32,
     pub build: BuildMethod,
@@ -98,6 +102,7 @@ pub fn trace_and_build(
     timings.wall_seconds = wall.elapsed().as_secs_f64();
     let grid = built.grid;
     Ok(PhotonReport {
+        provenance: None,
         scene: scene.name.clone(),
         seed,
         build: config.build,

@@ -17,7 +17,7 @@ use photonmap::metrics::rmse;
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{Sppm, SppmOptions};
 use photonmap::render::{GlobalIllumination, Image, RenderOptions};
-use photonmap::scene::{embedded, Scene};
+use photonmap::scene::Scene;
 use photonmap::timing::Timings;
 
 use super::args::in_range;
@@ -27,8 +27,8 @@ use super::args::in_range;
 /// remaining noise and a bound on its remaining bias.
 #[derive(Args)]
 pub struct ReferenceArgs {
-    /// Scene file, or the name of an embedded scene.
-    pub scene: PathBuf,
+    #[command(flatten)]
+    pub scene: super::args::SceneArgs,
     /// Output EXR (default: photonmap-out/reference/<scene>.sppm.exr under the
     /// current folder; a .json goes beside it).
     #[arg(long)]
@@ -72,9 +72,9 @@ pub struct ReferenceInfo {
 }
 
 pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
-    let scene = embedded::load_path_or_name(&a.scene)?;
+    let scene = a.scene.load()?.scene;
     let out = a.out.clone().unwrap_or_else(|| {
-        super::out_dir("reference").join(format!("{}.sppm.exr", stem(&a.scene)))
+        super::out_dir("reference").join(format!("{}.sppm.exr", stem(&a.scene.scene)))
     });
     if let Some(dir) = out
         .parent()
@@ -86,13 +86,16 @@ pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
     let gpu = super::gpu(platform)?;
     let mut command = format!(
         "photonmap reference {} --scale {} --iterations {} --photons-per-iteration {}",
-        a.scene.display(),
+        a.scene.scene.display(),
         a.scale,
         a.iterations,
         a.photons_per_iteration
     );
     if let Some(r) = a.radius {
         command += &format!(" --radius {r}");
+    }
+    for (k, v) in &a.scene.set {
+        command += &format!(" --set {k}={v}");
     }
     let progress = super::progress_lines(a.quiet);
     let (img, info) = make_reference(&gpu, &scene, a, command, &progress)?;

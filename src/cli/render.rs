@@ -1,4 +1,5 @@
-//! `photonmap render`: one image, or a fly-through of frames on one photon map.
+//! `photonmap render`: one image (any number of PNG, EXR and PFM files), or a
+//! fly-through of frames on one photon map.
 
 use std::path::{Path, PathBuf};
 
@@ -6,24 +7,28 @@ use anyhow::{anyhow, bail, Result};
 use clap::Args;
 
 use photonmap::gpu::Platform;
-use photonmap::image::write_atomically;
+use photonmap::image::{check_writable, write_all_atomically, write_atomically};
+use photonmap::provenance::Provenance;
 use photonmap::render::{
-    self, EstimatePass, GlobalIllumination, Image, Progress, RenderObserver, RenderOptions,
+    self, EstimatePass, GlobalIllumination, Image, PassPlan, Progress, RenderObserver,
+    RenderOptions,
 };
-use photonmap::scene::{embedded, Scene};
+use photonmap::scene::Scene;
 
-use super::args::{in_range, EstimateArgs, Method, PhotonMapArgs, SppmArgs};
+use super::args::{in_range, EstimateArgs, Method, PhotonMapArgs, SceneArgs, SppmArgs};
+use super::progress::{ProgressReport, Work};
 
-/// Render a scene to a PNG (sRGB) and optionally an EXR (linear float RGB).
+/// Render a scene to images: PNG (sRGB), EXR (linear float RGB, with the
+/// provenance in its header) or PFM, chosen by each output's extension.
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML; see README.md), or the name of an embedded scene
-    /// (`photonmap scenes` lists them: glass_ball, ring, cornell_box, ...).
-    pub scene: PathBuf,
-    /// Output PNG path (with --camera-path: the frames go to --out instead).
-    #[arg(short, long)]
-    pub output: Option<PathBuf>,
-    /// Also write linear float RGB to this OpenEXR path.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// An output image, by extension: .png, .exr or .pfm (repeatable: -o a.png
+    /// -o a.exr). All are written or none; each is checked before rendering.
+    #[arg(short, long = "output", value_name = "FILE")]
+    pub output: Vec<PathBuf>,
+    /// Also write linear float RGB to this OpenEXR path (the same as -o X.exr).
     #[arg(long)]
     pub exr: Option<PathBuf>,
     /// Random seed: the same seed on the same driver gives the same image.
@@ -39,10 +44,10 @@ pub struct RenderArgs {
     /// Image height in pixels (default: the scene's; 1..=16384).
     #[arg(long, value_parser = in_range(1, 16384))]
     pub height: Option<u32>,
-    /// No progress bar and no timing table on stderr.
+    /// No progress and no timing table on stderr.
     #[arg(long)]
     pub quiet: bool,
-    /// Print the per-stage timings as JSON on stdout.
+    /// Print a JSON report on stdout: provenance, options, outputs, timings.
     #[arg(long)]
     pub json: bool,
     /// List every pass that runs and every pass skipped, with why.
@@ -106,44 +111,95 @@ fn parse_every(text: &str) -> Result<SnapshotEvery, String> {
     }
 }
 
+/// An image format, by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Format {
+    Png,
+    Exr,
+    Pfm,
+}
+
+impl Format {
+    fn of(path: &Path) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        Ok(match ext.as_str() {
+            "png" => Format::Png,
+            "exr" => Format::Exr,
+            "pfm" => Format::Pfm,
+            _ => bail!(
+                "-o {}: the file name must end in .png, .exr or .pfm",
+                path.display()
+            ),
+        })
+    }
+
+    fn encode(self, image: &Image, provenance: &Provenance) -> Result<Vec<u8>> {
+        Ok(match self {
+            Format::Png => image.png_bytes()?,
+            Format::Exr => image.exr_bytes_with(&provenance.pairs())?,
+            Format::Pfm => image.pfm_bytes(),
+        })
+    }
+}
+
 /// Where the images go.
 enum Outputs {
-    Image { png: PathBuf, exr: Option<PathBuf> },
-    Frames { dir: PathBuf, exr: Option<PathBuf> },
+    Images(Vec<(PathBuf, Format)>),
+    /// A fly-through's frames (and any final-frame images).
+    Frames(PathBuf, Vec<(PathBuf, Format)>),
+}
+
+impl Outputs {
+    fn images(&self) -> &[(PathBuf, Format)] {
+        match self {
+            Outputs::Images(v) | Outputs::Frames(_, v) => v,
+        }
+    }
 }
 
 impl RenderArgs {
-    /// Checks every output path before any work.
+    /// Every output, checked before any work: a known extension, a folder
+    /// that exists and takes a new file, not a folder itself.
     fn outputs(&self) -> Result<Outputs> {
         if let Some(p) = &self.reference_software {
             super::check_output(p, "png", "--reference-software")?;
-        }
-        if let Some(e) = &self.exr {
-            super::check_output(e, "exr", "--exr")?;
+            check_writable(p)?;
         }
         if let Some(dir) = &self.snapshots {
             if !dir.is_dir() {
                 bail!("--snapshots {}: the folder does not exist", dir.display());
             }
         }
-        match (&self.output, &self.out) {
-            (Some(png), None) => {
-                super::check_output(png, "png", "-o")?;
-                Ok(Outputs::Image {
-                    png: png.clone(),
-                    exr: self.exr.clone(),
-                })
+        let mut images = Vec::new();
+        for p in self.output.iter().chain(&self.exr) {
+            let format = Format::of(p)?;
+            if self.exr.as_ref() == Some(p) && format != Format::Exr {
+                bail!("--exr {}: the file name must end in .exr", p.display());
             }
-            (None, Some(dir)) => {
+            super::check_output(
+                p,
+                p.extension().and_then(|e| e.to_str()).unwrap_or(""),
+                "-o",
+            )?;
+            check_writable(p)?;
+            images.push((p.clone(), format));
+        }
+        match &self.out {
+            Some(dir) => {
                 if !dir.is_dir() {
                     bail!("--out {}: the folder does not exist", dir.display());
                 }
-                Ok(Outputs::Frames {
-                    dir: dir.clone(),
-                    exr: self.exr.clone(),
-                })
+                Ok(Outputs::Frames(dir.clone(), images))
             }
-            _ => bail!("-o OUTPUT.png is required (or --camera-path PATH.toml --out DIR)"),
+            None if images.is_empty() => {
+                bail!("-o OUTPUT (.png, .exr or .pfm) is required (or --camera-path PATH.toml --out DIR)")
+            }
+            None => Ok(Outputs::Images(images)),
         }
     }
 
@@ -161,42 +217,76 @@ impl RenderArgs {
     }
 }
 
+/// What `--json` prints: provenance, the outputs and the run's figures.
+#[derive(serde::Serialize)]
+struct Report<'a> {
+    provenance: &'a Provenance,
+    outputs: Vec<(String, Format)>,
+    #[serde(flatten)]
+    figures: serde_json::Value,
+}
+
 pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     if args.method == Method::Sppm {
         return run_sppm(args, platform);
     }
     let outputs = args.outputs()?;
-    let scene = embedded::load_path_or_name(&args.scene)?;
-    warn_far_from_origin(&scene, args.quiet);
-    let options = args.options(&scene);
+    let loaded = args.scene.load()?;
+    let scene = &loaded.scene;
+    warn_far_from_origin(scene, args.quiet);
+    let options = args.options(scene);
     let cameras = match &args.camera_path {
         Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera)?,
         None => vec![scene.camera.clone()],
     };
     let gpu = super::gpu(platform)?;
-    let mut observer = CliObserver::new(args, &scene, &options, &outputs);
-    let out = render::render_views(&gpu, &scene, &options, &cameras, &mut observer)?;
+    let provenance = provenance(loaded.provenance, &gpu, "paper", &options);
+    let work = Work::Paper {
+        passes: PassPlan::new(scene, &options).passes_per_sample(),
+        samples: options.spp,
+        views: cameras.len(),
+        direct_only: args.direct_only,
+    };
+    let mut observer = CliObserver::new(args, scene, &outputs, work);
+    let out = render::render_views(&gpu, scene, &options, &cameras, &mut observer)?;
     observer.finish()?;
-    if out.image.has_non_finite() {
-        bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
-    }
-    let written = write_image(&out.image, &outputs)?;
-    if args.json {
-        super::print_json(&out.timings)?;
-    }
+    let written = write_images(&out.image, outputs.images(), &provenance)?;
     if let Some(path) = &args.reference_software {
-        write_software_reference(&out, &scene, path, args.quiet)?;
+        write_software_reference(&out, scene, path, args.quiet)?;
+    }
+    if args.json {
+        super::print_json(&Report {
+            provenance: &provenance,
+            outputs: written.clone(),
+            figures: serde_json::json!({ "method": "paper", "timings": out.timings, "estimates": out.estimates }),
+        })?;
     }
     if args.explain {
-        for l in out.explain(&scene, &options) {
-            let what = if l.ran { "run " } else { "skip" };
-            eprintln!("{what} {:<34} {:>6} passes  {}", l.stage, l.passes, l.why);
-        }
+        print_explain(&out.explain(scene, &options));
     }
     if !args.quiet {
         print_summary(&out, &options, &written);
     }
     Ok(())
+}
+
+fn provenance(
+    p: Provenance,
+    gpu: &photonmap::gpu::Gpu,
+    method: &str,
+    o: &RenderOptions,
+) -> Provenance {
+    let mut p = super::with_driver(p, gpu);
+    p.method = method.into();
+    (p.seed, p.spp, p.width, p.height) = (o.seed, o.spp, o.width, o.height);
+    p
+}
+
+fn print_explain(lines: &[photonmap::render::ExplainLine]) {
+    for l in lines {
+        let what = if l.ran { "run " } else { "skip" };
+        eprintln!("{what} {:<34} {:>6} passes  {}", l.stage, l.passes, l.why);
+    }
 }
 
 /// `--method sppm`: one view, iterations until --iterations or --time.
@@ -209,33 +299,35 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software and --spp");
     }
     let outputs = args.outputs()?;
-    let scene = embedded::load_path_or_name(&args.scene)?;
-    warn_far_from_origin(&scene, args.quiet);
-    let options = args.options(&scene);
+    let loaded = args.scene.load()?;
+    let scene = &loaded.scene;
+    warn_far_from_origin(scene, args.quiet);
+    let options = args.options(scene);
     let gpu = super::gpu(platform)?;
-    let mut observer = CliObserver::new(args, &scene, &options, &outputs);
-    let out =
-        render::sppm::render_sppm(&gpu, &scene, &options, &(&args.sppm).into(), &mut observer)?;
+    let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
+    let work = Work::Iterations(args.sppm.iterations);
+    let mut observer = CliObserver::new(args, scene, &outputs, work);
+    let sppm = (&args.sppm).into();
+    let out = render::sppm::render_sppm(&gpu, scene, &options, &sppm, &mut observer)?;
     observer.finish()?;
-    if out.image.has_non_finite() {
-        bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
-    }
-    let written = write_image(&out.image, &outputs)?;
+    let written = write_images(&out.image, outputs.images(), &provenance)?;
     if args.json {
-        super::print_json(&serde_json::json!({
-            "method": "sppm",
-            "iterations": out.iterations,
-            "photons_emitted": out.photons_emitted,
-            "initial_radius": out.initial_radius,
-            "final_largest_radius": out.final_largest_radius,
-            "timings": out.timings,
-        }))?;
+        super::print_json(&Report {
+            provenance: &provenance,
+            outputs: written.clone(),
+            figures: serde_json::json!({
+                "method": "sppm",
+                "sppm": sppm,
+                "iterations": out.iterations,
+                "photons_emitted": out.photons_emitted,
+                "initial_radius": out.initial_radius,
+                "final_largest_radius": out.final_largest_radius,
+                "timings": out.timings,
+            }),
+        })?;
     }
     if args.explain {
-        for l in &out.explain {
-            let what = if l.ran { "run " } else { "skip" };
-            eprintln!("{what} {:<34} {:>6} passes  {}", l.stage, l.passes, l.why);
-        }
+        print_explain(&out.explain);
     }
     if !args.quiet {
         eprint!("{}", out.timings.table());
@@ -243,8 +335,8 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
             "SPPM: {} iterations, {} photons emitted, radius {} -> {:.5} (largest)",
             out.iterations, out.photons_emitted, out.initial_radius, out.final_largest_radius
         );
-        for p in &written {
-            eprintln!("wrote {}", p.display());
+        for (p, _) in &written {
+            eprintln!("wrote {p}");
         }
     }
     Ok(())
@@ -260,23 +352,29 @@ fn warn_far_from_origin(scene: &Scene, quiet: bool) {
     }
 }
 
-/// Writes the final image (the frames are already written); returns what was written.
-fn write_image(image: &Image, outputs: &Outputs) -> Result<Vec<PathBuf>> {
-    // Encode everything first, so a failure writes nothing.
-    let (png, exr) = match outputs {
-        Outputs::Image { png, exr } => (Some(png), exr.as_ref()),
-        Outputs::Frames { exr, .. } => (None, exr.as_ref()),
-    };
-    let png_bytes = png.map(|_| image.png_bytes()).transpose()?;
-    let exr_bytes = exr.map(|_| image.exr_bytes()).transpose()?;
-    let mut written = Vec::new();
-    for (path, bytes) in [(png, png_bytes), (exr, exr_bytes)] {
-        if let (Some(path), Some(bytes)) = (path, bytes) {
-            write_atomically(path, &bytes)?;
-            written.push(path.clone());
-        }
+/// Writes the final image to every output, all or none; returns what was written.
+fn write_images(
+    image: &Image,
+    outputs: &[(PathBuf, Format)],
+    provenance: &Provenance,
+) -> Result<Vec<(String, Format)>> {
+    if image.has_non_finite() {
+        bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
     }
-    Ok(written)
+    // Encode everything first, so a failure writes nothing.
+    let encoded: Vec<(PathBuf, Vec<u8>)> = outputs
+        .iter()
+        .map(|(p, f)| Ok((p.clone(), f.encode(image, provenance)?)))
+        .collect::<Result<_>>()?;
+    let files: Vec<(&Path, &[u8])> = encoded
+        .iter()
+        .map(|(p, b)| (p.as_path(), b.as_slice()))
+        .collect();
+    write_all_atomically(&files)?;
+    Ok(outputs
+        .iter()
+        .map(|(p, f)| (p.display().to_string(), *f))
+        .collect())
 }
 
 fn write_software_reference(
@@ -299,20 +397,27 @@ fn write_software_reference(
     Ok(())
 }
 
-fn print_summary(out: &render::RenderOutput, options: &RenderOptions, written: &[PathBuf]) {
+fn print_summary(
+    out: &render::RenderOutput,
+    options: &RenderOptions,
+    written: &[(String, Format)],
+) {
     eprint!("{}", out.timings.table());
-    if let Some(e) = &out.estimate {
+    if !out.estimates.is_empty() {
+        let passes: u32 = out.estimates.iter().map(|e| e.passes).sum();
+        let draws: u64 = out.estimates.iter().map(|e| e.tile_draws).sum();
+        let e = &out.estimates[0];
         eprintln!(
-            "radiance estimate: {} passes, {} of {} pixels searched, {} tile draws of {} tiles",
-            e.passes,
+            "radiance estimate: {passes} passes in {} run{}, {} of {} pixels searched, {draws} tile draws of {} tiles",
+            out.estimates.len(),
+            if out.estimates.len() == 1 { "" } else { "s" },
             e.query_pixels,
             options.width as u64 * options.height as u64,
-            e.tile_draws,
             e.tiles
         );
     }
-    for p in written {
-        eprintln!("wrote {}", p.display());
+    for (p, _) in written {
+        eprintln!("wrote {p}");
     }
 }
 
@@ -378,11 +483,10 @@ impl RenderObserver for SnapshotWriter {
     }
 }
 
-/// The CLI's observer: the progress bar, snapshots of the first estimate, and
-/// the frames of a fly-through.
+/// The CLI's observer: the progress report, snapshots of the first estimate,
+/// and the frames of a fly-through.
 struct CliObserver {
-    bar: indicatif::ProgressBar,
-    scene: String,
+    progress: ProgressReport,
     snapshots: Option<SnapshotWriter>,
     frames: Option<PathBuf>,
     frame_times: Vec<f64>,
@@ -390,32 +494,16 @@ struct CliObserver {
 }
 
 impl CliObserver {
-    fn new(args: &RenderArgs, scene: &Scene, options: &RenderOptions, outputs: &Outputs) -> Self {
-        let bar = if args.quiet {
-            indicatif::ProgressBar::hidden()
-        } else {
-            let b = indicatif::ProgressBar::new(1);
-            b.set_style(
-                indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed}")
-                    .expect("valid template")
-                    .progress_chars("=> "),
-            );
-            b.set_message(format!(
-                "{} {}x{}",
-                scene.name, options.width, options.height
-            ));
-            b
-        };
+    fn new(args: &RenderArgs, scene: &Scene, outputs: &Outputs, work: Work) -> Self {
         Self {
-            bar,
-            scene: scene.name.clone(),
+            progress: ProgressReport::new(args.quiet, &scene.name, work),
             snapshots: args
                 .snapshots
                 .clone()
                 .map(|d| SnapshotWriter::new(d, args.every)),
             frames: match outputs {
-                Outputs::Frames { dir, .. } => Some(dir.clone()),
-                Outputs::Image { .. } => None,
+                Outputs::Frames(dir, _) => Some(dir.clone()),
+                Outputs::Images(_) => None,
             },
             frame_times: Vec::new(),
             clock: std::time::Instant::now(),
@@ -424,7 +512,7 @@ impl CliObserver {
 
     /// Writes the index of a fly-through's frames.
     fn finish(&mut self) -> Result<()> {
-        self.bar.finish_and_clear();
+        self.progress.finish();
         if let Some(dir) = &self.frames {
             let index = serde_json::json!({ "frames": self.frame_times.len(), "seconds_since_start": self.frame_times });
             write_atomically(&dir.join("frames.json"), index.to_string().as_bytes())?;
@@ -435,9 +523,7 @@ impl CliObserver {
 
 impl RenderObserver for CliObserver {
     fn progress(&mut self, p: &Progress<'_>) {
-        self.bar.set_message(format!("{} {}", self.scene, p.stage));
-        self.bar.set_length(p.total.max(1));
-        self.bar.set_position(p.done);
+        self.progress.update(p);
     }
 
     fn estimate_pass(&mut self, pass: &EstimatePass<'_>) -> photonmap::Result<()> {

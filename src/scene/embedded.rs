@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::{load_scene, load_scene_str, Scene, SceneError};
+use super::{load_scene_str, Scene, SceneError};
 
 include!(concat!(env!("OUT_DIR"), "/scene_sources.rs"));
 
@@ -51,14 +51,35 @@ pub fn load(name: &str) -> Result<Scene, SceneError> {
 /// that name (`ring`, `scenes/ring.toml` and `variants/furnace_64_bounces` all
 /// work from any folder).
 pub fn load_path_or_name(arg: &Path) -> Result<Scene, SceneError> {
-    if arg.exists() {
-        return load_scene(arg);
+    load_with_overrides(arg, &[]).map(|(scene, _)| scene)
+}
+
+/// The TOML text a scene argument names (a file, else an embedded scene) and
+/// the path errors and OBJ files are relative to.
+pub fn text_for(arg: &Path) -> Result<(String, std::path::PathBuf), SceneError> {
+    let given = arg.to_string_lossy();
+    let name = given.strip_prefix("scenes/").unwrap_or(&given);
+    if !arg.exists() {
+        if let Some(text) = source(name) {
+            let file = format!("scenes/{}.toml", name.trim_end_matches(".toml"));
+            return Ok((text.to_string(), file.into()));
+        }
     }
-    let text = arg.to_string_lossy();
-    let name = text.strip_prefix("scenes/").unwrap_or(&text);
-    match source(name) {
-        Some(_) => load(name),
-        // Neither: the file's own error ("cannot read the scene file").
-        None => load_scene(arg),
-    }
+    let text = std::fs::read_to_string(arg).map_err(|e| SceneError {
+        file: arg.to_path_buf(),
+        line: 0,
+        field: "(file)".into(),
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    Ok((text, arg.to_path_buf()))
+}
+
+/// A scene argument loaded with `--set` overrides; also returns its text.
+pub fn load_with_overrides(
+    arg: &Path,
+    overrides: &[(String, String)],
+) -> Result<(Scene, String), SceneError> {
+    let (text, path) = text_for(arg)?;
+    let scene = super::load_scene_str_with_overrides(&text, &path, overrides)?;
+    Ok((scene, text))
 }
