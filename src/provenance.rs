@@ -36,30 +36,14 @@ impl Provenance {
         }
     }
 
-    /// (name, value) pairs for an image header.
+    /// The image-header attribute that carries it: one text attribute,
+    /// `photonmap.provenance`, holding this as JSON (one attribute, so the
+    /// file's bytes do not depend on a hash map's order).
     pub fn pairs(&self) -> Vec<(String, String)> {
-        let mut v = vec![
-            ("photonmap.version".to_string(), self.version.clone()),
-            ("photonmap.scene".into(), self.scene.clone()),
-            ("photonmap.scene_fnv1a64".into(), self.scene_hash.clone()),
-            ("photonmap.method".into(), self.method.clone()),
-            ("photonmap.seed".into(), self.seed.to_string()),
-            ("photonmap.spp".into(), self.spp.to_string()),
-            (
-                "photonmap.size".into(),
-                format!("{}x{}", self.width, self.height),
-            ),
-            ("photonmap.platform".into(), self.platform.clone()),
-            ("photonmap.renderer".into(), self.renderer.clone()),
-            ("photonmap.gl_version".into(), self.gl_version.clone()),
-        ];
-        if let Some(c) = &self.commit {
-            v.push(("photonmap.commit".into(), c.clone()));
-        }
-        if !self.overrides.is_empty() {
-            v.push(("photonmap.overrides".into(), self.overrides.join(" ")));
-        }
-        v
+        vec![(
+            "photonmap.provenance".to_string(),
+            serde_json::to_string(self).unwrap_or_default(),
+        )]
     }
 }
 
