@@ -125,7 +125,7 @@ pub fn trace_and_build(
 
 pub fn print_report(r: &PhotonReport) {
     println!(
-        "{}: {:?} build{}",
+        "{}: {} build{}",
         r.scene,
         r.build,
         if r.faithful { " (faithful)" } else { "" }
@@ -142,8 +142,10 @@ pub fn print_report(r: &PhotonReport) {
         r.trace.target
     );
     println!(
-        "  grid {:?} over {:?}..{:?}: {} in the grid, {} in the map, {} of {} cells used, at most {} in a cell",
-        r.grid_resolution, r.grid_min, r.grid_max, r.photons_in_grid, r.photons_in_map, r.cells_with_photons, r.cells, r.max_photons_in_a_cell
+        "  grid {} x {} x {} cells over ({}, {}, {})..({}, {}, {}): {} in the grid, {} in the map, {} of {} cells used, at most {} in a cell",
+        r.grid_resolution[0], r.grid_resolution[1], r.grid_resolution[2],
+        r.grid_min[0], r.grid_min[1], r.grid_min[2], r.grid_max[0], r.grid_max[1], r.grid_max[2],
+        r.photons_in_grid, r.photons_in_map, r.cells_with_photons, r.cells, r.max_photons_in_a_cell
     );
     if let Some(p) = &r.trace.projection {
         println!(

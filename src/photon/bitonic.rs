@@ -7,7 +7,7 @@ use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
 use crate::timing::Timings;
 
-use super::{Grid, PhotonFrames};
+use super::{Grid, PhotonFrames, StageClock};
 
 /// Float addresses are exact below 2^24 (the float mantissa).
 pub const FLOAT_ADDRESS_LIMIT: u64 = 1 << 24;
@@ -215,44 +215,40 @@ impl BitonicBuild {
     ) -> Result<SortedPhotonMap> {
         let query = Query::timer(&self.gpu)?;
         let pairs = if self.compact {
-            query.begin();
+            let clock = StageClock::start(&self.gpu, &query);
             let (pairs, _) = self.compacted_pairs(frames, grid)?;
-            query.end();
             let levels = 32
                 - sort_texture_size(frames.record_count() as u64)
                     .0
                     .leading_zeros();
-            timings.add("compact", query.seconds(), levels as usize + 1);
+            clock.stop(timings, "compact", levels as usize + 1);
             pairs
         } else {
             let (w, h) = sort_texture_size(frames.record_count() as u64);
             let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
             let target = Target::new(&self.gpu, &[&pairs])?;
-            query.begin();
+            let clock = StageClock::start(&self.gpu, &query);
             let mut b = self.keys.bind();
             grid.bind(&mut b);
             frames.bind_records(&mut b);
             b.int("u_sort_width", w as i32)
                 .draw_fullscreen(&target, &DrawState::PLAIN)?;
-            query.end();
-            timings.add("keys", query.seconds(), 1);
+            clock.stop(timings, "keys", 1);
             drop(target);
             pairs
         };
         let (w, h) = (pairs.width, pairs.height);
-        query.begin();
+        let clock = StageClock::start(&self.gpu, &query);
         let (sorted, passes) = self.sort(pairs)?;
-        query.end();
-        timings.add("bitonic sort", query.seconds(), passes as usize);
-        query.begin();
+        clock.stop(timings, "bitonic sort", passes as usize);
+        let clock = StageClock::start(&self.gpu, &query);
         let (grid_first, grid_width) = self.binary_search(&sorted, grid.cell_count())?;
-        query.end();
-        timings.add("binary search", query.seconds(), 1);
+        clock.stop(timings, "binary search", 1);
 
         let t = || Texture::new(&self.gpu, w, h, TexFormat::Rgba32F);
         let (position, power, incoming) = (t()?, t()?, t()?);
         let target = Target::new(&self.gpu, &[&position, &power, &incoming])?;
-        query.begin();
+        let clock = StageClock::start(&self.gpu, &query);
         let mut b = self.gather.bind();
         b.texture("u_sorted", &sorted)
             .texture("u_position", &frames.position)
@@ -262,8 +258,7 @@ impl BitonicBuild {
             .int("u_record_width", frames.width as i32)
             .float("u_power_scale", frames.power_scale)
             .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        query.end();
-        timings.add("gather", query.seconds(), 1);
+        clock.stop(timings, "gather", 1);
         self.gpu.check("gathering sorted photons")?;
         Ok(SortedPhotonMap {
             pairs: sorted,

@@ -107,6 +107,15 @@ pub enum BuildMethod {
     Stencil,
 }
 
+impl std::fmt::Display for BuildMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            BuildMethod::Bitonic => "bitonic sort + binary search",
+            BuildMethod::Stencil => "stencil routing",
+        })
+    }
+}
+
 /// A photon map from either build.
 pub enum PhotonMap {
     Sorted(SortedPhotonMap),
@@ -140,6 +149,33 @@ impl PhotonMap {
                 .map(|c| c[0] as u32)
                 .collect(),
         }
+    }
+}
+
+/// Times one stage of a build: GPU time by timer query, wall clock with the
+/// GPU finished at both ends (llvmpipe's timer queries miss work; see timing).
+pub(crate) struct StageClock<'a> {
+    gpu: &'a crate::gpu::Gpu,
+    query: &'a crate::gpu::Query,
+    start: std::time::Instant,
+}
+
+impl<'a> StageClock<'a> {
+    pub(crate) fn start(gpu: &'a crate::gpu::Gpu, query: &'a crate::gpu::Query) -> Self {
+        gpu.finish();
+        query.begin();
+        Self {
+            gpu,
+            query,
+            start: std::time::Instant::now(),
+        }
+    }
+
+    pub(crate) fn stop(self, timings: &mut crate::timing::Timings, name: &str, passes: usize) {
+        self.query.end();
+        self.gpu.finish();
+        let wall = self.start.elapsed().as_secs_f64();
+        timings.add_both(name, self.query.seconds(), wall, passes);
     }
 }
 

@@ -18,7 +18,7 @@ use crate::gpu::{
 };
 use crate::timing::Timings;
 
-use super::{Grid, PhotonFrames};
+use super::{Grid, PhotonFrames, StageClock};
 
 /// How photon records reach the vertex stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -148,7 +148,7 @@ impl StencilRouting {
             vertices: vertices.as_ref(),
         };
 
-        query.begin();
+        let clock = StageClock::start(&self.gpu, &query);
         target.clear([0.0; 4]);
         target.clear_depth_stencil(1.0, 0);
         // Stencil pattern 0..m^2-1 per block (stencil export; colour untouched).
@@ -178,25 +178,23 @@ impl StencilRouting {
             None => &self.route_fetch,
         };
         draw.points(program, &target, &route, per_row, block)?;
-        query.end();
-        timings.add("route", query.seconds(), 2);
+        clock.stop(timings, "route", 2);
         let stencil = read_stencil.then(|| target.read_stencil());
 
         // Count destined photons per cell exactly.
-        query.begin();
+        let clock = StageClock::start(&self.gpu, &query);
         count_target.clear([0.0; 4]);
         let program = match &vertices {
             Some(_) => &self.count_readback,
             None => &self.count_fetch,
         };
         draw.points(program, &count_target, &DrawState::ADDITIVE, count_width, 1)?;
-        query.end();
-        timings.add("count", query.seconds(), 1);
+        clock.stop(timings, "count", 1);
 
         // Redistribute power: destined / stored per cell.
         let power = t(width, height)?;
         let power_target = Target::new(&self.gpu, &[&power])?;
-        query.begin();
+        let clock = StageClock::start(&self.gpu, &query);
         self.redistribute
             .bind()
             .texture("u_routed_position", &position)
@@ -207,8 +205,7 @@ impl StencilRouting {
             .int("u_count_width", count_width as i32)
             .float("u_power_scale", frames.power_scale)
             .draw_fullscreen(&power_target, &DrawState::PLAIN)?;
-        query.end();
-        timings.add("redistribute", query.seconds(), 1);
+        clock.stop(timings, "redistribute", 1);
         self.gpu.check("stencil routing")?;
         let map = RoutedPhotonMap {
             position,
@@ -238,7 +235,7 @@ impl StencilRouting {
             data.extend_from_slice(&i[4 * k..4 * k + 4]);
         }
         let vb = VertexBuffer::from_f32(&self.gpu, &data, &[4, 4, 4])?;
-        timings.add("read-back (wall)", wall.elapsed().as_secs_f64(), 1);
+        timings.add_both("read-back (wall)", 0.0, wall.elapsed().as_secs_f64(), 1);
         Ok(vb)
     }
 }

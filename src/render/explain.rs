@@ -189,16 +189,13 @@ impl RenderOutput {
                 ),
             ),
         ];
-        let build = match p.config.build {
-            crate::photon::BuildMethod::Bitonic => "bitonic sort + binary search",
-            crate::photon::BuildMethod::Stencil => "stencil routing",
-        };
+        let build = p.config.build.to_string();
         for st in &p.build_stages.stages {
             lines.push(line(
                 &format!("build map: {}", st.name),
                 st.passes,
                 true,
-                build.into(),
+                build.clone(),
             ));
         }
         lines
