@@ -5,6 +5,16 @@
 /// Texels per row of each packed-scene texture (src/scene/pack.rs).
 pub const PRIMITIVE_TEXELS: u32 = 4;
 pub const MATERIAL_TEXELS: u32 = 3;
+/// Primitive records in one row of the primitive texture (so its width is
+/// PRIMITIVE_TEXELS x this, and its height grows by one per this many).
+pub const PRIMITIVES_PER_ROW: u32 = 1024;
+/// Width of the BVH textures (nodes: 2 texels each; leaf order: 1 each).
+pub const BVH_ROW_TEXELS: u32 = 4096;
+/// Entries of the BVH traversal stack in glsl/common/scene.glsl; a deeper tree is refused.
+pub const BVH_STACK: usize = 64;
+/// 1 + 2 gamma(3) in f32: the slab test's far distance widened by its worst
+/// rounding, so a box never culls a ray its primitives would hit (pbrt-v4 6.1).
+pub const BOX_ROBUST: f32 = 1.0 + 3.0 * f32::EPSILON;
 pub const LIGHT_TEXELS: u32 = 6;
 
 /// Primitive kinds, the first float of a primitive's head texel.
@@ -44,6 +54,10 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PRIMITIVE_TEXELS", u(PRIMITIVE_TEXELS)),
         ("MATERIAL_TEXELS", u(MATERIAL_TEXELS)),
         ("LIGHT_TEXELS", u(LIGHT_TEXELS)),
+        ("PRIMITIVES_PER_ROW", u(PRIMITIVES_PER_ROW)),
+        ("BVH_ROW_TEXELS", u(BVH_ROW_TEXELS)),
+        ("BVH_STACK", BVH_STACK.to_string()),
+        ("BOX_ROBUST", format!("{BOX_ROBUST:?}")),
         ("PRIM_SPHERE", u(PRIM_SPHERE)),
         ("PRIM_CYLINDER", u(PRIM_CYLINDER)),
         ("PRIM_PARALLELOGRAM", u(PRIM_PARALLELOGRAM)),

@@ -48,9 +48,9 @@ vec4 intersect_cylinder(vec3 o, vec3 d, vec3 base, vec3 axis, float radius, floa
     return NO_HIT;
 }
 
-// Parallelogram corner + u e1 + v e2 (u, v in [0, 1]) and triangle (u, v >= 0,
-// u + v <= 1), both by Moller-Trumbore.
-vec4 intersect_planar(vec3 o, vec3 d, vec3 corner, vec3 e1, vec3 e2, bool triangle) {
+// Parallelogram corner + u e1 + v e2 (u, v in [0, 1]) by Moller-Trumbore.
+// (Triangles take the watertight test below.)
+vec4 intersect_parallelogram(vec3 o, vec3 d, vec3 corner, vec3 e1, vec3 e2) {
     vec3 pvec = cross(d, e2);
     float det = dot(e1, pvec);
     if (det == 0.0) return NO_HIT;
@@ -60,8 +60,60 @@ vec4 intersect_planar(vec3 o, vec3 d, vec3 corner, vec3 e1, vec3 e2, bool triang
     if (u < 0.0 || u > 1.0) return NO_HIT;
     vec3 qvec = cross(tvec, e1);
     float v = dot(d, qvec) * inv_det;
-    if (v < 0.0 || (triangle ? u + v > 1.0 : v > 1.0)) return NO_HIT;
+    if (v < 0.0 || v > 1.0) return NO_HIT;
     float t = dot(e2, qvec) * inv_det;
     if (t <= 0.0) return NO_HIT;
     return vec4(t, u, v, 1.0);
+}
+
+// A ray prepared once for the watertight triangle test (Woop, Benthin and Wald,
+// JCGT 2013): axes permuted so z is the direction's largest component (k), and
+// the shear and scale that take the direction to +z (s). inv = 1 / d for box
+// tests, with zero components replaced by a huge number of the same sign.
+struct SceneRay { vec3 o; vec3 d; vec3 inv; ivec3 k; vec3 s; };
+
+SceneRay scene_ray(vec3 o, vec3 d) {
+    SceneRay r;
+    r.o = o;
+    r.d = d;
+    for (int i = 0; i < 3; ++i)
+        r.inv[i] = abs(d[i]) < 1e-30 ? (d[i] < 0.0 ? -1e30 : 1e30) : 1.0 / d[i];
+    vec3 a = abs(d);
+    int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0) { int swap = kx; kx = ky; ky = swap; } // keeps the winding
+    r.k = ivec3(kx, ky, kz);
+    float sz = 1.0 / d[kz];
+    r.s = vec3(d[kx] * sz, d[ky] * sz, sz);
+    return r;
+}
+
+// a b - c d with its exact sign. `precise` forbids fusing into an fma, which
+// would make the two triangles of a shared edge round differently; a float
+// result of 0 is recomputed in double, where the products are exact.
+float edge_function(float a, float b, float c, float d) {
+    precise float e = a * b - c * d;
+    if (e == 0.0) e = float(double(a) * double(b) - double(c) * double(d));
+    return e;
+}
+
+// Triangle v0 v1 v2, watertight: a ray through a shared edge or vertex hits
+// at least one of the triangles around it. (u, v) are the barycentric weights
+// of v1 and v2.
+vec4 intersect_triangle(SceneRay r, vec3 v0, vec3 v1, vec3 v2) {
+    vec3 a = v0 - r.o, b = v1 - r.o, c = v2 - r.o;
+    float ax = a[r.k.x] - r.s.x * a[r.k.z], ay = a[r.k.y] - r.s.y * a[r.k.z];
+    float bx = b[r.k.x] - r.s.x * b[r.k.z], by = b[r.k.y] - r.s.y * b[r.k.z];
+    float cx = c[r.k.x] - r.s.x * c[r.k.z], cy = c[r.k.y] - r.s.y * c[r.k.z];
+    float u = edge_function(cx, by, cy, bx);
+    float v = edge_function(ax, cy, ay, cx);
+    float w = edge_function(bx, ay, by, ax);
+    if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return NO_HIT;
+    float det = u + v + w;
+    if (det == 0.0) return NO_HIT;
+    float t_scaled = u * (r.s.z * a[r.k.z]) + v * (r.s.z * b[r.k.z]) + w * (r.s.z * c[r.k.z]);
+    if ((det < 0.0 ? -t_scaled : t_scaled) <= 0.0) return NO_HIT;
+    float inv_det = 1.0 / det;
+    return vec4(t_scaled * inv_det, v * inv_det, w * inv_det, 1.0);
 }

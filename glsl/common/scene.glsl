@@ -1,33 +1,60 @@
 // The scene as textures (packed by src/scene/pack.rs) and the closest-hit and
-// shadow queries over all of it: a loop over every primitive, as in the paper.
+// shadow queries over it, through a bounding volume hierarchy (src/scene/bvh.rs;
+// the paper's ray tracer used a uniform grid, and its scenes are small enough
+// for a loop over every primitive, but meshes are not).
 #include "common/intersect.glsl"
 
-uniform sampler2D u_primitives; // PRIMITIVE_TEXELS a primitive, one row each
-uniform sampler2D u_materials;  // MATERIAL_TEXELS a material
-uniform sampler2D u_lights;     // LIGHT_TEXELS a light
+uniform sampler2D u_primitives;  // PRIMITIVE_TEXELS a primitive, PRIMITIVES_PER_ROW a row
+uniform isampler2D u_bvh_nodes;  // 2 texels a node, BVH_ROW_TEXELS a row
+uniform isampler2D u_bvh_order;  // leaf position -> primitive, BVH_ROW_TEXELS a row
+uniform sampler2D u_materials;   // MATERIAL_TEXELS a material
+uniform sampler2D u_lights;      // LIGHT_TEXELS a light
 uniform int u_primitive_count;
 uniform int u_light_count;
 
-// PRIM_*, MAT_*, LIGHT_* kind codes and the *_TEXELS row lengths are
-// #defines from src/layout.rs, injected into every program.
+// PRIM_*, MAT_*, LIGHT_* kind codes, the *_TEXELS row lengths and the BVH
+// sizes are #defines from src/layout.rs, injected into every program.
 
-vec4 primitive_texel(int prim, int i) { return texelFetch(u_primitives, ivec2(i, prim), 0); }
+vec4 primitive_texel(int prim, int i) {
+    ivec2 at = ivec2((prim % PRIMITIVES_PER_ROW) * PRIMITIVE_TEXELS + i, prim / PRIMITIVES_PER_ROW);
+    return texelFetch(u_primitives, at, 0);
+}
 
-vec4 intersect_primitive(int prim, vec3 o, vec3 d) {
+vec4 intersect_primitive_ray(int prim, SceneRay r) {
     vec4 head = primitive_texel(prim, 0);
     int kind = int(head.x);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (kind == PRIM_SPHERE) return intersect_sphere(o, d, a.xyz, a.w);
-    if (kind == PRIM_CYLINDER) return intersect_cylinder(o, d, a.xyz, b.xyz, a.w, b.w);
+    if (kind == PRIM_SPHERE) return intersect_sphere(r.o, r.d, a.xyz, a.w);
+    if (kind == PRIM_CYLINDER) return intersect_cylinder(r.o, r.d, a.xyz, b.xyz, a.w, b.w);
     vec4 c = primitive_texel(prim, 3);
-    return intersect_planar(o, d, a.xyz, b.xyz, c.xyz, kind == PRIM_TRIANGLE);
+    if (kind == PRIM_TRIANGLE) return intersect_triangle(r, a.xyz, b.xyz, c.xyz);
+    return intersect_parallelogram(r.o, r.d, a.xyz, b.xyz, c.xyz);
+}
+
+vec4 intersect_primitive(int prim, vec3 o, vec3 d) {
+    return intersect_primitive_ray(prim, scene_ray(o, d));
+}
+
+// The geometric normal of primitive `prim` at p: outward for spheres and
+// cylinders, e1 x e2 for planar shapes (v1 - v0, v2 - v0 for triangles).
+vec3 geometric_normal(int prim, vec3 p) {
+    int kind = int(primitive_texel(prim, 0).x);
+    vec4 a = primitive_texel(prim, 1);
+    vec4 b = primitive_texel(prim, 2);
+    if (kind == PRIM_SPHERE) return normalize(p - a.xyz);
+    if (kind == PRIM_CYLINDER) {
+        vec3 r = p - a.xyz;
+        return normalize(r - dot(r, b.xyz) * b.xyz);
+    }
+    vec3 c = primitive_texel(prim, 3).xyz;
+    if (kind == PRIM_TRIANGLE) return normalize(cross(b.xyz - a.xyz, c - a.xyz));
+    return normalize(cross(b.xyz, c));
 }
 
 // The hit point rebuilt from surface parameters, not from o + t d: its error then
 // scales with the surface's coordinates, not with the ray's length (pbrt-v4, 6.8).
-// Also returns the geometric normal (outward for spheres and cylinders,
-// e1 x e2 for planar shapes).
+// Also returns the geometric normal.
 vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
     vec4 head = primitive_texel(prim, 0);
     int kind = int(head.x);
@@ -45,9 +72,13 @@ vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
         normal = normalize(r - dot(r, b.xyz) * b.xyz);
         return on_axis + a.w * normal;
     }
-    vec4 c = primitive_texel(prim, 3);
-    normal = normalize(cross(b.xyz, c.xyz));
-    return a.xyz + hit.y * b.xyz + hit.z * c.xyz;
+    vec3 c = primitive_texel(prim, 3).xyz;
+    if (kind == PRIM_TRIANGLE) {
+        normal = normalize(cross(b.xyz - a.xyz, c - a.xyz));
+        return (1.0 - hit.y - hit.z) * a.xyz + hit.y * b.xyz + hit.z * c;
+    }
+    normal = normalize(cross(b.xyz, c));
+    return a.xyz + hit.y * b.xyz + hit.z * c;
 }
 
 int primitive_material(int prim) { return int(primitive_texel(prim, 0).y); }
@@ -68,28 +99,91 @@ vec3 offset_origin(vec3 p, vec3 n, vec3 dir) {
     return p + (dot(dir, n) >= 0.0 ? s : -s) * n;
 }
 
+// ---- BVH traversal: an ordered stack (near child first; the far one pushed
+// with its entry distance, and dropped unread once a closer hit is known).
+
+ivec4 bvh_node_texel(int node, int which) {
+    int i = 2 * node + which;
+    return texelFetch(u_bvh_nodes, ivec2(i % BVH_ROW_TEXELS, i / BVH_ROW_TEXELS), 0);
+}
+
+int bvh_leaf_primitive(int position) {
+    return texelFetch(u_bvh_order, ivec2(position % BVH_ROW_TEXELS, position / BVH_ROW_TEXELS), 0).x;
+}
+
+// BOX_ROBUST (src/layout.rs) widens the far distance of the slab test.
+const float BOX_MISS = 1e30;
+
+// Entry distance of the ray into the box (lo, hi), or BOX_MISS.
+float box_entry(ivec4 lo, ivec4 hi, SceneRay r, float t_max) {
+    vec3 t0 = (intBitsToFloat(lo.xyz) - r.o) * r.inv;
+    vec3 t1 = (intBitsToFloat(hi.xyz) - r.o) * r.inv;
+    vec3 near = min(t0, t1), far = max(t0, t1);
+    float t_in = max(max(near.x, near.y), max(near.z, 0.0));
+    float t_out = min(min(far.x, far.y), far.z) * BOX_ROBUST;
+    return t_in <= min(t_out, t_max) ? t_in : BOX_MISS;
+}
+
+// The closest primitive hit before best.x (set by the caller), or -1; with
+// any_hit, the first found. best becomes its record.
+int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
+    if (u_primitive_count == 0) return -1;
+    ivec4 lo = bvh_node_texel(0, 0), hi = bvh_node_texel(0, 1);
+    if (box_entry(lo, hi, r, best.x) == BOX_MISS) return -1;
+    int hit = -1;
+    int a = lo.w, b = hi.w; // inner: children a, b; leaf: -b primitives from a
+    ivec2 stack_node[BVH_STACK];
+    float stack_entry[BVH_STACK];
+    int depth = 0;
+    for (;;) {
+        if (b < 0) {
+            for (int i = a; i < a - b; ++i) {
+                int prim = bvh_leaf_primitive(i);
+                vec4 h = intersect_primitive_ray(prim, r);
+                if (h.w > 0.0 && h.x < best.x) {
+                    best = h;
+                    hit = prim;
+                }
+            }
+            if (any_hit && hit >= 0) return hit;
+        } else {
+            ivec4 l0 = bvh_node_texel(a, 0), l1 = bvh_node_texel(a, 1);
+            ivec4 r0 = bvh_node_texel(b, 0), r1 = bvh_node_texel(b, 1);
+            float tl = box_entry(l0, l1, r, best.x);
+            float tr = box_entry(r0, r1, r, best.x);
+            if (min(tl, tr) < BOX_MISS) {
+                bool right_first = tr < tl;
+                if (max(tl, tr) < BOX_MISS) {
+                    stack_node[depth] = right_first ? ivec2(l0.w, l1.w) : ivec2(r0.w, r1.w);
+                    stack_entry[depth] = max(tl, tr);
+                    ++depth; // at most the tree's depth - 1 (checked on the host)
+                }
+                ivec2 near = right_first ? ivec2(r0.w, r1.w) : ivec2(l0.w, l1.w);
+                a = near.x;
+                b = near.y;
+                continue;
+            }
+        }
+        while (depth > 0 && stack_entry[depth - 1] >= best.x) --depth;
+        if (depth == 0) break;
+        --depth;
+        a = stack_node[depth].x;
+        b = stack_node[depth].y;
+    }
+    return hit;
+}
+
 // Closest hit along a unit direction: returns the primitive or -1, with its record.
 int closest_hit(vec3 o, vec3 d, out vec4 best) {
     best = NO_HIT;
-    int best_prim = -1;
-    for (int i = 0; i < u_primitive_count; ++i) {
-        vec4 h = intersect_primitive(i, o, d);
-        if (h.w > 0.0 && h.x < best.x) {
-            best = h;
-            best_prim = i;
-        }
-    }
-    return best_prim;
+    return bvh_trace(scene_ray(o, d), false, best);
 }
 
 // Whether anything blocks the segment from o toward o + t_max d (d unit).
 // Glass blocks too: light through glass arrives as caustic photons, not here.
 bool occluded(vec3 o, vec3 d, float t_max) {
-    for (int i = 0; i < u_primitive_count; ++i) {
-        vec4 h = intersect_primitive(i, o, d);
-        if (h.w > 0.0 && h.x < t_max) return true;
-    }
-    return false;
+    vec4 h = vec4(t_max, 0.0, 0.0, 0.0);
+    return bvh_trace(scene_ray(o, d), true, h) >= 0;
 }
 
 vec4 material_texel(int m, int i) { return texelFetch(u_materials, ivec2(i, m), 0); }

@@ -28,19 +28,6 @@ layout(location = 1) out vec4 o_power;
 layout(location = 2) out vec4 o_incoming;
 layout(location = 3) out vec4 o_outgoing;
 
-// The normal of primitive `prim` at p (for the origin offset).
-vec3 primitive_normal(int prim, vec3 p) {
-    int kind = int(primitive_texel(prim, 0).x);
-    vec4 a = primitive_texel(prim, 1);
-    vec4 b = primitive_texel(prim, 2);
-    if (kind == PRIM_SPHERE) return normalize(p - a.xyz);
-    if (kind == PRIM_CYLINDER) {
-        vec3 r = p - a.xyz;
-        return normalize(r - dot(r, b.xyz) * b.xyz);
-    }
-    return normalize(cross(b.xyz, primitive_texel(prim, 3).xyz));
-}
-
 // What the previous interaction multiplies the power by on the way out.
 vec3 leaving_factor(int mat) {
     if (mat < 0) return vec3(1.0); // emission
@@ -66,7 +53,7 @@ void main() {
     vec3 d = last_outgoing.xyz;
     int last_prim = int(last_outgoing.w);
     vec3 origin = last_position.xyz;
-    if (last_prim >= 0) origin = offset_origin(origin, primitive_normal(last_prim, origin), d);
+    if (last_prim >= 0) origin = offset_origin(origin, geometric_normal(last_prim, origin), d);
 
     vec4 hit;
     int prim = closest_hit(origin, d, hit);

@@ -11,6 +11,7 @@ pub enum TexFormat {
     R32F,
     Rgba32I,
     Rg32I,
+    R32I,
 }
 
 impl TexFormat {
@@ -18,12 +19,15 @@ impl TexFormat {
         match self {
             TexFormat::Rgba32F | TexFormat::Rgba32I => 4,
             TexFormat::Rg32F | TexFormat::Rg32I => 2,
-            TexFormat::R32F => 1,
+            TexFormat::R32F | TexFormat::R32I => 1,
         }
     }
 
     pub fn is_integer(self) -> bool {
-        matches!(self, TexFormat::Rgba32I | TexFormat::Rg32I)
+        matches!(
+            self,
+            TexFormat::Rgba32I | TexFormat::Rg32I | TexFormat::R32I
+        )
     }
 
     fn gl(self) -> (u32, u32, u32) {
@@ -33,6 +37,7 @@ impl TexFormat {
             TexFormat::R32F => (glow::R32F, glow::RED, glow::FLOAT),
             TexFormat::Rgba32I => (glow::RGBA32I, glow::RGBA_INTEGER, glow::INT),
             TexFormat::Rg32I => (glow::RG32I, glow::RG_INTEGER, glow::INT),
+            TexFormat::R32I => (glow::R32I, glow::RED_INTEGER, glow::INT),
         }
     }
 }

@@ -61,7 +61,7 @@ pub fn intersect_cylinder(
     None
 }
 
-pub fn intersect_planar(o: Vec3, d: Vec3, corner: Vec3, e1: Vec3, e2: Vec3, triangle: bool) -> Hit {
+pub fn intersect_parallelogram(o: Vec3, d: Vec3, corner: Vec3, e1: Vec3, e2: Vec3) -> Hit {
     let pvec = d.cross(e2);
     let det = e1.dot(pvec);
     if det == 0.0 {
@@ -75,11 +75,104 @@ pub fn intersect_planar(o: Vec3, d: Vec3, corner: Vec3, e1: Vec3, e2: Vec3, tria
     }
     let qvec = tvec.cross(e1);
     let v = d.dot(qvec) * inv_det;
-    if v < 0.0 || (if triangle { u + v > 1.0 } else { v > 1.0 }) {
+    if !(0.0..=1.0).contains(&v) {
         return None;
     }
     let t = e2.dot(qvec) * inv_det;
     (t > 0.0).then_some((t, u, v))
+}
+
+/// The ray prepared for the watertight triangle test, as `SceneRay` in GLSL.
+#[derive(Clone, Copy, Debug)]
+pub struct ShearedRay {
+    pub o: Vec3,
+    pub d: Vec3,
+    /// 1 / d, zero components replaced by +-1e30 (for box tests).
+    pub inv: Vec3,
+    pub k: [usize; 3],
+    pub s: Vec3,
+}
+
+impl ShearedRay {
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let inv = Vec3::from_array(d.to_array().map(|c| {
+            if c.abs() < 1e-30 {
+                if c < 0.0 {
+                    -1e30
+                } else {
+                    1e30
+                }
+            } else {
+                1.0 / c
+            }
+        }));
+        let a = d.abs();
+        let kz = if a.x > a.y {
+            if a.x > a.z {
+                0
+            } else {
+                2
+            }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let kx = if kz == 2 { 0 } else { kz + 1 };
+        let ky = if kx == 2 { 0 } else { kx + 1 };
+        let (kx, ky) = if d[kz] < 0.0 { (ky, kx) } else { (kx, ky) };
+        let sz = 1.0 / d[kz];
+        Self {
+            o,
+            d,
+            inv,
+            k: [kx, ky, kz],
+            s: Vec3::new(d[kx] * sz, d[ky] * sz, sz),
+        }
+    }
+}
+
+/// a b - c d with its exact sign: a float 0 is recomputed in f64, where the products are exact.
+fn edge_function(a: f32, b: f32, c: f32, d: f32) -> f32 {
+    let e = a * b - c * d;
+    if e != 0.0 {
+        e
+    } else {
+        (a as f64 * b as f64 - c as f64 * d as f64) as f32
+    }
+}
+
+/// Watertight (Woop, Benthin and Wald 2013); (u, v) weigh v1 and v2.
+pub fn intersect_triangle(r: &ShearedRay, v0: Vec3, v1: Vec3, v2: Vec3) -> Hit {
+    let [kx, ky, kz] = r.k;
+    let (a, b, c) = (v0 - r.o, v1 - r.o, v2 - r.o);
+    let (ax, ay) = (a[kx] - r.s.x * a[kz], a[ky] - r.s.y * a[kz]);
+    let (bx, by) = (b[kx] - r.s.x * b[kz], b[ky] - r.s.y * b[kz]);
+    let (cx, cy) = (c[kx] - r.s.x * c[kz], c[ky] - r.s.y * c[kz]);
+    let u = edge_function(cx, by, cy, bx);
+    let v = edge_function(ax, cy, ay, cx);
+    let w = edge_function(bx, ay, by, ax);
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return None;
+    }
+    let t_scaled = u * (r.s.z * a[kz]) + v * (r.s.z * b[kz]) + w * (r.s.z * c[kz]);
+    if (if det < 0.0 { -t_scaled } else { t_scaled }) <= 0.0 {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    Some((t_scaled * inv_det, v * inv_det, w * inv_det))
+}
+
+/// The hit of a prepared ray with one primitive.
+pub fn intersect_geometry_ray(g: &Geometry, r: &ShearedRay) -> Hit {
+    match *g {
+        Geometry::Triangle { v0, v1, v2 } => intersect_triangle(r, v0, v1, v2),
+        _ => intersect_geometry(g, r.o, r.d),
+    }
 }
 
 pub fn intersect_geometry(g: &Geometry, o: Vec3, d: Vec3) -> Hit {
@@ -95,8 +188,8 @@ pub fn intersect_geometry(g: &Geometry, o: Vec3, d: Vec3) -> Hit {
             corner,
             edge1,
             edge2,
-        } => intersect_planar(o, d, corner, edge1, edge2, false),
-        Geometry::Triangle { v0, v1, v2 } => intersect_planar(o, d, v0, v1 - v0, v2 - v0, true),
+        } => intersect_parallelogram(o, d, corner, edge1, edge2),
+        Geometry::Triangle { v0, v1, v2 } => intersect_triangle(&ShearedRay::new(o, d), v0, v1, v2),
     }
 }
 

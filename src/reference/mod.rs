@@ -1,5 +1,6 @@
 //! Plain-Rust twins of the GPU kernels, for tests and the paper's software column.
 
+pub mod bvh;
 pub mod intersect;
 pub mod knn;
 pub mod path_trace;

@@ -47,10 +47,10 @@ pub fn surface_point(g: &Geometry, o: Vec3, d: Vec3, t: f32, u: f32, v: f32) -> 
             corner + u * edge1 + v * edge2,
             edge1.cross(edge2).normalize(),
         ),
-        Geometry::Triangle { v0, v1, v2 } => {
-            let (e1, e2) = (v1 - v0, v2 - v0);
-            (v0 + u * e1 + v * e2, e1.cross(e2).normalize())
-        }
+        Geometry::Triangle { v0, v1, v2 } => (
+            (1.0 - u - v) * v0 + u * v1 + v * v2,
+            (v1 - v0).cross(v2 - v0).normalize(),
+        ),
     }
 }
 

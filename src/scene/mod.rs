@@ -1,9 +1,11 @@
 //! The scene: a plain-Rust model of camera, shapes, materials, lights and the
 //! paper's per-scene parameters, loaded from TOML (+ OBJ) and validated.
 
+pub mod bvh;
 pub mod camera_path;
 pub mod defaults;
 pub mod embedded;
+pub mod generate;
 pub mod load;
 pub mod pack;
 

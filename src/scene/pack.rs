@@ -1,14 +1,18 @@
 //! The scene packed into float textures once, in the layout glsl/common/scene.glsl reads.
 
+use crate::error::Error;
 use crate::gpu::{Gpu, Result, TexFormat, Texture};
 use crate::layout::{
-    LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE, MAT_EMITTER, MAT_GLASS,
-    MAT_MIRROR, PRIMITIVE_TEXELS, PRIM_CYLINDER, PRIM_PARALLELOGRAM, PRIM_SPHERE, PRIM_TRIANGLE,
+    BVH_ROW_TEXELS, LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE,
+    MAT_EMITTER, MAT_GLASS, MAT_MIRROR, PRIMITIVES_PER_ROW, PRIMITIVE_TEXELS, PRIM_CYLINDER,
+    PRIM_PARALLELOGRAM, PRIM_SPHERE, PRIM_TRIANGLE,
 };
 
+use super::bvh::FlatBvh;
 use super::{Geometry, Light, Material, Scene};
 
-/// Rows of RGBA floats, one row per primitive / material / light.
+/// RGBA float texels: PRIMITIVE_TEXELS a primitive (PRIMITIVES_PER_ROW to a
+/// row of the texture), one row per material and per light.
 pub struct PackedScene {
     pub primitives: Vec<[f32; 4]>,
     pub materials: Vec<[f32; 4]>,
@@ -35,7 +39,9 @@ pub fn pack_geometry(g: &Geometry) -> [[f32; 4]; 3] {
             edge1,
             edge2,
         } => [v(corner, 0.0), v(edge1, 0.0), v(edge2, 0.0)],
-        Geometry::Triangle { v0, v1, v2 } => [v(v0, 0.0), v(v1 - v0, 0.0), v(v2 - v0, 0.0)],
+        // Vertices, not edges: triangles sharing a vertex must share its exact bits
+        // for the watertight test (v0 + (v1 - v0) need not round to v1).
+        Geometry::Triangle { v0, v1, v2 } => [v(v0, 0.0), v(v1, 0.0), v(v2, 0.0)],
     }
 }
 
@@ -140,6 +146,12 @@ impl PackedScene {
 /// The packed scene on the GPU.
 pub struct SceneTextures {
     pub primitives: Texture,
+    /// The BVH's nodes (RGBA32I, 2 texels a node) and its leaf order (R32I).
+    pub bvh_nodes: Texture,
+    pub bvh_order: Texture,
+    /// Levels and nodes of the BVH, for reports.
+    pub bvh_depth: u32,
+    pub bvh_node_count: usize,
     pub materials: Texture,
     pub lights: Texture,
     pub primitive_count: usize,
@@ -148,17 +160,51 @@ pub struct SceneTextures {
 }
 
 fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture> {
-    let height = (rows.len() as u32 / width).max(1);
+    let height = (rows.len().div_ceil(width as usize) as u32).max(1);
     let mut data: Vec<f32> = rows.iter().flatten().copied().collect();
-    data.resize((width * height * 4) as usize, 0.0);
+    data.resize(width as usize * height as usize * 4, 0.0);
     Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, &data)
+}
+
+/// `values` (channels of `format` a texel) in rows of BVH_ROW_TEXELS texels.
+fn upload_ints(gpu: &Gpu, mut values: Vec<i32>, format: TexFormat) -> Result<Texture> {
+    let row = BVH_ROW_TEXELS as usize * format.channels();
+    let height = values.len().div_ceil(row).max(1);
+    values.resize(row * height, 0);
+    Texture::from_i32_format(gpu, BVH_ROW_TEXELS, height as u32, format, &values)
+}
+
+/// Refuses a scene whose primitive texture this driver cannot hold.
+fn check_primitive_capacity(gpu: &Gpu, count: usize) -> Result<()> {
+    let rows = count.div_ceil(PRIMITIVES_PER_ROW as usize);
+    let max = gpu.max_texture_size() as usize;
+    if rows > max {
+        return Err(Error::TooLarge(format!(
+            "{count} primitives: this driver's textures hold at most {} ({PRIMITIVES_PER_ROW} a row, {max} rows)",
+            max * PRIMITIVES_PER_ROW as usize
+        )));
+    }
+    Ok(())
 }
 
 impl SceneTextures {
     pub fn new(gpu: &Gpu, scene: &Scene) -> Result<Self> {
+        check_primitive_capacity(gpu, scene.shapes.len())?;
+        let bvh = super::bvh::build(scene)?;
+        Self::with_bvh(gpu, scene, &bvh)
+    }
+
+    /// The textures with a hierarchy built already (tests pass their own).
+    pub fn with_bvh(gpu: &Gpu, scene: &Scene, bvh: &FlatBvh) -> Result<Self> {
         let p = PackedScene::new(scene);
+        let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
+        let order: Vec<i32> = bvh.order.iter().map(|&i| i as i32).collect();
         Ok(Self {
-            primitives: upload(gpu, &p.primitives, PRIMITIVE_TEXELS)?,
+            primitives: upload(gpu, &p.primitives, PRIMITIVE_TEXELS * PRIMITIVES_PER_ROW)?,
+            bvh_nodes: upload_ints(gpu, nodes, TexFormat::Rgba32I)?,
+            bvh_order: upload_ints(gpu, order, TexFormat::R32I)?,
+            bvh_depth: bvh.depth,
+            bvh_node_count: bvh.nodes.len(),
             materials: upload(gpu, &p.materials, MATERIAL_TEXELS)?,
             lights: upload(gpu, &p.lights, LIGHT_TEXELS)?,
             primitive_count: p.primitive_count,
@@ -170,6 +216,8 @@ impl SceneTextures {
     /// Binds the textures and counts that glsl/common/scene.glsl declares.
     pub fn bind(&self, b: &mut crate::gpu::Bindings<'_>) {
         b.texture("u_primitives", &self.primitives)
+            .texture("u_bvh_nodes", &self.bvh_nodes)
+            .texture("u_bvh_order", &self.bvh_order)
             .texture("u_materials", &self.materials)
             .texture("u_lights", &self.lights)
             .int("u_primitive_count", self.primitive_count as i32)
