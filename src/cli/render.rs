@@ -236,7 +236,7 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     warn_far_from_origin(scene, args.quiet);
     let options = args.options(scene);
     let cameras = match &args.camera_path {
-        Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera)?,
+        Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera, scene.origin)?,
         None => vec![scene.camera.clone()],
     };
     let gpu = super::gpu(platform)?;
@@ -346,7 +346,7 @@ fn warn_far_from_origin(scene: &Scene, quiet: bool) {
     let ratio = scene.offset_ratio();
     if ratio > 1000.0 && !quiet {
         eprintln!(
-            "warning: coordinates reach {ratio:.0} x the scene's size; 32-bit floats resolve them only to ~{:.0e} of it, so fine detail (sharp caustics) may blur: move the scene near the origin",
+            "warning: coordinates reach {ratio:.0} x the scene's size, even with the scene rebased to its centre; 32-bit floats resolve them only to ~{:.0e} of it, so fine detail (sharp caustics) may blur: bring the camera and the scene's parts closer together",
             ratio * f32::EPSILON
         );
     }

@@ -8,12 +8,17 @@
 //! look_at = [0.0, 0.6, 0.0]
 //! vfov = 38.0                 # optional: the scene's
 //! ```
+//!
+//! Key positions are in the scene file's frame: they are read in f64 and
+//! rebased to the scene's local origin (`Scene::origin`) like the scene's
+//! own points.
 
 use std::path::Path;
 
-use glam::Vec3;
+use glam::DVec3;
 use serde::Deserialize;
 
+use super::rebase::{dvec3, Coord};
 use super::{Camera, SceneError};
 
 #[derive(Deserialize)]
@@ -26,13 +31,18 @@ struct PathFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Key {
-    position: [f32; 3],
-    look_at: [f32; 3],
+    position: [Coord; 3],
+    look_at: [Coord; 3],
     vfov: Option<f32>,
 }
 
-/// The cameras of a path, each like `base` (size, up) but placed as the path says.
-pub fn load_camera_path(path: &Path, base: &Camera) -> Result<Vec<Camera>, SceneError> {
+/// The cameras of a path, each like `base` (size, up) but placed as the path
+/// says, in the frame of a scene whose local origin is `origin`.
+pub fn load_camera_path(
+    path: &Path,
+    base: &Camera,
+    origin: DVec3,
+) -> Result<Vec<Camera>, SceneError> {
     let err = |line: usize, field: &str, message: String| SceneError {
         file: path.to_path_buf(),
         line,
@@ -56,8 +66,9 @@ pub fn load_camera_path(path: &Path, base: &Camera) -> Result<Vec<Camera>, Scene
     }
     let mut keys = Vec::new();
     for (i, k) in file.key.iter().enumerate() {
-        let (p, l) = (Vec3::from(k.position), Vec3::from(k.look_at));
+        let (p, l) = (dvec3(k.position), dvec3(k.look_at));
         let vfov = k.vfov.unwrap_or(base.vfov_degrees);
+        let (p, l) = ((p - origin).as_vec3(), (l - origin).as_vec3());
         if !p.is_finite() || !l.is_finite() || (p - l).length() == 0.0 {
             return Err(err(
                 0,

@@ -8,10 +8,15 @@ pub mod embedded;
 pub mod generate;
 pub mod load;
 pub mod pack;
+pub mod rebase;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
-pub use load::{load_scene, load_scene_str, load_scene_str_with_overrides, SceneError};
+pub use load::{
+    load_scene, load_scene_str, load_scene_str_translated, load_scene_str_with_overrides,
+    SceneError,
+};
+pub use rebase::Rebase;
 
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -194,6 +199,12 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub render: RenderParams,
     pub photon_map: PhotonMapParams,
+    /// Where the scene's local origin stands in the world (its file's
+    /// frame): every point above is relative to it. The loader reads points
+    /// in f64 and rebases them (`rebase`) so that a scene far from the
+    /// world's origin keeps f32's precision; the renderer, translation-
+    /// invariant, works in the local frame. Zero for `with_shapes`.
+    pub origin: DVec3,
 }
 
 impl Scene {
@@ -216,6 +227,7 @@ impl Scene {
             materials,
             shapes,
             lights,
+            origin: DVec3::ZERO,
         }
     }
 
@@ -229,9 +241,12 @@ impl Scene {
         bounds_size(&self.shapes, &self.lights)
     }
 
-    /// The largest coordinate magnitude over the scene's size: past ~1e3, f32
-    /// positions are coarse against the scene's own details, which blur
-    /// (stress suite: RING moved by 1e4 leaves the seed-to-seed tolerance).
+    /// The largest coordinate magnitude over the scene's size, in the local
+    /// frame the renderer works in: past ~1e3, f32 positions are coarse
+    /// against the scene's own details, which blur. A loaded scene is
+    /// rebased to its centre, so a scene that is merely far from the world's
+    /// origin measures ~1 here; what remains large is a scene whose parts
+    /// (camera included) are far from each other against its shapes' size.
     pub fn offset_ratio(&self) -> f32 {
         let (lo, hi) = self.bounds();
         let far = lo
