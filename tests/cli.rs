@@ -1230,3 +1230,68 @@ fn threads_do_not_change_the_image() {
         );
     }
 }
+
+#[test]
+fn bench_meshes_reports_every_size_with_rates_renders_and_a_plot() {
+    let d = tmp("meshes");
+    let out = photonmap()
+        .args([
+            "bench",
+            "meshes",
+            "--triangles",
+            "8,2000",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--photons",
+            "4096",
+            "--json",
+            "--out",
+        ])
+        .arg(&d)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = report["rows"].as_array().unwrap();
+    // The analytic ball, then the meshes as generated (the UV sphere rounds the count).
+    let triangles: Vec<u64> = rows
+        .iter()
+        .map(|r| r["triangles"].as_u64().unwrap())
+        .collect();
+    assert_eq!(triangles[0], 0);
+    assert_eq!(triangles[1], 8);
+    assert!((1800..2200).contains(&triangles[2]), "{triangles:?}");
+    for r in rows {
+        for rate in [
+            "eye_rays_per_second",
+            "shadow_rays_per_second",
+            "photon_rays_per_second",
+        ] {
+            assert!(r[rate].as_f64().unwrap() > 0.0, "{rate}: {r}");
+        }
+        assert!(r["render_seconds"].as_f64().unwrap() > 0.0);
+        assert!(r["bvh_depth"].as_u64().unwrap() >= 1);
+    }
+    assert_eq!(rows[0]["rays"]["eye_rays"], 48 * 32);
+    assert!(report["provenance"]["renderer"].as_str().is_some());
+    for f in [
+        "meshes.json",
+        "meshes.svg",
+        "render_analytic.png",
+        "render_8.png",
+    ] {
+        assert!(d.join(f).is_file(), "{f} missing");
+    }
+    let bad = photonmap()
+        .args(["bench", "meshes", "--triangles", "4"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("8"));
+}

@@ -422,70 +422,34 @@ fn log_points(r: &AccuracyReport) -> (Vec<f64>, Vec<f64>) {
     (xs.collect(), ys.collect())
 }
 
-/// Relative MSE against seconds, log-log, the Pareto front joined: an SVG
-/// written by hand (plotters' text needs system fonts CI may lack).
+/// RMSE against seconds, log-log, the Pareto front joined.
 pub fn svg_plot(r: &AccuracyReport) -> String {
-    let (w, h, m) = (720.0, 480.0, 70.0);
-    let (xs, ys) = log_points(r);
-    let (x0, x1) = (
-        xs.iter().copied().fold(f64::INFINITY, f64::min).floor(),
-        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil(),
+    let mut plot = super::plot::LogLog::new(
+        &format!(
+            "{}: RMSE against the SPPM reference, by run time (log-log)",
+            r.scene
+        ),
+        "seconds per render (wall clock)",
+        "RMSE of one render (bias and noise)",
     );
-    let (y0, y1) = (
-        ys.iter().copied().fold(f64::INFINITY, f64::min).floor(),
-        ys.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil(),
-    );
-    let (x1, y1) = (
-        if x1 <= x0 { x0 + 1.0 } else { x1 },
-        if y1 <= y0 { y0 + 1.0 } else { y1 },
-    );
-    let px = |x: f64| m + (x - x0) / (x1 - x0) * (w - 2.0 * m);
-    let py = |y: f64| h - m - (y - y0) / (y1 - y0) * (h - 2.0 * m);
-    let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n");
-    s += &format!("<text x=\"{}\" y=\"22\" font-size=\"15\" text-anchor=\"middle\">{}: RMSE against the SPPM reference, by run time (log-log)</text>\n", w / 2.0, r.scene);
-    s += &format!("<line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n<line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>\n", h - m, w - m, h - m, h - m);
-    for d in x0 as i64..=x1 as i64 {
-        let x = px(d as f64);
-        s += &format!("<line x1=\"{x}\" y1=\"{}\" x2=\"{x}\" y2=\"{}\" stroke=\"black\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">{} s</text>\n", h - m, h - m + 5.0, h - m + 18.0, 10f64.powi(d as i32));
-    }
-    for d in y0 as i64..=y1 as i64 {
-        let y = py(d as f64);
-        s += &format!("<line x1=\"{}\" y1=\"{y}\" x2=\"{m}\" y2=\"{y}\" stroke=\"black\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{d}</text>\n", m - 5.0, m - 8.0, y + 4.0);
-    }
-    s += &format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">seconds per render (wall clock)</text>\n",
-        w / 2.0,
-        h - 20.0
-    );
-    s += &format!("<text x=\"18\" y=\"{}\" transform=\"rotate(-90 18 {})\" text-anchor=\"middle\">RMSE of one render (bias and noise)</text>\n", h / 2.0, h / 2.0);
-    let mut front: Vec<usize> = (0..r.runs.len())
-        .filter(|&i| r.runs[i].on_pareto_front)
-        .collect();
-    front.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]));
-    let path: Vec<String> = front
+    let point = |x: &AccuracyRun| (x.seconds, x.rmse, x.label.clone());
+    let front = r
+        .runs
         .iter()
-        .map(|&i| format!("{:.1},{:.1}", px(xs[i]), py(ys[i])))
+        .filter(|x| x.on_pareto_front)
+        .map(point)
         .collect();
-    s += &format!(
-        "<polyline points=\"{}\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"1.5\"/>\n",
-        path.join(" ")
-    );
-    for (i, run) in r.runs.iter().enumerate() {
-        let colour = match (run.on_pareto_front, run.method.as_str()) {
-            (true, _) => "#d62728",
-            (false, "sppm") => "#2ca02c",
-            _ => "#1f77b4",
-        };
-        s += &format!(
-            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{colour}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"9\">{}</text>\n",
-            px(xs[i]),
-            py(ys[i]),
-            px(xs[i]) + 6.0,
-            py(ys[i]) - 5.0,
-            run.label
-        );
+    plot.points("#d62728", front, true);
+    for (method, colour) in [("sppm", "#2ca02c"), ("photon map", "#1f77b4")] {
+        let others = r
+            .runs
+            .iter()
+            .filter(|x| !x.on_pareto_front && (x.method == "sppm") == (method == "sppm"))
+            .map(point)
+            .collect();
+        plot.points(colour, others, false);
     }
-    s + "</svg>\n"
+    plot.svg()
 }
 
 /// The same plot as a PNG: points and the front on log-log axes (no text; the SVG has the labels).

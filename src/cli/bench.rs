@@ -16,9 +16,12 @@ pub enum BenchCommand {
     /// difficult paths, the furnace; one JSON object per case with --json.
     Stress(StressArgs),
     /// Run time against error around a scene's defaults (photons, k, maximum
-    /// radius, shadow rays, build, tiling, samples), against its converged
+    /// radius, shadow rays, build, tiling, samples) and SPPM, against its SPPM
     /// reference; CSV, JSON, SVG and PNG plots of the Pareto front.
     Accuracy(super::accuracy::AccuracyArgs),
+    /// The BVH at scale: a ball on a floor, analytic and as meshes of growing
+    /// size; BVH build, eye/shadow/photon rays per second, render times.
+    Meshes(super::meshes::MeshesArgs),
     /// Whether the stencil test skips fragment work on this driver (the
     /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
     Mask(MaskArgs),
@@ -73,6 +76,7 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
         BenchCommand::Stress(a) => run_stress(&a, platform),
         BenchCommand::Accuracy(a) => super::accuracy::run_bench(&a, platform),
         BenchCommand::Mask(a) => run_mask(&a, platform),
+        BenchCommand::Meshes(a) => super::meshes::run(&a, platform),
         BenchCommand::Build(a) => {
             if a.min_log2 > a.max_log2 {
                 bail!(

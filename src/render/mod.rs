@@ -8,6 +8,7 @@ pub mod explain;
 pub mod observer;
 pub mod plan;
 pub mod radiance_estimate;
+pub mod ray_rates;
 pub mod ray_trace;
 pub mod software;
 pub mod sppm;

@@ -67,8 +67,6 @@ pub const MAX_PROJECTION_RESOLUTION: u32 = 128;
 pub const IOR_RANGE: (f32, f32) = (1.0, 10.0);
 /// Every coordinate stays within this magnitude.
 pub const MAX_COORDINATE: f32 = 1e15;
-/// Explicit shapes plus mesh triangles the brute-force tracer loops over.
-pub const MAX_PRIMITIVES: usize = 16384;
 
 // ---- the defaults as parameter sets ------------------------------------------
 

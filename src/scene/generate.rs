@@ -53,10 +53,17 @@ impl IndexedMesh {
 /// A unit sphere of about `triangles` triangles (at least 8) whose radius is
 /// displaced by up to 10% by smooth bumps: closed, outward winding.
 pub fn displaced_sphere(triangles: usize) -> IndexedMesh {
+    uv_sphere(triangles, 0.05)
+}
+
+/// A unit UV sphere of about `triangles` triangles (at least 8), its radius
+/// displaced by smooth bumps of up to 2 `bumps` (0: a plain sphere, whose
+/// vertices lie on the unit sphere): closed, outward winding.
+pub fn uv_sphere(triangles: usize, bumps: f32) -> IndexedMesh {
     // Rings r and 2r columns give 4r(r - 1) triangles.
     let rings = ((triangles as f64 / 4.0).sqrt().round() as u32).max(2);
     let columns = 2 * rings;
-    let bump = |d: Vec3| 1.0 + 0.05 * ((7.0 * d.x).sin() * (5.0 * d.y).sin() + (6.0 * d.z).cos());
+    let bump = |d: Vec3| 1.0 + bumps * ((7.0 * d.x).sin() * (5.0 * d.y).sin() + (6.0 * d.z).cos());
     let point = |theta: f32, phi: f32| {
         let d = Vec3::new(
             theta.sin() * phi.cos(),

@@ -44,8 +44,7 @@ use super::defaults::{
     MAX_BOUNCES, MAX_COORDINATE, MAX_PROJECTION_RESOLUTION, MIN_PROJECTION_RESOLUTION, VFOV_RANGE,
 };
 pub use super::defaults::{
-    MAX_GRID_SIDE, MAX_IMAGE_SIDE, MAX_K, MAX_PHOTONS_STORED, MAX_PRIMITIVES, MAX_SHADOW_RAYS,
-    MAX_SPECULAR_DEPTH,
+    MAX_GRID_SIDE, MAX_IMAGE_SIDE, MAX_K, MAX_PHOTONS_STORED, MAX_SHADOW_RAYS, MAX_SPECULAR_DEPTH,
 };
 use super::rebase::{self, dvec3, Coord, Rebase};
 use super::{Camera, Geometry, Light, Material, PhotonMapParams, RenderParams, Scene, Shape};
@@ -302,9 +301,6 @@ fn read_scene(cx: &Cx, root: &DeTable) -> Result<Scene, SceneError> {
             "light",
             "the scene has no [[light]]: nothing would be lit".into(),
         ));
-    }
-    if shapes.len() > MAX_PRIMITIVES {
-        return Err(cx.err(0..0, "shape", format!("{} primitives (mesh triangles included); at most {MAX_PRIMITIVES} are supported until an acceleration structure exists", shapes.len())));
     }
     let photon_map = photon_map.finish(cx, &shapes, &materials)?;
     let name = name.unwrap_or_else(|| {
