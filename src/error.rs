@@ -28,6 +28,9 @@ pub struct SceneError {
 
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
+    /// SIGINT or SIGTERM came (src/interrupt.rs): the work stopped and nothing was written.
+    #[error("interrupted by {}: stopped, and no output was written", signal_name(*.signal))]
+    Interrupted { signal: i32 },
     /// The headless platform (EGL or OSMesa) could not give a GL 4.5 context.
     #[error("{0}")]
     Platform(String),
@@ -88,9 +91,6 @@ pub enum Error {
     },
     #[error("GL: the scene stores caustics only, but no light can send a photon towards a mirror or glass shape")]
     NoCausticPath,
-    /// Work the caller asked to stop (a signal).
-    #[error("interrupted")]
-    Interrupted,
 }
 
 impl Error {
@@ -100,5 +100,14 @@ impl Error {
             path: path.into(),
             source,
         }
+    }
+}
+
+/// A stopping signal's name, for messages.
+pub fn signal_name(signal: i32) -> &'static str {
+    match signal {
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
     }
 }

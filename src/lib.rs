@@ -11,6 +11,7 @@
 pub mod error;
 pub mod gpu;
 pub mod image;
+pub mod interrupt;
 pub mod layout;
 pub mod metrics;
 pub mod photon;

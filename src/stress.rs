@@ -208,6 +208,10 @@ pub fn run(gpu: &Gpu, quick: bool, progress: &dyn Fn(&str)) -> Vec<StressCase> {
     grids(gpu, quick, progress, &mut cases);
     bad_input(gpu, &mut cases);
     difficult_paths(gpu, &mut cases);
+    meshes(gpu, progress, &mut cases);
+    if !quick {
+        progressive(gpu, progress, &mut cases);
+    }
     progress("furnace");
     cases.push(case(
         "furnace: closed diffuse sphere, point light at its centre",
@@ -587,4 +591,173 @@ fn difficult_paths(gpu: &Gpu, cases: &mut Vec<StressCase>) {
             Ok((out.image.mean()[0], o, m))
         })),
     }
+}
+
+/// Renders `changed` and `original` at 64 x 48 and scores the first against
+/// the second by relative MSE, with twice the original's seed-to-seed relative
+/// MSE as the limit.
+fn same_image(
+    gpu: &Gpu,
+    original: &Scene,
+    changed: &Scene,
+    detail: &str,
+) -> Result<(f64, Outcome, String)> {
+    let (w, h) = (64, 48);
+    let base = render(gpu, original, &small(original, w, h, 1), &mut ())?;
+    let other_seed = render(gpu, original, &small(original, w, h, 2), &mut ())?;
+    let noise = compare(&other_seed.image, &base.image, None)?.rel_mse;
+    let (out, bad) = finite_render(gpu, changed, &small(changed, w, h, 1))?;
+    let e = compare(&out.image, &base.image, None)?.rel_mse;
+    let (o, m) = verdict(
+        e <= 2.0 * noise,
+        &bad,
+        format!("seed-to-seed {noise:.5}; {detail}"),
+    );
+    Ok((e, o, m))
+}
+
+/// Meshes: degenerate and duplicate triangles change nothing, and a mesh
+/// file placed 1e6 from the origin renders as at the origin.
+fn meshes(gpu: &Gpu, progress: &dyn Fn(&str), cases: &mut Vec<StressCase>) {
+    use crate::scene::{Geometry, Shape};
+    let figure = "relative MSE against the original (limit: 2 x seed-to-seed)";
+    progress("degenerate and duplicate triangles");
+    cases.push(case(
+        "GLASS BALL plus degenerate triangles and its floor twice more as coincident triangles",
+        figure,
+        || {
+            let original = embedded::load("glass_ball")?;
+            let mut changed = original.clone();
+            let floor = original.shapes[0];
+            let Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            } = floor.geometry
+            else {
+                return Err(Error::InvalidOption(
+                    "GLASS BALL's first shape is not its floor".into(),
+                ));
+            };
+            let (a, b, c, d) = (
+                corner,
+                corner + edge1,
+                corner + edge1 + edge2,
+                corner + edge2,
+            );
+            let lifted = |p: Vec3| p + Vec3::new(0.0, 0.5, 0.0);
+            let triangles = [
+                (a, b, c),
+                (a, c, d),
+                (a, b, c),
+                (a, c, d), // the floor, twice, coincident
+                (
+                    lifted(a),
+                    lifted(c),
+                    lifted(a) + 2.0 * (lifted(c) - lifted(a)),
+                ), // collinear
+                (lifted(b), lifted(b), lifted(b)), // a point
+                (lifted(a), lifted(a), lifted(d)), // two equal vertices
+            ];
+            for (v0, v1, v2) in triangles {
+                changed.shapes.push(Shape {
+                    geometry: Geometry::Triangle { v0, v1, v2 },
+                    material: floor.material,
+                });
+            }
+            same_image(gpu, &original, &changed, "7 triangles added")
+        },
+    ));
+    progress("a mesh 1e6 from the origin");
+    cases.push(case(
+        "a 20,000-triangle OBJ mesh moved by 1e6 (MESH STAGE)",
+        figure,
+        || {
+            let dir =
+                tempfile::tempdir().map_err(|e| Error::io("create", std::env::temp_dir(), e))?;
+            let obj = dir.path().join("ball.obj");
+            let mesh = crate::scene::generate::uv_sphere(20_000, 0.0);
+            std::fs::write(&obj, mesh.to_obj(false)).map_err(|e| Error::io("write", &obj, e))?;
+            let stage = embedded::source("variants/mesh_stage").unwrap_or_default();
+            let sphere = "type = \"sphere\"\ncenter = [0.0, 0.9, 0.0]\nradius = 0.9\n";
+            if !stage.contains(sphere) {
+                return Err(Error::InvalidOption(
+                    "MESH STAGE has no ball to replace".into(),
+                ));
+            }
+            let text = stage.replace(
+                sphere,
+                &format!(
+                    "type = \"mesh\"\nfile = {:?}\nscale = 0.9\ntranslate = [0.0, 0.9, 0.0]\n",
+                    obj.display().to_string()
+                ),
+            );
+            let file = dir.path().join("stage.toml");
+            let at_origin = load_scene_str(&text, &file)?;
+            let moved = load_scene_str_translated(
+                &text,
+                &file,
+                DVec3::new(1e6, -1e6, 1e6),
+                Rebase::SceneCentre,
+            )?;
+            let o = moved.origin.to_array();
+            same_image(gpu, &at_origin, &moved, &format!("local origin {o:?}"))
+        },
+    ));
+}
+
+/// SPPM run for thousands of iterations: no NaN or Inf anywhere in its state
+/// and image, and every radius still positive (alpha 0.5 shrinks them fastest
+/// of the usual choices).
+fn progressive(gpu: &Gpu, progress: &dyn Fn(&str), cases: &mut Vec<StressCase>) {
+    const ITERATIONS: u32 = 2000;
+    progress("SPPM over 2000 iterations");
+    cases.push(case(
+        "SPPM over 2000 iterations (RING, 32 x 24, alpha 0.5, 1024 photons an iteration)",
+        "smallest radius over the first (pixels that gathered photons)",
+        || {
+            let scene = embedded::load("ring")?;
+            let options = small(&scene, 32, 24, 1);
+            let sppm_options = crate::render::sppm::SppmOptions {
+                iterations: ITERATIONS,
+                alpha: 0.5,
+                photons_per_iteration: 1024,
+                ..Default::default()
+            };
+            let mut sppm = crate::render::sppm::Sppm::new(gpu, &scene, &options, &sppm_options)?;
+            let mut timings = crate::timing::Timings::default();
+            for _ in 0..ITERATIONS {
+                sppm.iterate(&mut timings, &mut ())?;
+            }
+            let (flux, sums) = (sppm.state.flux.read_f32(), sppm.state.sums.read_f32());
+            let image = sppm.image()?;
+            let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+            let image_finite = image.pixels.iter().flatten().all(|x| x.is_finite());
+            let mut bad = Vec::new();
+            for (name, ok) in [
+                ("state", finite(&flux) && finite(&sums)),
+                ("image", image_finite),
+            ] {
+                if !ok {
+                    bad.push(name);
+                }
+            }
+            let smallest = flux
+                .chunks(4)
+                .zip(sums.chunks(4))
+                .filter(|(_, s)| s[3] > 0.0)
+                .map(|(f, _)| f[3].sqrt())
+                .fold(f32::INFINITY, f32::min);
+            let relative = f64::from(smallest / sppm.initial_radius);
+            let (o, m) = verdict(
+                smallest > 0.0 && smallest.is_finite(),
+                &bad.join(", "),
+                format!(
+                    "first radius {}, smallest now {smallest:.3e}",
+                    sppm.initial_radius
+                ),
+            );
+            Ok((relative, o, m))
+        },
+    ));
 }

@@ -114,8 +114,25 @@ fn run_stress(a: &StressArgs, platform: Platform) -> Result<()> {
             );
         }
     }
-    if cases.iter().any(|c| c.outcome == Outcome::Fail) {
-        bail!("some stress cases failed");
+    let count = |o: Outcome| cases.iter().filter(|c| c.outcome == o).count();
+    let (pass, fail, refused) = (
+        count(Outcome::Pass),
+        count(Outcome::Fail),
+        count(Outcome::Refused),
+    );
+    let seconds: f64 = cases.iter().map(|c| c.seconds).sum();
+    if a.json {
+        let summary = serde_json::json!({ "summary": {
+            "cases": cases.len(), "pass": pass, "fail": fail, "refused": refused, "seconds": seconds } });
+        println!("{summary}");
+    } else {
+        println!(
+            "{} cases: {pass} pass, {fail} fail, {refused} refused ({seconds:.1} s)",
+            cases.len()
+        );
+    }
+    if fail > 0 {
+        bail!("{fail} stress cases failed");
     }
     Ok(())
 }

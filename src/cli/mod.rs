@@ -88,10 +88,18 @@ pub fn out_dir(kind: &str) -> std::path::PathBuf {
     std::path::Path::new("photonmap-out").join(kind)
 }
 
-/// The exit of a command that failed: its error and every cause, on stderr.
+/// The exit of a command that failed: its error and every cause, on stderr;
+/// 128 + the signal after SIGINT or SIGTERM (130, 143), as shells expect.
 pub fn fail(e: anyhow::Error) -> std::process::ExitCode {
     eprintln!("error: {e:#}");
-    std::process::ExitCode::FAILURE
+    let signal = e.chain().find_map(|c| match c.downcast_ref() {
+        Some(photonmap::error::Error::Interrupted { signal }) => Some(*signal),
+        _ => None,
+    });
+    match signal {
+        Some(s) => std::process::ExitCode::from((128 + s) as u8),
+        None => std::process::ExitCode::FAILURE,
+    }
 }
 
 /// Prints `value` as pretty JSON on stdout.

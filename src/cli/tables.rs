@@ -8,7 +8,6 @@ use clap::Args;
 use serde::Serialize;
 
 use photonmap::gpu::{Gpu, Platform};
-use photonmap::image::write_atomically;
 use photonmap::photon::bench::{bench_size, paper_grid, BuildBenchRow};
 use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::render::software::software_image;
@@ -281,8 +280,40 @@ fn visibly_different(a: &Image, b: &Image) -> f64 {
     n as f64 / a.pixels.len().max(1) as f64
 }
 
-fn write_png(path: &Path, img: &Image) -> Result<()> {
-    Ok(write_atomically(path, &img.png_bytes()?)?)
+/// Every file of a `tables` run, kept until the run has finished and then
+/// written all or nothing, so an interrupted or failed run leaves the
+/// previous results as they were.
+#[derive(Default)]
+struct Staged(std::cell::RefCell<Vec<(PathBuf, Vec<u8>)>>);
+
+impl Staged {
+    fn add(&self, path: PathBuf, bytes: Vec<u8>) {
+        self.0.borrow_mut().push((path, bytes));
+    }
+
+    fn png(&self, path: PathBuf, img: &Image) -> Result<()> {
+        self.add(path, img.png_bytes()?);
+        Ok(())
+    }
+
+    /// Writes every file; then removes older snapshots in `figure8/` that this run did not make.
+    fn publish(self, out: &Path) -> Result<()> {
+        let files = self.0.into_inner();
+        let refs: Vec<(&Path, &[u8])> = files
+            .iter()
+            .map(|(p, b)| (p.as_path(), b.as_slice()))
+            .collect();
+        photonmap::image::write_all_atomically(&refs)?;
+        let made: std::collections::HashSet<&Path> = refs.iter().map(|(p, _)| *p).collect();
+        if let Ok(entries) = std::fs::read_dir(out.join("figure8")) {
+            for e in entries.flatten() {
+                if !made.contains(e.path().as_path()) {
+                    let _ = std::fs::remove_file(e.path());
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Counts the instructions of a kernel's optimised SPIR-V (glslangValidator -Os).
@@ -452,8 +483,10 @@ pub fn run_tables(
         .out
         .clone()
         .unwrap_or_else(|| default_out(&caps.gl_renderer));
-    std::fs::create_dir_all(out.join("figure7"))
-        .with_context(|| format!("creating {}", out.display()))?;
+    for dir in ["figure7", "figure8"] {
+        std::fs::create_dir_all(out.join(dir))
+            .with_context(|| format!("creating {}", out.display()))?;
+    }
     let run = TablesRun {
         gpu,
         scale: if o.quick { 4 } else { 1 },
@@ -462,10 +495,11 @@ pub fn run_tables(
         faithful: o.faithful,
         out: &out,
         progress,
+        staged: Staged::default(),
     };
     let (table1, totals, figure7_rows) = run.table1()?;
-    let figure7 = out.join("figure7.png");
-    write_png(&figure7, &montage(&figure7_rows))?;
+    run.staged
+        .png(out.join("figure7.png"), &montage(&figure7_rows))?;
     let convergence = run.section_3_3()?;
     let mut passes = Vec::new();
     for k in 10..=(if o.quick { 12 } else { 20 }) {
@@ -499,12 +533,14 @@ pub fn run_tables(
         figure8,
         table2: table2(),
     };
-    write_atomically(
-        &out.join("results.json"),
-        serde_json::to_string_pretty(&report)?.as_bytes(),
-    )?;
-    write_atomically(&out.join("table1.csv"), table1_csv(&report).as_bytes())?;
-    write_atomically(&out.join("tables.md"), markdown(&report).as_bytes())?;
+    let staged = run.staged;
+    staged.add(
+        out.join("results.json"),
+        serde_json::to_string_pretty(&report)?.into_bytes(),
+    );
+    staged.add(out.join("table1.csv"), table1_csv(&report).into_bytes());
+    staged.add(out.join("tables.md"), markdown(&report).into_bytes());
+    staged.publish(&out)?;
     Ok((report, out))
 }
 
@@ -517,6 +553,7 @@ struct TablesRun<'a> {
     faithful: bool,
     out: &'a Path,
     progress: &'a dyn Fn(&str),
+    staged: Staged,
 }
 
 type Table1 = (Vec<Table1Cell>, Vec<Table1Total>, Vec<Vec<Image>>);
@@ -577,18 +614,16 @@ impl TablesRun<'_> {
                     .out
                     .join("figure7")
                     .join(format!("{name}_{build:?}.png").to_lowercase());
-                write_png(&file, &r.image)?;
+                self.staged.png(file, &r.image)?;
                 row.push(r.image.clone());
                 if build == BuildMethod::Bitonic {
                     (self.progress)(&format!("Figure 7: {name} software reference"));
                     let sw = software_image(&r.state, scene).context("software reference")?;
-                    write_png(
-                        &self
-                            .out
-                            .join("figure7")
-                            .join(format!("{name}_software.png")),
-                        &sw,
-                    )?;
+                    let file = self
+                        .out
+                        .join("figure7")
+                        .join(format!("{name}_software.png"));
+                    self.staged.png(file, &sw)?;
                     row.push(sw);
                 }
             }
@@ -658,11 +693,9 @@ impl TablesRun<'_> {
     /// Figure 8: the GLASS BALL caustic during convergence.
     fn figure8(&self) -> Result<Figure8> {
         (self.progress)("Figure 8: GLASS BALL snapshots");
-        let snap_dir = self.out.join("figure8");
-        std::fs::create_dir_all(&snap_dir)?;
-        for e in std::fs::read_dir(&snap_dir)?.flatten() {
-            let _ = std::fs::remove_file(e.path());
-        }
+        // Snapshots are written to a temporary folder and staged from there.
+        let temporary = tempfile::tempdir()?;
+        let snap_dir = temporary.path().to_path_buf();
         let scene = embedded::load("glass_ball")?;
         let opts = self.options(
             &scene,
@@ -713,7 +746,13 @@ impl TablesRun<'_> {
                 })
             })
             .collect::<Result<_>>()?;
-        write_png(&self.out.join("figure8.png"), &montage(&[crops]))?;
+        let index = std::iter::once("snapshots.json".to_string());
+        for file in written.iter().map(|s| s.file.clone()).chain(index) {
+            let bytes = std::fs::read(snap_dir.join(&file))?;
+            self.staged.add(self.out.join("figure8").join(&file), bytes);
+        }
+        self.staged
+            .png(self.out.join("figure8.png"), &montage(&[crops]))?;
         Ok(Figure8 {
             file: "figure8.png".into(),
             snapshots: picks.iter().map(|&i| snaps[i].clone()).collect(),

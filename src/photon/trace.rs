@@ -350,6 +350,7 @@ impl PhotonTracer {
         gpu_seconds += self.emit_pass(scene, textures, batch, seed)?;
         let mut frames_used = frames;
         for bounce in 1..frames {
+            crate::interrupt::check()?;
             gpu_seconds += self.bounce_pass(scene, textures, batch, seed, bounce)?;
             if self.config.stop_when_dead
                 && bounce + 1 < frames
@@ -548,6 +549,7 @@ impl PhotonTracer {
         let mut attempts = Vec::new();
         let mut all_seconds = 0.0;
         loop {
+            crate::interrupt::check()?;
             let mut batch = self.batch_aimed(scene, aim.clone(), emitted)?;
             self.trace_batch(scene, textures, &mut batch, seed)?;
             let mut frames = batch.frames;

@@ -166,6 +166,7 @@ pub fn render_views(
     for (view, camera) in cameras.iter().enumerate() {
         let mut sum = ImageSum::default();
         for sample in 0..plan.spp {
+            crate::interrupt::check()?;
             let at = At {
                 view,
                 views: cameras.len(),

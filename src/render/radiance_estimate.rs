@@ -223,6 +223,7 @@ impl RadianceEstimate {
             .map(|_| Query::occlusion(&self.gpu))
             .collect::<Result<_>>()?;
         for pass in 0..options.max_passes {
+            crate::interrupt::check()?;
             timer.begin();
             let searching = match options.mode {
                 EstimateMode::Tiled { .. } => {

@@ -441,6 +441,7 @@ pub fn render_sppm(
     let wall = std::time::Instant::now();
     let mut observed = 0.0;
     while run.iteration < sppm.iterations {
+        crate::interrupt::check()?;
         if sppm
             .seconds
             .is_some_and(|s| run.iteration > 0 && wall.elapsed().as_secs_f64() - observed >= s)

@@ -49,7 +49,7 @@ pub fn load_camera_path(
         field: field.into(),
         message,
     };
-    let text = std::fs::read_to_string(path)
+    let text = super::file::read_stable(path)
         .map_err(|e| err(0, "(file)", format!("cannot read the camera path: {e}")))?;
     let file: PathFile = toml::from_str(&text).map_err(|e| {
         let line = e.span().map_or(0, |s| {

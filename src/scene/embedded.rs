@@ -65,7 +65,7 @@ pub fn text_for(arg: &Path) -> Result<(String, std::path::PathBuf), SceneError> 
             return Ok((text.to_string(), file.into()));
         }
     }
-    let text = std::fs::read_to_string(arg).map_err(|e| SceneError {
+    let text = super::file::read_stable(arg).map_err(|e| SceneError {
         file: arg.to_path_buf(),
         line: 0,
         field: "(file)".into(),

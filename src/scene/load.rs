@@ -149,7 +149,7 @@ const LIGHT_KINDS: &Kinds<LightKind> = &[
 // ---- loading -------------------------------------------------------------------
 
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let text = super::file::read_stable(path).map_err(|e| SceneError {
         file: path.to_path_buf(),
         line: 0,
         field: "(file)".into(),

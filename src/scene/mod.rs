@@ -5,6 +5,7 @@ pub mod bvh;
 pub mod camera_path;
 pub mod defaults;
 pub mod embedded;
+pub mod file;
 pub mod generate;
 pub mod load;
 pub mod pack;
