@@ -4,8 +4,12 @@
 //! PHOTONMAP_FUZZ_ITERATIONS sets the length of a run (default 3000 a target),
 //! PHOTONMAP_FUZZ_SEED the mutations.
 //! Inputs that once broke the loader live in tests/fuzz_corpus/regressions/.
+//! The newer inputs (`--set` overrides, camera paths, OBJ with MTL) go
+//! through tests/fuzz/harness.rs, as their cargo-fuzz targets do.
 
 mod common;
+#[path = "fuzz/harness.rs"]
+mod harness;
 
 use common::Rng;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -314,4 +318,70 @@ fn the_cargo_fuzz_corpus_loads_without_panics() {
         replayed += 1;
     }
     assert!(replayed > 1000, "{replayed} corpus files");
+}
+
+/// Mutates the seeds of one harness target (files of `ext` in tests/fuzz_corpus/,
+/// each prefixed with a random byte when `prefix`), and requires no panic and
+/// both outcomes.
+fn mutate_target(
+    what: &str,
+    ext: &str,
+    prefix: bool,
+    target: fn(&[u8]) -> Option<bool>,
+    rng_seed: u64,
+) {
+    let seeds = files(ext);
+    assert!(!seeds.is_empty(), "no .{ext} seeds");
+    let mut rng = Rng(seed(rng_seed));
+    let (mut accepted, mut refused) = (0, 0);
+    for _ in 0..iterations() / 3 {
+        let text = mutate(&seeds[rng.below(seeds.len())], &mut rng);
+        let mut input = Vec::new();
+        if prefix {
+            input.push(rng.below(256) as u8);
+        }
+        input.extend_from_slice(text.as_bytes());
+        match catch_unwind(AssertUnwindSafe(|| target(&input))) {
+            Err(_) => panic!("{what} panicked on:\n{}", String::from_utf8_lossy(&input)),
+            Ok(Some(true)) => accepted += 1,
+            Ok(_) => refused += 1,
+        }
+    }
+    eprintln!("{accepted} mutated {what} accepted, {refused} refused");
+    assert!(
+        accepted > 0 && refused > 0,
+        "the mutations must reach both outcomes"
+    );
+}
+
+#[test]
+fn mutated_overrides_never_panic() {
+    mutate_target("--set overrides", "set", true, harness::overrides, 0x5e7);
+}
+
+#[test]
+fn mutated_camera_paths_never_panic_and_accepted_cameras_have_a_basis() {
+    mutate_target("camera paths", "path", false, harness::camera_path, 0xca3);
+}
+
+#[test]
+fn mutated_obj_and_mtl_files_never_panic() {
+    mutate_target("OBJ + MTL pairs", "objmtl", true, harness::obj_mtl, 0x3711);
+}
+
+/// The corpora of the harness targets, replayed.
+#[test]
+fn the_cargo_fuzz_corpora_of_the_newer_inputs_load_without_panics() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus");
+    for (name, target) in harness::TARGETS {
+        let mut replayed = 0;
+        for entry in std::fs::read_dir(root.join(name)).unwrap().flatten() {
+            let bytes = std::fs::read(entry.path()).unwrap();
+            if catch_unwind(AssertUnwindSafe(|| target(&bytes))).is_err() {
+                panic!("{name} panicked on {}", entry.path().display());
+            }
+            replayed += 1;
+        }
+        assert!(replayed > 0, "no corpus for {name}");
+    }
 }

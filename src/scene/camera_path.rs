@@ -51,6 +51,22 @@ pub fn load_camera_path(
     };
     let text = super::file::read_stable(path)
         .map_err(|e| err(0, "(file)", format!("cannot read the camera path: {e}")))?;
+    camera_path_from_str(&text, path, base, origin)
+}
+
+/// `load_camera_path` on the file's text; `path` names it in errors.
+pub fn camera_path_from_str(
+    text: &str,
+    path: &Path,
+    base: &Camera,
+    origin: DVec3,
+) -> Result<Vec<Camera>, SceneError> {
+    let err = |line: usize, field: &str, message: String| SceneError {
+        file: path.to_path_buf(),
+        line,
+        field: field.into(),
+        message,
+    };
     let file: PathFile = toml::from_str(&text).map_err(|e| {
         let line = e.span().map_or(0, |s| {
             text[..s.start.min(text.len())].matches('\n').count() + 1
@@ -74,6 +90,16 @@ pub fn load_camera_path(
                 0,
                 &format!("key[{i}]"),
                 "position and look_at must be finite and distinct".into(),
+            ));
+        }
+        if (l - p).normalize().cross(base.up).length() < 1e-6 {
+            return Err(err(
+                0,
+                &format!("key[{i}]"),
+                format!(
+                    "looks along the scene camera's up vector {:?}: no image plane is defined",
+                    base.up.to_array()
+                ),
             ));
         }
         if !(vfov > 0.0 && vfov < 180.0) {

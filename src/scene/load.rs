@@ -763,8 +763,13 @@ fn load_obj(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _) = tobj::load_obj(path, &opts)
-        .map_err(|e| format!("cannot read OBJ file {}: {e}", path.display()))?;
+    // tobj panics on some malformed MTL lines (a colour with fewer than three
+    // numbers: found by tests/fuzz_loading.rs); that is a refusal, not a crash.
+    let loaded = std::panic::catch_unwind(|| tobj::load_obj(path, &opts)).map_err(|_| {
+        format!("cannot read OBJ file {}: its MTL file has a malformed line (a colour needs three numbers)", path.display())
+    })?;
+    let (models, _) =
+        loaded.map_err(|e| format!("cannot read OBJ file {}: {e}", path.display()))?;
     let mut tris = Vec::new();
     for model in &models {
         let m = &model.mesh;
