@@ -67,7 +67,7 @@ pub fn camera_path_from_str(
         field: field.into(),
         message,
     };
-    let file: PathFile = toml::from_str(&text).map_err(|e| {
+    let file: PathFile = toml::from_str(text).map_err(|e| {
         let line = e.span().map_or(0, |s| {
             text[..s.start.min(text.len())].matches('\n').count() + 1
         });
