@@ -72,8 +72,11 @@ pub fn obj_mtl(data: &[u8]) -> Option<bool> {
     Some(load_scene_str(&scene, &dir.path().join("scene.toml")).is_ok())
 }
 
+/// A target: its input's bytes to whether they were accepted.
+pub type Target = fn(&[u8]) -> Option<bool>;
+
 /// The targets by name, as their corpus folders are named.
-pub const TARGETS: [(&str, fn(&[u8]) -> Option<bool>); 3] = [
+pub const TARGETS: [(&str, Target); 3] = [
     ("overrides", overrides),
     ("camera_path", camera_path),
     ("obj_mtl", obj_mtl),
