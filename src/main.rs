@@ -42,10 +42,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    if let Err(e) = photonmap::interrupt::install() {
-        eprintln!("note: SIGINT and SIGTERM will end the program at once: {e}");
-    }
-    cli::set_threads(cli.threads);
+    cli::prepare(cli.threads);
     let p = cli.platform;
     let result = match cli.command {
         Command::Render(a) => cli::render::run(&a, p),

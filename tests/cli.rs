@@ -831,10 +831,14 @@ fn the_binary_alone_renders_by_name_lists_scenes_and_runs_the_stress_suite() {
         assert!(listed.contains(name), "{listed}");
     }
     let out = run(&["bench", "stress", "--quick", "--json", "--quiet"]);
-    let cases: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+    let mut cases: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
+    // The last line sums the cases up.
+    let summary = cases.pop().unwrap();
+    assert_eq!(summary["summary"]["cases"], cases.len(), "{summary}");
+    assert_eq!(summary["summary"]["fail"], 0, "{summary}");
     assert!(cases.len() >= 15, "{} cases", cases.len());
     for c in &cases {
         assert_ne!(c["outcome"], "fail", "{c}");

@@ -28,6 +28,9 @@ fn render_gi(
     };
     gi.estimate.mode = mode;
     gi.estimate.budget = 48;
+    // The paper's estimate, which the CPU twin, brute force and the software
+    // reference compute (the leak tests have their own test below).
+    gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
     o.global = Some(gi);
     render(&gpu, scene, &o, &mut ()).unwrap()
 }

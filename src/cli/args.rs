@@ -78,8 +78,9 @@ pub struct EstimateArgs {
     pub budget: u32,
     /// Which photons in the search sphere may light a pixel: all (none, the
     /// paper's; light leaks through walls thinner than the radius), those near
-    /// its tangent plane (disc), those nothing blocks (visibility), or both.
-    #[arg(long, value_enum, default_value_t = LeakTest::None)]
+    /// its tangent plane (disc), those nothing blocks (visibility, the
+    /// default), or both.
+    #[arg(long, value_enum, default_value_t = LeakTest::Visibility)]
     pub leak_test: LeakTest,
 }
 

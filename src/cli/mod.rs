@@ -45,6 +45,14 @@ pub fn gpu(platform: Platform) -> Result<Gpu> {
     Ok(gpu)
 }
 
+/// Before any command: the signal handlers (src/interrupt.rs) and llvmpipe's threads.
+pub fn prepare(threads: Option<u32>) {
+    if let Err(e) = photonmap::interrupt::install() {
+        eprintln!("note: SIGINT and SIGTERM will end the program at once: {e}");
+    }
+    set_threads(threads);
+}
+
 /// The provenance's driver part.
 pub fn with_driver(
     mut p: photonmap::provenance::Provenance,

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
+use photonmap::render::radiance_estimate::LeakTest;
 
 use photonmap::gpu::Platform;
 use photonmap::image::{check_writable, write_all_atomically, write_atomically};
@@ -252,6 +253,10 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     observer.finish()?;
     let written = write_images(&out.image, outputs.images(), &provenance)?;
     if let Some(path) = &args.reference_software {
+        let leak = options.global.as_ref().map(|g| g.estimate.leak);
+        if !args.quiet && leak.is_some_and(|l| l != LeakTest::None) {
+            eprintln!("note: the software reference is the paper's estimate, with no leak test; add --leak-test none to compare like with like");
+        }
         write_software_reference(&out, scene, path, args.quiet)?;
     }
     if args.json {

@@ -184,6 +184,9 @@ fn options(
         ..GlobalIllumination::default()
     };
     gi.estimate.mode = mode;
+    // The paper's estimate, every photon in the sphere, so the times compare
+    // with the paper's (the default leak test costs RING about half again).
+    gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
     o.global = Some(gi);
     o
 }

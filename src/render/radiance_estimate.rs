@@ -60,7 +60,8 @@ pub struct EstimateOptions {
     pub max_passes: u32,
     /// The paper's float convert1dto2d for photon addresses (`--faithful`).
     pub float_addressing: bool,
-    /// Which photons in the sphere may light the query point.
+    /// Which photons in the sphere may light the query point (default:
+    /// visibility; README, "Light through walls").
     pub leak: LeakTest,
 }
 
@@ -71,7 +72,7 @@ impl Default for EstimateOptions {
             budget: 64,
             max_passes: 100_000,
             float_addressing: false,
-            leak: LeakTest::None,
+            leak: LeakTest::Visibility,
         }
     }
 }
