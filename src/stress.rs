@@ -102,6 +102,8 @@ pub fn transformed(scene: &Scene, s: f32, t: Vec3) -> Scene {
                 position: p(position),
                 intensity: intensity * s * s,
             },
+            // Its triangles are shapes, moved above.
+            Light::Triangles { .. } => *light,
         };
     }
     out.photon_map.max_radius *= s;

@@ -291,6 +291,7 @@ fn projection_maps_keep_every_direction_that_reaches_a_specular_shape() {
                         edge2,
                         ..
                     } => corner + a * edge1 + b * edge2,
+                    Light::Triangles { .. } => unreachable!("the paper scenes have none"),
                 };
                 let d = emission_direction(light, u, v);
                 if specular

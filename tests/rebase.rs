@@ -29,6 +29,8 @@ fn points(s: &Scene) -> Vec<Vec3> {
         match *light {
             Light::Area { corner, .. } => p.push(corner),
             Light::Point { position, .. } => p.push(position),
+            // Its triangles are shapes, counted above.
+            Light::Triangles { .. } => {}
         }
     }
     if let Some((lo, hi)) = s.photon_map.grid_bounds {

@@ -24,13 +24,13 @@ impl IndexedMesh {
             .collect();
         self.triangles
             .iter()
-            .map(|t| Shape {
-                geometry: Geometry::Triangle {
+            .map(|t| {
+                let geometry = Geometry::Triangle {
                     v0: p[t[0] as usize],
                     v1: p[t[1] as usize],
                     v2: p[t[2] as usize],
-                },
-                material,
+                };
+                Shape::new(geometry, material)
             })
             .collect()
     }
