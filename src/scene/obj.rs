@@ -105,7 +105,7 @@ pub fn load(path: &Path, with_mtl: bool) -> Result<ObjMesh, String> {
                 _ => Ok((Vec::new(), Default::default())),
             },
         )
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+        .map_err(|e| format!("OBJ file {}: {e}", path.display()))?;
     let materials = scan
         .libraries
         .iter()
@@ -135,7 +135,7 @@ pub fn load(path: &Path, with_mtl: bool) -> Result<ObjMesh, String> {
         for tri in m.indices.chunks_exact(3) {
             let Some((face, k)) = faces.next() else {
                 return Err(format!(
-                    "{}: tobj read more triangles than the file's faces give (a bug)",
+                    "OBJ file {}: tobj read more triangles than the file's faces give (a bug)",
                     path.display()
                 ));
             };
@@ -155,7 +155,7 @@ pub fn load(path: &Path, with_mtl: bool) -> Result<ObjMesh, String> {
     }
     if faces.next().is_some() {
         return Err(format!(
-            "{}: tobj read fewer triangles than the file's faces give (a bug)",
+            "OBJ file {}: tobj read fewer triangles than the file's faces give (a bug)",
             path.display()
         ));
     }
@@ -203,9 +203,9 @@ impl Library {
             return Vec::new();
         }
         match tobj::load_mtl_buf(&mut Cursor::new(self.text.as_bytes())) {
-            Err(e) => vec![Err(format!("{}: {e}", self.path.display()))],
+            Err(e) => vec![Err(format!("MTL file {}: {e}", self.path.display()))],
             Ok((mats, _)) if mats.len() != self.names.len() => vec![Err(format!(
-                "{}: tobj read {} materials where the file defines {}",
+                "MTL file {}: tobj read {} materials where the file defines {}",
                 self.path.display(),
                 mats.len(),
                 self.names.len()
@@ -249,7 +249,7 @@ fn prescan_obj(text: &str, path: &Path, with_mtl: bool) -> Result<Scan, String> 
     };
     let mut counts = Counts::default();
     for (i, line) in text.lines().enumerate() {
-        let at = |message: String| format!("{}:{}: {message}", path.display(), i + 1);
+        let at = |message: String| format!("OBJ file {}:{}: {message}", path.display(), i + 1);
         let mut words = line.split_whitespace();
         match words.next() {
             Some("v") => {
@@ -259,7 +259,7 @@ fn prescan_obj(text: &str, path: &Path, with_mtl: bool) -> Result<Scan, String> 
                     .find(|c| !c.is_finite() || c.abs() > MAX_OBJ_COORDINATE)
                 {
                     return Err(at(format!(
-                        "v: coordinate {bad} (coordinates must be finite, within {MAX_OBJ_COORDINATE:e})"
+                        "v: coordinate {bad} is not a finite number within {MAX_OBJ_COORDINATE:e}"
                     )));
                 }
                 counts.positions += 1;
@@ -302,8 +302,19 @@ fn prescan_obj(text: &str, path: &Path, with_mtl: bool) -> Result<Scan, String> 
             }
             Some("mtllib") if with_mtl => {
                 let written = line.split_once(' ').unwrap_or_default().1.trim();
-                let lib = library(path, written).map_err(at)?;
-                scan.libraries.push(lib);
+                if written.is_empty() {
+                    return Err(at("mtllib: no file named".into()));
+                }
+                let full = path.parent().unwrap_or(Path::new(".")).join(written);
+                let text = read_text(&full).map_err(|e| at(format!("mtllib: {e}")))?;
+                // Errors inside it name the MTL file and its line.
+                let names = prescan_mtl(&text, &full)?;
+                scan.libraries.push(Library {
+                    written: PathBuf::from(written),
+                    path: full,
+                    text,
+                    names,
+                });
             }
             Some("usemtl") if with_mtl => {
                 let name = line.split_once(' ').unwrap_or_default().1.trim();
@@ -398,23 +409,27 @@ fn face<'a>(words: impl Iterator<Item = &'a str>, counts: &Counts) -> Result<Fac
             return Err(format!("f: corner `{corner}` has more than 3 indices"));
         }
         let kinds = [
-            ("vertex", counts.positions),
-            ("texture coordinate", counts.texcoords),
-            ("normal", counts.normals),
+            ("vertex", "vertices", counts.positions),
+            (
+                "texture coordinate",
+                "texture coordinates",
+                counts.texcoords,
+            ),
+            ("normal", "normals", counts.normals),
         ];
         let mut indices = [None; 3];
         for (k, part) in parts.iter().enumerate() {
             if part.is_empty() && k > 0 {
                 continue;
             }
-            let (what, defined) = kinds[k];
+            let (what, plural, defined) = kinds[k];
             let i: isize = part
                 .parse()
                 .map_err(|_| format!("f: corner `{corner}`: `{part}` is not an index"))?;
             let resolved = if i < 0 { defined as isize + i } else { i - 1 };
             if i == 0 || resolved < 0 || resolved >= defined as isize {
                 return Err(format!(
-                    "f: corner `{corner}` refers to {what} {i}, but {defined} {what}s are defined before this line"
+                    "f: corner `{corner}` refers to {what} {i}, but {defined} {plural} are defined before this line"
                 ));
             }
             indices[k] = Some(resolved as usize);
@@ -431,28 +446,12 @@ fn face<'a>(words: impl Iterator<Item = &'a str>, counts: &Counts) -> Result<Fac
     })
 }
 
-/// An `mtllib` file beside the OBJ, read and pre-scanned.
-fn library(obj: &Path, written: &str) -> Result<Library, String> {
-    if written.is_empty() {
-        return Err("mtllib: no file named".into());
-    }
-    let path = obj.parent().unwrap_or(Path::new(".")).join(written);
-    let text = read_text(&path).map_err(|e| format!("mtllib: {e}"))?;
-    let names = prescan_mtl(&text, &path)?;
-    Ok(Library {
-        written: PathBuf::from(written),
-        path,
-        text,
-        names,
-    })
-}
-
 /// Checks every MTL line tobj reads (it panics on a colour of fewer than
 /// three numbers); returns each material's name and statement lines.
 fn prescan_mtl(text: &str, path: &Path) -> Result<Vec<(String, HashMap<String, usize>)>, String> {
     let mut out: Vec<(String, HashMap<String, usize>)> = Vec::new();
     for (i, raw) in text.lines().enumerate() {
-        let at = |message: String| format!("{}:{}: {message}", path.display(), i + 1);
+        let at = |message: String| format!("MTL file {}:{}: {message}", path.display(), i + 1);
         let line = raw.trim();
         let mut words = line.split_whitespace();
         let Some(key) = words.next() else { continue };
@@ -518,7 +517,7 @@ pub fn renderer_material(m: &MtlMaterial) -> Result<Material, String> {
             .or_else(|| m.lines.get("newmtl"))
             .copied()
             .unwrap_or(0);
-        format!("{}:{l}: material {:?}", m.file.display(), m.name)
+        format!("MTL file {}:{l}: material {:?}", m.file.display(), m.name)
     };
     let rgb = |c: [f32; 3]| Vec3::from(c);
     let illum = m.mtl.illumination_model;

@@ -43,7 +43,7 @@ pub(super) fn read_mesh(t: &Table, model: &mut Model) -> Result<(), SceneError> 
                 span.clone(),
                 &t.field(&format!("object_materials.{name}")),
                 format!(
-                    "{} has no group or object named {name:?} (it has: {})",
+                    "OBJ file {} has no group or object named {name:?} (it has: {})",
                     path.display(),
                     mesh.objects.join(", ")
                 ),
@@ -136,7 +136,7 @@ fn register_mtl(model: &mut Model, mesh: &ObjMesh, k: usize, file: &str) -> Resu
     match model.names.get(&name) {
         Some(&m) if model.materials[m] == material => Ok(m),
         Some(_) => Err(format!(
-            "{}: material {:?} maps to {material:?}, but a different material named {name:?} exists already",
+            "MTL file {}: material {:?} maps to {material:?}, but a different material named {name:?} exists already",
             mtl.file.display(),
             mtl.name
         )),
@@ -150,7 +150,7 @@ fn register_mtl(model: &mut Model, mesh: &ObjMesh, k: usize, file: &str) -> Resu
 
 fn no_material(path: &std::path::Path, tri: &ObjTriangle, object: &str) -> String {
     format!(
-        "{}:{}: this face (of {object:?}) has no material: no `usemtl` of an MTL file before it, and the [[shape]] gives no `material` (nor `object_materials` for {object:?})",
+        "OBJ file {}:{}: this face (of {object:?}) has no material: no `usemtl` of an MTL file before it, and the [[shape]] gives no `material` (nor `object_materials` for {object:?})",
         path.display(),
         tri.line
     )
