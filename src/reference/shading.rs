@@ -24,7 +24,7 @@ pub fn shading_normal(shape: &Shape, p: Vec3, n: Vec3) -> Vec3 {
     let w2 = e1.cross(q).dot(c) * inv;
     let s = (1.0 - w1 - w2) * n0 + w1 * n1 + w2 * n2;
     let len = s.length();
-    if !(len > 0.0) || s.dot(n) <= 0.0 {
+    if len.is_nan() || len <= 0.0 || s.dot(n) <= 0.0 {
         return n;
     }
     s / len

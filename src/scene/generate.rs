@@ -35,6 +35,31 @@ impl IndexedMesh {
             .collect()
     }
 
+    /// The mesh as OBJ text (`v` lines, then `f` lines), with a `vn` per
+    /// vertex when `normals` are given (one per position, in order).
+    pub fn obj_text(&self, normals: Option<&[Vec3]>) -> String {
+        let mut out = String::new();
+        for p in &self.positions {
+            out += &format!("v {:?} {:?} {:?}\n", p.x, p.y, p.z);
+        }
+        for n in normals.unwrap_or(&[]) {
+            out += &format!("vn {:?} {:?} {:?}\n", n.x, n.y, n.z);
+        }
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| i + 1);
+            out += &match normals {
+                Some(_) => format!("f {a}//{a} {b}//{b} {c}//{c}\n"),
+                None => format!("f {a} {b} {c}\n"),
+            };
+        }
+        out
+    }
+
+    /// Each vertex's direction from the origin: a sphere's normals.
+    pub fn radial_normals(&self) -> Vec<Vec3> {
+        self.positions.iter().map(|p| p.normalize()).collect()
+    }
+
     /// Triangles of a grid of `rows` x `columns` vertices that wraps around in
     /// columns (and in rows too when `wrap_rows`), offset by `first`.
     fn grid(&mut self, first: u32, rows: u32, columns: u32, wrap_rows: bool) {

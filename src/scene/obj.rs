@@ -187,13 +187,16 @@ struct FaceScan {
     normals: Option<Vec<usize>>,
 }
 
+/// An MTL material's name and the line of each of its statements.
+type MtlNames = Vec<(String, HashMap<String, usize>)>;
+
 /// An `mtllib` the OBJ names: as written, its path, text, and its materials'
 /// names and statement lines.
 struct Library {
     written: PathBuf,
     path: PathBuf,
     text: String,
-    names: Vec<(String, HashMap<String, usize>)>,
+    names: MtlNames,
 }
 
 impl Library {
@@ -448,8 +451,8 @@ fn face<'a>(words: impl Iterator<Item = &'a str>, counts: &Counts) -> Result<Fac
 
 /// Checks every MTL line tobj reads (it panics on a colour of fewer than
 /// three numbers); returns each material's name and statement lines.
-fn prescan_mtl(text: &str, path: &Path) -> Result<Vec<(String, HashMap<String, usize>)>, String> {
-    let mut out: Vec<(String, HashMap<String, usize>)> = Vec::new();
+fn prescan_mtl(text: &str, path: &Path) -> Result<MtlNames, String> {
+    let mut out: MtlNames = Vec::new();
     for (i, raw) in text.lines().enumerate() {
         let at = |message: String| format!("MTL file {}:{}: {message}", path.display(), i + 1);
         let line = raw.trim();
@@ -484,10 +487,10 @@ fn prescan_mtl(text: &str, path: &Path) -> Result<Vec<(String, HashMap<String, u
                 }
             }
             "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns"
-            | "map_NS" | "bump" | "map_d" => {
-                if line[key.len()..].trim().is_empty() {
-                    return Err(at(format!("{key}: no file named")));
-                }
+            | "map_NS" | "bump" | "map_d"
+                if line[key.len()..].trim().is_empty() =>
+            {
+                return Err(at(format!("{key}: no file named")));
             }
             _ => {}
         }
