@@ -7,7 +7,11 @@ use glam::Vec3;
 
 use crate::scene::{triangle_area, Geometry, Light, Material, Scene, Shape};
 
+use crate::scene::pack::PackedScene;
+
 use super::intersect::intersect_geometry;
+use super::photon::sample_light_triangle;
+use super::random::{rng_init, rng_next};
 use super::shading::{facing_shading_normal, specular_about};
 
 /// Closest hit: (shape index, t, point, geometric normal).
@@ -295,4 +299,100 @@ pub fn eye_ray_at(scene: &Scene, width: u32, height: u32, fx: f32, fy: f32) -> (
     let ny = (height as f32 - fy) / height as f32 * 2.0 - 1.0;
     let d = -w + nx * tan_v * aspect * u + ny * tan_v * v;
     (cam.position, d.normalize())
+}
+
+/// glsl/render/direct.frag for the eye ray (o, d) of GL pixel `px` (y up)
+/// at depth 0, drawing the same random numbers from the render's `seed`:
+/// the radiance the pass adds over all `shadow_rays` samples per area light
+/// (path throughput 1). Area lights are the parallelogram's stratified
+/// point, or a `Triangles` light's triangle picked by area and a uniform
+/// point in it (`photon::sample_light_triangle`, the twin of the shader's).
+pub fn direct_light_sampled(
+    scene: &Scene,
+    packed: &PackedScene,
+    seed: u32,
+    px: [u32; 2],
+    shadow_rays: u32,
+    (o, d): (Vec3, Vec3),
+) -> Vec3 {
+    let floor = 1e-6 * scene.size();
+    let Some((i, _t, p, n)) = closest_hit(scene, o, d) else {
+        return Vec3::ZERO;
+    };
+    let shape = &scene.shapes[i];
+    let albedo = match scene.materials[shape.material] {
+        Material::Emitter { radiance, normal } => {
+            return if d.dot(normal.unwrap_or(n)) < 0.0 {
+                radiance
+            } else {
+                Vec3::ZERO
+            };
+        }
+        Material::Diffuse { albedo } => albedo,
+        _ => return Vec3::ZERO,
+    };
+    let nf = if n.dot(d) < 0.0 { n } else { -n };
+    let shaded = shape.normals.is_some();
+    let nsf = facing_shading_normal(shape, p, n, d);
+    let origin = p + offset_scale(p, floor) * nf;
+    let cosine = |wi: Vec3, cos_x: f32| if shaded { nsf.dot(wi).max(0.0) } else { cos_x };
+    let (nx, _) = crate::sampling::strata(shadow_rays);
+    let strata_y = shadow_rays / nx;
+    let row = |l: usize, k: usize| glam::Vec4::from(packed.lights[l * 6 + k]);
+    let mut sum = Vec3::ZERO;
+    for (l, light) in scene.lights.iter().enumerate() {
+        if let Light::Point {
+            position,
+            intensity,
+        } = *light
+        {
+            let to = position - origin;
+            let dist = to.length();
+            let wi = to / dist;
+            let cos_x = nf.dot(wi);
+            if cos_x > 0.0 && !occluded(scene, origin, wi, dist) {
+                sum += intensity * cosine(wi, cos_x) / (dist * dist);
+            }
+            continue;
+        }
+        let emitted = row(l, 4).truncate();
+        let (mut light_sum, mut area) = (Vec3::ZERO, 0.0);
+        for s in 0..shadow_rays {
+            let mut rng = rng_init(seed, px, 0x4000_0000 | ((l as u32) << 12) | s);
+            let su = ((s % nx) as f32 + rng_next(&mut rng)) / nx as f32;
+            let sv = ((s / nx) as f32 + rng_next(&mut rng)) / strata_y as f32;
+            let (q, light_normal) = match *light {
+                Light::Triangles { .. } => {
+                    area = row(l, 1).z;
+                    let (q, normal, _) = sample_light_triangle(packed, l, su, sv);
+                    (q, normal)
+                }
+                _ => {
+                    let (a, e1, e2) = (
+                        row(l, 1).truncate(),
+                        row(l, 2).truncate(),
+                        row(l, 3).truncate(),
+                    );
+                    area = e1.cross(e2).length();
+                    (
+                        a + su * e1 + sv * e2,
+                        Vec3::new(row(l, 0).y, row(l, 0).z, row(l, 0).w),
+                    )
+                }
+            };
+            let to = q - origin;
+            let dist = to.length();
+            let wi = to / dist;
+            let (cos_x, cos_l) = (nf.dot(wi), -light_normal.dot(wi));
+            if cos_x <= 0.0 || cos_l <= 0.0 {
+                continue;
+            }
+            if occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor)) {
+                continue;
+            }
+            light_sum += emitted * (cosine(wi, cos_x) * cos_l / (dist * dist));
+        }
+        sum += light_sum * (area / shadow_rays as f32);
+    }
+    albedo / std::f32::consts::PI * sum
 }

@@ -72,22 +72,24 @@ pub struct ObjMesh {
 }
 
 /// The text of a file a scene refers to: from disk, or, when no such file
-/// exists and the path lies under `scenes/`, its embedded copy.
+/// exists and the path lies under `scenes/`, its embedded copy. The error
+/// says why it cannot be read.
 pub fn read_text(path: &Path) -> Result<String, String> {
     if !path.exists() {
         if let Some(text) = super::embedded::file(path) {
             return Ok(text.to_string());
         }
-        return Err(format!("cannot read {}: no such file", path.display()));
+        return Err("no such file".into());
     }
-    std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+    std::fs::read_to_string(path).map_err(|e| e.to_string())
 }
 
 /// Loads `path`. With `with_mtl` false (the scene gives a `material` for
 /// the whole mesh) the MTL files are not read, and `usemtl` names are not
 /// checked: every triangle's `material` is None.
 pub fn load(path: &Path, with_mtl: bool) -> Result<ObjMesh, String> {
-    let text = read_text(path).map_err(|e| format!("cannot read OBJ file {e}"))?;
+    let text =
+        read_text(path).map_err(|e| format!("cannot read OBJ file {}: {e}", path.display()))?;
     let scan = prescan_obj(&text, path, with_mtl)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
@@ -309,7 +311,12 @@ fn prescan_obj(text: &str, path: &Path, with_mtl: bool) -> Result<Scan, String> 
                     return Err(at("mtllib: no file named".into()));
                 }
                 let full = path.parent().unwrap_or(Path::new(".")).join(written);
-                let text = read_text(&full).map_err(|e| at(format!("mtllib: {e}")))?;
+                let text = read_text(&full).map_err(|e| {
+                    at(format!(
+                        "mtllib: cannot read MTL file {}: {e}",
+                        full.display()
+                    ))
+                })?;
                 // Errors inside it name the MTL file and its line.
                 let names = prescan_mtl(&text, &full)?;
                 scan.libraries.push(Library {
