@@ -172,6 +172,40 @@ fn an_emissive_obj_quad_lights_like_the_equivalent_area_light() {
     );
 }
 
+/// The stage under its area light with its ball as an OBJ sphere of 20,000
+/// triangles with vertex normals, of albedo `albedo` x the analytic ball's.
+fn stage_with_mesh_ball(albedo: f32) -> Scene {
+    let dir = common::tempdir("stage_mesh_ball");
+    common::write_sphere_obj(&dir.join("ball.obj"), 20_000, true);
+    let ball = "type = \"sphere\"\ncenter = [0.3, 0.5, 0.0]\nradius = 0.5\nmaterial = \"ball\"";
+    let mesh = "type = \"mesh\"\nfile = \"ball.obj\"\nscale = 0.5\ntranslate = [0.3, 0.5, 0.0]\nmaterial = \"ball\"";
+    let [r, g, b] = [0.3f32, 0.5, 0.7].map(|c| c * albedo);
+    let text = STAGE.replace(ball, mesh).replace(
+        "ball = { type = \"diffuse\", albedo = [0.3, 0.5, 0.7] }",
+        &format!("ball = {{ type = \"diffuse\", albedo = [{r:?}, {g:?}, {b:?}] }}"),
+    );
+    let light = "[[light]]\ntype = \"area\"\ncorner = [-0.6, 2.2, -0.4]\nedge1 = [0.8, 0.0, 0.0]\nedge2 = [0.0, 0.0, 0.6]\nnormal = [0.0, -1.0, 0.0]\nradiance = [12.0, 12.0, 12.0]\n";
+    load_scene_str(&format!("{text}{light}"), &dir.join("stage.toml")).unwrap()
+}
+
+/// Shading normals are consistent between the eye and the photons: a
+/// diffuse ball as a fine OBJ sphere with vertex normals (shaded by the
+/// interpolated normal, its photons weighted by the adjoint's correction)
+/// renders the stage, direct light and photon map, as the analytic ball does.
+#[test]
+fn a_diffuse_obj_sphere_with_vertex_normals_matches_the_analytic_ball() {
+    let analytic = lit_stage(None);
+    let mesh = stage_with_mesh_ball(1.0);
+    assert!(mesh.shapes.iter().filter(|s| s.normals.is_some()).count() > 19_000);
+    agree(
+        "diffuse ball, analytic against a 20k-triangle OBJ sphere",
+        &renders(&analytic, 48, 36, false, 100),
+        &renders(&mesh, 48, 36, false, 200),
+        &renders(&stage_with_mesh_ball(0.8), 48, 36, false, 300),
+        4,
+    );
+}
+
 // ---- GLASS BALL with a tessellated OBJ sphere -----------------------------------------
 
 /// GLASS BALL with its sphere as an OBJ UV sphere of about `triangles`
