@@ -18,6 +18,15 @@ pub const BVH_STACK: usize = 128;
 /// rounding, so a box never culls a ray its primitives would hit (pbrt-v4 6.1).
 pub const BOX_ROBUST: f32 = 1.0 + 3.0 * f32::EPSILON;
 pub const LIGHT_TEXELS: u32 = 6;
+/// Texels of one triangle's vertex normals (n0, n1, n2) in the normals
+/// texture, and records in one row of it. A primitive's head texel names
+/// its record (.z = record + 1; 0: none, so a primitive without normals
+/// costs nothing).
+pub const NORMAL_TEXELS: u32 = 3;
+pub const NORMALS_PER_ROW: u32 = 1024;
+/// Texels in one row of the emissive-triangle texture: one texel an
+/// emissive triangle, (cumulative area fraction within its light, primitive).
+pub const LIGHT_TRIANGLE_ROW_TEXELS: u32 = 4096;
 
 /// Primitive kinds, the first float of a primitive's head texel.
 pub const PRIM_SPHERE: u32 = 0;
@@ -34,6 +43,8 @@ pub const MAT_EMITTER: u32 = 3;
 /// Light kinds, the first float of a light's head texel.
 pub const LIGHT_AREA: u32 = 0;
 pub const LIGHT_POINT: u32 = 1;
+/// The emissive triangles of an OBJ (object, material) group, sampled by area.
+pub const LIGHT_TRIANGLES: u32 = 2;
 
 /// The key of photon records that are not in the map: they sort last.
 pub const INVALID_KEY: i32 = i32::MAX;
@@ -56,6 +67,9 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PRIMITIVE_TEXELS", u(PRIMITIVE_TEXELS)),
         ("MATERIAL_TEXELS", u(MATERIAL_TEXELS)),
         ("LIGHT_TEXELS", u(LIGHT_TEXELS)),
+        ("NORMAL_TEXELS", u(NORMAL_TEXELS)),
+        ("NORMALS_PER_ROW", u(NORMALS_PER_ROW)),
+        ("LIGHT_TRIANGLE_ROW_TEXELS", u(LIGHT_TRIANGLE_ROW_TEXELS)),
         ("PRIMITIVES_PER_ROW", u(PRIMITIVES_PER_ROW)),
         ("BVH_ROW_TEXELS", u(BVH_ROW_TEXELS)),
         ("BVH_STACK", BVH_STACK.to_string()),
@@ -70,6 +84,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("MAT_EMITTER", u(MAT_EMITTER)),
         ("LIGHT_AREA", u(LIGHT_AREA)),
         ("LIGHT_POINT", u(LIGHT_POINT)),
+        ("LIGHT_TRIANGLES", u(LIGHT_TRIANGLES)),
         ("INVALID_KEY", format!("0x{INVALID_KEY:x}")),
         (
             "RANDOM_PER_PHOTON_FRAME",

@@ -102,6 +102,8 @@ pub fn transformed(scene: &Scene, s: f32, t: Vec3) -> Scene {
                 position: p(position),
                 intensity: intensity * s * s,
             },
+            // Its triangles are shapes, moved above.
+            Light::Triangles { .. } => *light,
         };
     }
     out.photon_map.max_radius *= s;
@@ -660,10 +662,10 @@ fn meshes(gpu: &Gpu, progress: &dyn Fn(&str), cases: &mut Vec<StressCase>) {
                 (lifted(a), lifted(a), lifted(d)), // two equal vertices
             ];
             for (v0, v1, v2) in triangles {
-                changed.shapes.push(Shape {
-                    geometry: Geometry::Triangle { v0, v1, v2 },
-                    material: floor.material,
-                });
+                changed.shapes.push(Shape::new(
+                    Geometry::Triangle { v0, v1, v2 },
+                    floor.material,
+                ));
             }
             same_image(gpu, &original, &changed, "7 triangles added")
         },
@@ -677,7 +679,7 @@ fn meshes(gpu: &Gpu, progress: &dyn Fn(&str), cases: &mut Vec<StressCase>) {
                 tempfile::tempdir().map_err(|e| Error::io("create", std::env::temp_dir(), e))?;
             let obj = dir.path().join("ball.obj");
             let mesh = crate::scene::generate::uv_sphere(20_000, 0.0);
-            std::fs::write(&obj, mesh.to_obj(false)).map_err(|e| Error::io("write", &obj, e))?;
+            std::fs::write(&obj, mesh.obj_text(None)).map_err(|e| Error::io("write", &obj, e))?;
             let stage = embedded::source("variants/mesh_stage").unwrap_or_default();
             let sphere = "type = \"sphere\"\ncenter = [0.0, 0.9, 0.0]\nradius = 0.9\n";
             if !stage.contains(sphere) {

@@ -127,10 +127,7 @@ fn soup(n: usize, rng: &mut Rng, analytic: bool) -> Vec<Shape> {
     }
     geometry
         .into_iter()
-        .map(|geometry| Shape {
-            geometry,
-            material: 0,
-        })
+        .map(|geometry| Shape::new(geometry, 0))
         .collect()
 }
 

@@ -177,6 +177,14 @@ fn assert_sane(scene: &Scene, input: &str) {
                 position,
                 intensity,
             } => [position, intensity].into_iter().for_each(v),
+            Light::Triangles {
+                first,
+                count,
+                radiance,
+            } => {
+                v(radiance);
+                assert!(first + count <= scene.shapes.len() && count > 0);
+            }
         }
     }
     assert!(scene.photon_map.max_radius.is_finite() && scene.photon_map.max_radius > 0.0);

@@ -19,10 +19,7 @@ fn one_shape_scene(g: Geometry) -> Scene {
         Geometry::Triangle { v0, .. } => v0,
     };
     Scene::with_shapes(
-        vec![Shape {
-            geometry: g,
-            material: 0,
-        }],
+        vec![Shape::new(g, 0)],
         vec![Material::Diffuse {
             albedo: Vec3::splat(0.5),
         }],

@@ -29,6 +29,8 @@ fn points(s: &Scene) -> Vec<Vec3> {
         match *light {
             Light::Area { corner, .. } => p.push(corner),
             Light::Point { position, .. } => p.push(position),
+            // Its triangles are shapes, counted above.
+            Light::Triangles { .. } => {}
         }
     }
     if let Some((lo, hi)) = s.photon_map.grid_bounds {
@@ -54,8 +56,15 @@ fn ulps_apart(a: &Scene, b: &Scene, shift: Vec3) -> f32 {
         .fold(0.0, f32::max)
 }
 
+/// Moves of about 1e4, 1e6 and 1e8, each a multiple of 1024: the rounding
+/// step of every embedded scene's local origin (the power of two at or
+/// above its points' box; 2 for the paper scenes, 1024 for the measured
+/// Cornell box in millimetres), so each moved scene is moved back exactly.
 fn moves() -> [DVec3; 3] {
-    [1e4, 1e6, 1e8].map(|d| DVec3::new(d, -d, d))
+    [1e4, 1e6, 1e8].map(|d: f64| {
+        let d = (d / 1024.0).round() * 1024.0;
+        DVec3::new(d, -d, d)
+    })
 }
 
 #[test]
@@ -77,7 +86,7 @@ fn every_embedded_scene_moved_far_loads_as_the_original() {
             let ulps = ulps_apart(&moved, &original, Vec3::ZERO);
             eprintln!("{name} moved by {t}: {ulps} ulps");
             assert!(ulps <= 1.0, "{name} moved by {t}: {ulps} ulps");
-            if t.x == 1e4 {
+            if t.x < 1e5 {
                 assert_eq!(ulps, 0.0, "{name}");
             }
             assert_eq!(moved.offset_ratio(), original.offset_ratio(), "{name}");

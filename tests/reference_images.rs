@@ -158,6 +158,7 @@ fn the_comparison_catches_defects() {
             match l {
                 Light::Area { radiance, .. } => *radiance *= 1.1,
                 Light::Point { intensity, .. } => *intensity *= 1.1,
+                Light::Triangles { radiance, .. } => *radiance *= 1.1,
             }
         }
         for m in &mut bright.materials {

@@ -330,7 +330,7 @@ fn the_paper_scenes_match_the_pinned_numbers() {
         (65000, 500, 32)
     );
     assert_eq!(c.photon_map.grid_resolution, [25, 25, 50]);
-    let power = c.lights[0].power();
+    let power = c.lights[0].power(&c.shapes);
     assert!(
         (power.x - std::f32::consts::PI * 0.25 * 25.0).abs() < 1e-4,
         "{power}"

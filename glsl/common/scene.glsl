@@ -9,6 +9,8 @@ uniform isampler2D u_bvh_nodes;  // 2 texels a node, BVH_ROW_TEXELS a row
 uniform isampler2D u_bvh_order;  // leaf position -> primitive, BVH_ROW_TEXELS a row
 uniform sampler2D u_materials;   // MATERIAL_TEXELS a material
 uniform sampler2D u_lights;      // LIGHT_TEXELS a light
+uniform sampler2D u_normals;     // NORMAL_TEXELS a triangle with vertex normals, NORMALS_PER_ROW a row
+uniform sampler2D u_light_triangles; // a texel an emissive triangle (area cdf, primitive)
 uniform int u_primitive_count;
 uniform int u_light_count;
 
@@ -82,6 +84,37 @@ vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
 }
 
 int primitive_material(int prim) { return int(primitive_texel(prim, 0).y); }
+
+// ---- shading normals: a triangle's vertex normals, interpolated.
+
+// Whether the primitive has vertex normals (head .z = record + 1, 0: none).
+bool has_shading_normal(int prim) { return primitive_texel(prim, 0).z > 0.0; }
+
+// The shading normal at p (a point of primitive prim, whose unit geometric
+// normal is n): the vertex normals interpolated by p's barycentric weights
+// and normalised, on n's side; n itself for a primitive without normals, or
+// where the interpolated normal points to the other side of the face.
+// src/reference/shading.rs is its twin.
+vec3 shading_normal(int prim, vec3 p, vec3 n) {
+    int record = int(primitive_texel(prim, 0).z) - 1;
+    if (record < 0) return n;
+    vec3 a = primitive_texel(prim, 1).xyz;
+    vec3 e1 = primitive_texel(prim, 2).xyz - a;
+    vec3 e2 = primitive_texel(prim, 3).xyz - a;
+    vec3 q = p - a;
+    vec3 c = cross(e1, e2);
+    float inv = 1.0 / dot(c, c);
+    float w1 = dot(cross(q, e2), c) * inv;
+    float w2 = dot(cross(e1, q), c) * inv;
+    ivec2 at = ivec2((record % NORMALS_PER_ROW) * NORMAL_TEXELS, record / NORMALS_PER_ROW);
+    vec3 n0 = texelFetch(u_normals, at, 0).xyz;
+    vec3 n1 = texelFetch(u_normals, at + ivec2(1, 0), 0).xyz;
+    vec3 n2 = texelFetch(u_normals, at + ivec2(2, 0), 0).xyz;
+    vec3 s = (1.0 - w1 - w2) * n0 + w1 * n1 + w2 * n2;
+    float len = length(s);
+    if (!(len > 0.0) || dot(s, n) <= 0.0) return n;
+    return s / len;
+}
 
 // Distance to move a ray origin off a surface at p: relative to p's magnitude
 // (float error in p scales with it) plus a floor relative to the scene's size.
@@ -189,3 +222,34 @@ bool occluded(vec3 o, vec3 d, float t_max) {
 vec4 material_texel(int m, int i) { return texelFetch(u_materials, ivec2(i, m), 0); }
 int material_kind(int m) { return int(material_texel(m, 0).x); }
 vec4 light_texel(int l, int i) { return texelFetch(u_lights, ivec2(i, l), 0); }
+
+vec4 light_triangle_texel(int i) {
+    return texelFetch(u_light_triangles, ivec2(i % LIGHT_TRIANGLE_ROW_TEXELS, i / LIGHT_TRIANGLE_ROW_TEXELS), 0);
+}
+
+// A point of a LIGHT_TRIANGLES light l, uniform over its area, from two
+// uniforms: u1 picks a triangle in proportion to its area (binary search of
+// the light's cumulative areas) and, rescaled within the triangle's share,
+// gives with u2 a uniform point in it. Also its front-face unit normal and
+// its primitive. (The pdf is 1 / the light's area: row 1 .z.)
+// src/reference/photon.rs `sample_light_triangle` is its twin.
+vec3 sample_light_triangle(int l, float u1, float u2, out vec3 normal, out int prim) {
+    vec4 range = light_texel(l, 1); // first texel, count, area
+    int first = int(range.x);
+    int lo = 0, hi = int(range.y) - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (u1 < light_triangle_texel(first + mid).x) hi = mid;
+        else lo = mid + 1;
+    }
+    vec4 entry = light_triangle_texel(first + lo);
+    float below = lo > 0 ? light_triangle_texel(first + lo - 1).x : 0.0;
+    float u = clamp((u1 - below) / (entry.x - below), 0.0, 1.0);
+    prim = int(entry.y);
+    vec3 a = primitive_texel(prim, 1).xyz;
+    vec3 b = primitive_texel(prim, 2).xyz;
+    vec3 c = primitive_texel(prim, 3).xyz;
+    normal = normalize(cross(b - a, c - a));
+    float s = sqrt(u);
+    return (1.0 - s) * a + (u2 * s) * b + (s - u2 * s) * c;
+}

@@ -2,7 +2,9 @@
 // Frame 0 of the photon textures: each photon leaves a light chosen in
 // proportion to its power, carrying power = light power / (photons emitted x
 // probability of that light). Area lights: a uniform point and a
-// cosine-distributed direction; point lights: an isotropic direction.
+// cosine-distributed direction (the emissive triangles of an OBJ group: a
+// triangle by area, a uniform point in it, cosine about its normal); point
+// lights: an isotropic direction.
 // PROJECTION_MAPS (scenes that store caustics only): lights are picked by the
 // power their projection maps keep, and a direction's two uniforms are drawn
 // within a kept cell (src/photon/projection.rs), the photon carrying the kept
@@ -71,10 +73,18 @@ void main() {
     }
 #endif
     vec3 p, d, power;
+    float leaving = choice.z; // the primitive the photon leaves (-1: none)
     if (int(head.x) == LIGHT_POINT) {
         p = a;
         d = sample_sphere(u1, u2);
         power = 4.0 * PI * emitted;
+    } else if (int(head.x) == LIGHT_TRIANGLES) {
+        vec3 normal;
+        int prim;
+        p = sample_light_triangle(l, u1, u2, normal, prim);
+        d = sample_cosine(normal, u3, u4);
+        power = PI * light_texel(l, 1).z * emitted;
+        leaving = float(prim);
     } else {
         vec3 e1 = light_texel(l, 2).xyz;
         vec3 e2 = light_texel(l, 3).xyz;
@@ -85,5 +95,5 @@ void main() {
     o_position = vec4(p, -1.0);
     o_power = vec4(power / (float(u_emitted) * probability), 0.0);
     o_incoming = vec4(0.0, 0.0, 0.0, 1.0);
-    o_outgoing = vec4(d, choice.z);
+    o_outgoing = vec4(d, leaving);
 }

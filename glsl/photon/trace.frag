@@ -7,11 +7,13 @@
 // stores caustics only: every photon alive at a diffuse hit then came by
 // specular bounces alone); mirrors reflect; glass
 // reflects or refracts by exact Fresnel. Lost or absorbed photons are marked
-// dead, never compacted.
+// dead, never compacted. On triangles with vertex normals, mirror and glass
+// directions are taken about the shading normal, and the power takes the
+// adjoint's shading-normal correction (below).
 #include "common/scene.glsl"
 #include "common/photon_random.glsl"
 #include "common/sampling.glsl"
-#include "common/fresnel.glsl"
+#include "common/specular.glsl"
 
 uniform sampler2D u_position;
 uniform sampler2D u_power;
@@ -70,21 +72,38 @@ void main() {
     bool stored = false;
     bool alive = true;
     vec3 next;
+    // Vertex normals: the shading normal on the side the photon arrives at.
+    bool shaded = has_shading_normal(prim);
+    vec3 ms = nf;
+    if (shaded) ms = shading_normal(prim, p, n) * (dot(n, d) < 0.0 ? 1.0 : -1.0);
     if (kind == MAT_DIFFUSE) {
         stored = u_bounce >= 2 || u_store_direct != 0;
         vec3 albedo = material_texel(mat, 1).rgb;
         alive = u_caustics_only == 0 && u0 < max(albedo.r, max(albedo.g, albedo.b));
         next = sample_cosine(nf, u1, u2);
-    } else if (kind == MAT_MIRROR) {
-        next = reflect(d, nf);
+        // The adjoint BSDF with a shading normal (Veach 1997, 5.3): the
+        // photon's power, stored here and carried on (its direction is
+        // cosine-distributed about the geometric normal), is weighted by
+        // |w_in . n_s| / |w_in . n_g|, so that a density estimate with the
+        // plain albedo / pi gives the radiance the eye side computes with the
+        // shading normal's cosine.
+        if (shaded) {
+            float cos_g = -dot(nf, d);
+            power *= cos_g > 0.0 ? max(-dot(ms, d), 0.0) / cos_g : 0.0;
+        }
     } else {
         bool entering = dot(n, d) < 0.0;
-        float ior = material_texel(mat, 0).y;
-        float eta = entering ? 1.0 / ior : ior;
-        float cos_i = -dot(d, nf);
-        float cos_t;
-        float f = fresnel_dielectric(cos_i, eta, cos_t);
-        next = u0 < f ? reflect(d, nf) : eta * d + (eta * cos_i - cos_t) * nf;
+        float ior = kind == MAT_MIRROR ? 0.0 : material_texel(mat, 0).y;
+        if (shaded) {
+            bool used;
+            next = specular_shaded(d, nf, ms, ior, entering, u0, used);
+            // The adjoint's correction for a specular bounce about n_s:
+            // |w_in . n_s| |w_out . n_g| / (|w_in . n_g| |w_out . n_s|).
+            float den = -dot(d, nf) * abs(dot(next, ms));
+            if (used) power *= den > 0.0 ? (-dot(d, ms) * abs(dot(next, nf))) / den : 0.0;
+        } else {
+            next = specular_about(d, nf, ior, entering, u0);
+        }
     }
     o_position = vec4(p, float(mat));
     o_power = vec4(power, stored ? 1.0 : 0.0);

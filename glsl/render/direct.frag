@@ -1,5 +1,6 @@
 #version 450 core
 // Direct light at diffuse hits by shadow rays (stratified over each area light,
+// a parallelogram or the emissive triangles of an OBJ group sampled by area;
 // one ray per point light), and emitters seen along the path. Drawn with additive
 // blending: one call per batch of shadow samples adds its share. It also records
 // the first diffuse hit of each eye path, where the radiance estimate will add
@@ -26,6 +27,24 @@ layout(location = 2) out vec4 o_diffuse_normal;     // facing the viewer, w = ma
 layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the hit
 
 
+// Where shadow sample s of area light l lands: the point q, the light's
+// unit normal there, and the light's area (its pdf is 1 / area). Strata are
+// (su, sv); a LIGHT_TRIANGLES light picks its triangle with su.
+vec3 area_light_point(int l, float su, float sv, out vec3 light_normal, out float area) {
+    vec4 head = light_texel(l, 0);
+    if (int(head.x) == LIGHT_TRIANGLES) {
+        int prim;
+        area = light_texel(l, 1).z;
+        return sample_light_triangle(l, su, sv, light_normal, prim);
+    }
+    vec3 a = light_texel(l, 1).xyz;
+    vec3 e1 = light_texel(l, 2).xyz;
+    vec3 e2 = light_texel(l, 3).xyz;
+    light_normal = head.yzw;
+    area = length(cross(e1, e2));
+    return a + su * e1 + sv * e2;
+}
+
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     o_radiance = vec4(0.0);
@@ -38,12 +57,15 @@ void main() {
     int mat = int(hp.w);
     int kind = material_kind(mat);
     vec3 d = texelFetch(u_hit_direction, px, 0).xyz;
-    vec3 n = texelFetch(u_hit_normal, px, 0).xyz;
+    vec4 hn = texelFetch(u_hit_normal, px, 0);
+    vec3 n = hn.xyz;
     bool first_batch = u_sample_begin == 0;
 
     if (kind == MAT_EMITTER) {
-        // One-sided: radiance leaves on the side of the light's normal only.
-        vec3 light_normal = material_texel(mat, 2).xyz;
+        // One-sided: radiance leaves on the side of the light's normal only
+        // (.w = 1: the primitive's own front face, its geometric normal).
+        vec4 ln = material_texel(mat, 2);
+        vec3 light_normal = ln.w != 0.0 ? n : ln.xyz;
         if (first_batch && dot(d, light_normal) < 0.0)
             o_radiance = vec4(ht.rgb * material_texel(mat, 1).rgb, 0.0);
         return;
@@ -52,6 +74,13 @@ void main() {
 
     vec3 nf = dot(n, d) < 0.0 ? n : -n; // one BRDF on both sides: shade the side seen
     vec3 p = hp.xyz;
+    // Shading normal (vertex normals) on the side seen: it weighs the light
+    // by |cos| to it, while the geometric nf decides which side the light
+    // must be on and moves the shadow ray's origin.
+    int prim = int(hn.w);
+    bool shaded = has_shading_normal(prim);
+    vec3 nsf = nf;
+    if (shaded) nsf = shading_normal(prim, p, n) * (dot(n, d) < 0.0 ? 1.0 : -1.0);
     vec3 origin = p + offset_scale(p) * nf;
     vec3 albedo = material_texel(mat, 1).rgb;
     vec3 sum = vec3(0.0);
@@ -59,29 +88,29 @@ void main() {
 
     for (int l = 0; l < (u_light_sampling != 0 ? u_light_count : 0); ++l) {
         vec4 head = light_texel(l, 0);
-        vec3 a = light_texel(l, 1).xyz;
-        vec3 emitted = light_texel(l, 4).rgb;
         if (int(head.x) == LIGHT_POINT) {
             if (!first_batch) continue;
+            vec3 a = light_texel(l, 1).xyz;
+            vec3 emitted = light_texel(l, 4).rgb;
             vec3 to_light = a - origin;
             float dist = length(to_light);
             vec3 wi = to_light / dist;
             float cos_x = dot(nf, wi);
+            float cos_s = shaded ? max(dot(nsf, wi), 0.0) : cos_x;
             if (cos_x > 0.0 && !occluded(origin, wi, dist))
-                sum += emitted * cos_x / (dist * dist);
+                sum += emitted * cos_s / (dist * dist);
             continue;
         }
-        vec3 e1 = light_texel(l, 2).xyz;
-        vec3 e2 = light_texel(l, 3).xyz;
-        vec3 light_normal = head.yzw;
-        float area = length(cross(e1, e2));
+        vec3 emitted = light_texel(l, 4).rgb;
         vec3 light_sum = vec3(0.0);
+        float area = 0.0;
         for (int s = u_sample_begin; s < u_sample_end; ++s) {
             uint rng = rng_init(u_seed, uvec2(px),
                                 0x40000000u | (uint(u_depth) << 24) | (uint(l) << 12) | uint(s));
             float su = (float(s % u_strata_x) + rng_next(rng)) / float(u_strata_x);
             float sv = (float(s / u_strata_x) + rng_next(rng)) / float(strata_y);
-            vec3 q = a + su * e1 + sv * e2;
+            vec3 light_normal;
+            vec3 q = area_light_point(l, su, sv, light_normal, area);
             vec3 to_light = q - origin;
             float dist = length(to_light);
             vec3 wi = to_light / dist;
@@ -90,7 +119,8 @@ void main() {
             if (cos_x <= 0.0 || cos_l <= 0.0) continue;
             // Stop short of the light's own surface by its offset scale.
             if (occluded(origin, wi, dist - 2.0 * offset_scale(q))) continue;
-            light_sum += emitted * (cos_x * cos_l / (dist * dist));
+            float cos_s = shaded ? max(dot(nsf, wi), 0.0) : cos_x;
+            light_sum += emitted * (cos_s * cos_l / (dist * dist));
         }
         sum += light_sum * (area / float(u_shadow_rays));
     }

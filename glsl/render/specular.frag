@@ -2,10 +2,12 @@
 // The next ray of each eye path at a mirror or glass hit. Glass chooses
 // reflection with probability F (exact Fresnel) and refraction otherwise, so the
 // throughput needs no weight (F / F = (1 - F) / (1 - F) = 1): one path per
-// pixel whose expectation equals the split tree (ARCHITECTURE.md).
+// pixel whose expectation equals the split tree (ARCHITECTURE.md). On a
+// triangle with vertex normals the direction is taken about the shading
+// normal (common/specular.glsl); the geometric normal still moves the origin.
 #include "common/scene.glsl"
 #include "common/random.glsl"
-#include "common/fresnel.glsl"
+#include "common/specular.glsl"
 
 uniform sampler2D u_hit_position;
 uniform sampler2D u_hit_normal;
@@ -30,26 +32,30 @@ void main() {
     int kind = material_kind(mat);
     if (kind != MAT_MIRROR && kind != MAT_GLASS) return;
     vec3 d = texelFetch(u_hit_direction, px, 0).xyz;
-    vec3 n = texelFetch(u_hit_normal, px, 0).xyz;
+    vec4 hn = texelFetch(u_hit_normal, px, 0);
+    vec3 n = hn.xyz;
     bool entering = dot(n, d) < 0.0;
     vec3 nf = entering ? n : -n;
-    float cos_i = -dot(d, nf);
     vec3 throughput = ht.rgb;
-    vec3 next;
+    float ior = 0.0;
+    float u = 0.0;
     if (kind == MAT_MIRROR) {
-        next = reflect(d, nf);
         throughput *= material_texel(mat, 1).rgb;
     } else {
-        float ior = material_texel(mat, 0).y;
-        float eta = entering ? 1.0 / ior : ior;
-        float cos_t;
-        float f = fresnel_dielectric(cos_i, eta, cos_t);
+        ior = material_texel(mat, 0).y;
         uint rng = rng_init(u_seed, uvec2(px), 0x20000000u | uint(u_depth));
-        if (rng_next(rng) < f) {
-            next = reflect(d, nf);
-        } else {
-            next = eta * d + (eta * cos_i - cos_t) * nf;
-        }
+        u = rng_next(rng);
+    }
+    int prim = int(hn.w);
+    vec3 next;
+    if (has_shading_normal(prim)) {
+        // Vertex normals: the direction about the shading normal, falling
+        // back to the geometric one where it would leave on the wrong side.
+        vec3 ms = shading_normal(prim, hp.xyz, n) * (entering ? 1.0 : -1.0);
+        bool used;
+        next = specular_shaded(d, nf, ms, ior, entering, u, used);
+    } else {
+        next = specular_about(d, nf, ior, entering, u);
     }
     next = normalize(next);
     o_ray_origin = vec4(offset_origin(hp.xyz, nf, next), 1.0);

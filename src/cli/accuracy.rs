@@ -152,7 +152,11 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
             }),
         );
     }
-    if scene.lights.iter().any(|l| matches!(l, Light::Area { .. })) {
+    if scene
+        .lights
+        .iter()
+        .any(|l| matches!(l, Light::Area { .. } | Light::Triangles { .. }))
+    {
         for s in if quick { vec![1] } else { vec![1, 16] } {
             if s != base.run.shadow_rays {
                 out.push(base.with(format!("{s} shadow rays"), |r| r.shadow_rays = s));

@@ -105,7 +105,7 @@ impl ProjectionMaps {
             .lights
             .iter()
             .zip(&self.maps)
-            .map(|(l, m)| l.power().element_sum() as f64 * m.fraction())
+            .map(|(l, m)| l.power(&scene.shapes).element_sum() as f64 * m.fraction())
             .collect()
     }
 
@@ -114,7 +114,7 @@ impl ProjectionMaps {
         let total: f64 = scene
             .lights
             .iter()
-            .map(|l| l.power().element_sum() as f64)
+            .map(|l| l.power(&scene.shapes).element_sum() as f64)
             .sum();
         self.kept_power(scene).iter().sum::<f64>() / total.max(f64::MIN_POSITIVE)
     }
@@ -163,6 +163,8 @@ pub fn emission_direction(light: &Light, u: f32, v: f32) -> Vec3 {
     match *light {
         Light::Point { .. } => sample_sphere(u, v),
         Light::Area { normal, .. } => sample_cosine(normal, u, v),
+        // Each triangle's own normal: no one direction (the map keeps all).
+        Light::Triangles { .. } => sample_cosine(Vec3::Y, u, v),
     }
 }
 
@@ -214,6 +216,7 @@ fn light_spheres(light: &Light) -> Vec<(Vec3, f32)> {
             edge1,
             edge2,
         }),
+        Light::Triangles { .. } => Vec::new(),
     }
 }
 
@@ -358,6 +361,13 @@ fn cell_cone(light: &Light, resolution: u32, column: u32, row: u32) -> (Vec3, f3
 }
 
 fn light_map(light: &Light, resolution: u32, spheres: &[(Vec3, f32)]) -> ProjectionMap {
+    // The emissive triangles of an OBJ group emit about each triangle's own
+    // normal, so a cell of the direction's uniforms is no one cone: their
+    // map keeps every cell (photons are not aimed; nothing is lost).
+    if let Light::Triangles { .. } = light {
+        let cells = (0..resolution * resolution).collect();
+        return ProjectionMap { resolution, cells };
+    }
     // A ray from a point p of a light patch that meets sphere (c, r) passes
     // within r + patch radius of c when moved to the patch's centre: so the
     // cone from the centre to the grown sphere holds every useful direction.
@@ -402,13 +412,13 @@ mod tests {
 
     fn point_and_sphere(distance: f32, radius: f32) -> Scene {
         Scene::with_shapes(
-            vec![Shape {
-                geometry: Geometry::Sphere {
+            vec![Shape::new(
+                Geometry::Sphere {
                     center: Vec3::new(0.0, 0.0, -distance),
                     radius,
                 },
-                material: 0,
-            }],
+                0,
+            )],
             vec![Material::Mirror {
                 reflectance: Vec3::ONE,
             }],

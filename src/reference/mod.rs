@@ -7,4 +7,5 @@ pub mod path_trace;
 pub mod photon;
 pub mod random;
 pub mod ray_trace;
+pub mod shading;
 pub mod sppm;

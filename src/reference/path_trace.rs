@@ -14,9 +14,10 @@
 use glam::{DVec3, Vec3};
 
 use crate::sampling::sample_cosine;
-use crate::scene::{Light, Material, Scene};
+use crate::scene::{triangle_area, Geometry, Light, Material, Scene};
 
 use super::ray_trace::{closest_hit, eye_ray_at, occluded, offset_scale};
+use super::shading::facing_shading_normal;
 
 /// A small, fast generator for the path tracer's own numbers (xorshift64*).
 struct Rng(u64);
@@ -105,23 +106,35 @@ fn radiance(scene: &Scene, mut o: Vec3, mut d: Vec3, rng: &mut Rng) -> Vec3 {
         let Some((shape, _, p, n)) = closest_hit(scene, o, d) else {
             break;
         };
-        match scene.materials[scene.shapes[shape].material] {
+        let s = &scene.shapes[shape];
+        match scene.materials[s.material] {
             Material::Emitter { radiance, normal } => {
-                if depth == 0 && d.dot(normal) < 0.0 {
+                if depth == 0 && d.dot(normal.unwrap_or(n)) < 0.0 {
                     l += beta * radiance;
                 }
                 break;
             }
             Material::Diffuse { albedo } => {
                 let nf = if n.dot(d) < 0.0 { n } else { -n };
+                // With vertex normals the cosines are the shading normal's;
+                // the geometric normal decides sides.
+                let ms = s
+                    .normals
+                    .is_some()
+                    .then(|| facing_shading_normal(s, p, n, d));
                 let origin = p + offset_scale(p, floor) * nf;
-                l += beta * albedo / std::f32::consts::PI * direct(scene, origin, nf, floor, rng);
+                l += beta * albedo / std::f32::consts::PI
+                    * direct(scene, origin, nf, ms, floor, rng);
                 let keep = albedo.max_element();
                 if keep <= 0.0 || rng.next() >= keep {
                     break;
                 }
                 beta *= albedo / keep;
                 d = sample_cosine(nf, rng.next(), rng.next());
+                // Sampled by the geometric cosine: weigh by cos_s / cos_g.
+                if let Some(ms) = ms {
+                    beta *= ms.dot(d).max(0.0) / nf.dot(d);
+                }
                 o = origin;
             }
             _ => unreachable!("diffuse-only scenes"),
@@ -130,11 +143,21 @@ fn radiance(scene: &Scene, mut o: Vec3, mut d: Vec3, rng: &mut Rng) -> Vec3 {
     l
 }
 
-/// Irradiance at `origin` (normal `nf`) from every light, one sample each.
-fn direct(scene: &Scene, origin: Vec3, nf: Vec3, floor: f32, rng: &mut Rng) -> Vec3 {
+/// Irradiance at `origin` (normal `nf`, shading normal `ms` if any) from
+/// every light, one sample each.
+fn direct(
+    scene: &Scene,
+    origin: Vec3,
+    nf: Vec3,
+    ms: Option<Vec3>,
+    floor: f32,
+    rng: &mut Rng,
+) -> Vec3 {
+    let cosine = |wi: Vec3, c: f32| ms.map_or(c, |m| m.dot(wi).max(0.0));
     let mut e = Vec3::ZERO;
     for light in &scene.lights {
-        match *light {
+        // A point of an area light, its normal, and 1 / its pdf (the area).
+        let (q, normal, radiance, area) = match *light {
             Light::Point {
                 position,
                 intensity,
@@ -144,8 +167,9 @@ fn direct(scene: &Scene, origin: Vec3, nf: Vec3, floor: f32, rng: &mut Rng) -> V
                 let wi = to / dist;
                 let c = nf.dot(wi);
                 if c > 0.0 && !occluded(scene, origin, wi, dist) {
-                    e += intensity * c / (dist * dist);
+                    e += intensity * cosine(wi, c) / (dist * dist);
                 }
+                continue;
             }
             Light::Area {
                 corner,
@@ -153,20 +177,55 @@ fn direct(scene: &Scene, origin: Vec3, nf: Vec3, floor: f32, rng: &mut Rng) -> V
                 edge2,
                 normal,
                 radiance,
-            } => {
-                let q = corner + rng.next() * edge1 + rng.next() * edge2;
-                let to = q - origin;
-                let dist = to.length();
-                let wi = to / dist;
-                let (c, cl) = (nf.dot(wi), -normal.dot(wi));
-                if c > 0.0
-                    && cl > 0.0
-                    && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor))
-                {
-                    e += radiance * c * cl / (dist * dist) * edge1.cross(edge2).length();
-                }
+            } => (
+                corner + rng.next() * edge1 + rng.next() * edge2,
+                normal,
+                radiance,
+                edge1.cross(edge2).length(),
+            ),
+            Light::Triangles { radiance, .. } => {
+                let (q, normal) = triangle_light_point(scene, light, rng);
+                (q, normal, radiance, light.area(&scene.shapes))
             }
+        };
+        let to = q - origin;
+        let dist = to.length();
+        let wi = to / dist;
+        let (c, cl) = (nf.dot(wi), -normal.dot(wi));
+        if c > 0.0 && cl > 0.0 && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor))
+        {
+            e += radiance * cosine(wi, c) * cl / (dist * dist) * area;
         }
     }
     e
+}
+
+/// A point uniform over a `Triangles` light's area (a triangle by area, by a
+/// linear scan, then a uniform point in it) and its triangle's normal.
+fn triangle_light_point(scene: &Scene, light: &Light, rng: &mut Rng) -> (Vec3, Vec3) {
+    let Light::Triangles { first, count, .. } = *light else {
+        return (Vec3::ZERO, Vec3::Y);
+    };
+    let shapes = &scene.shapes[first..first + count];
+    let mut pick = rng.next() * light.area(&scene.shapes);
+    let mut chosen = shapes[shapes.len() - 1].geometry;
+    for s in shapes {
+        let a = triangle_area(&s.geometry);
+        if pick < a {
+            chosen = s.geometry;
+            break;
+        }
+        pick -= a;
+    }
+    let Geometry::Triangle { v0, v1, v2 } = chosen else {
+        return (Vec3::ZERO, Vec3::Y);
+    };
+    let (mut b1, mut b2) = (rng.next(), rng.next());
+    if b1 + b2 > 1.0 {
+        (b1, b2) = (1.0 - b1, 1.0 - b2);
+    }
+    (
+        v0 + b1 * (v1 - v0) + b2 * (v2 - v0),
+        (v1 - v0).cross(v2 - v0).normalize(),
+    )
 }

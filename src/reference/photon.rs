@@ -10,7 +10,10 @@ use crate::scene::{Material, Scene};
 
 use super::intersect::intersect_geometry;
 use super::random::{rng_init, rng_next};
-use super::ray_trace::{closest_hit, fresnel_dielectric, offset_scale};
+use super::ray_trace::{closest_hit, offset_scale};
+use super::shading::{
+    diffuse_adjoint, facing_shading_normal, specular_about, specular_adjoint, specular_shaded,
+};
 pub use crate::sampling::{basis_around, sample_cosine, sample_sphere};
 
 const PI: f32 = std::f32::consts::PI;
@@ -22,10 +25,6 @@ pub struct PhotonRecord {
     pub power: Vec4,
     pub incoming: Vec4,
     pub outgoing: Vec4,
-}
-
-fn reflect(d: Vec3, n: Vec3) -> Vec3 {
-    d - 2.0 * n.dot(d) * n
 }
 
 fn primitive_normal(scene: &Scene, prim: usize, p: Vec3) -> Vec3 {
@@ -113,8 +112,17 @@ pub fn emit(
         }
         emitted_radiance *= kept.z;
     }
+    let mut leaving = choice.z;
     let (p, d, power) = if head.x as i32 == 1 {
         (a, sample_sphere(u1, u2), 4.0 * PI * emitted_radiance)
+    } else if head.x as i32 == 2 {
+        let (p, normal, prim) = sample_light_triangle(packed, l, u1, u2);
+        leaving = prim as f32;
+        (
+            p,
+            sample_cosine(normal, u3, u4),
+            PI * light_row(l, 1).z * emitted_radiance,
+        )
     } else {
         let (e1, e2) = (light_row(l, 2).truncate(), light_row(l, 3).truncate());
         (
@@ -127,8 +135,44 @@ pub fn emit(
         position: p.extend(-1.0),
         power: (power / (emitted as f32 * probability)).extend(0.0),
         incoming: Vec4::new(0.0, 0.0, 0.0, 1.0),
-        outgoing: d.extend(choice.z),
+        outgoing: d.extend(leaving),
     }
+}
+
+/// glsl/common/scene.glsl `sample_light_triangle`: a point of the
+/// LIGHT_TRIANGLES light l uniform over its area (u1 picks the triangle by
+/// area and is reused within it), its triangle's unit normal, its primitive.
+pub fn sample_light_triangle(
+    packed: &PackedScene,
+    l: usize,
+    u1: f32,
+    u2: f32,
+) -> (Vec3, Vec3, usize) {
+    let range = Vec4::from(packed.lights[l * 6 + 1]);
+    let first = range.x as usize;
+    let cdf = |k: usize| packed.light_triangles[first + k][0];
+    let (mut lo, mut hi) = (0i32, range.y as i32 - 1);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if u1 < cdf(mid as usize) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    let k = lo as usize;
+    let below = if k > 0 { cdf(k - 1) } else { 0.0 };
+    let u = ((u1 - below) / (cdf(k) - below)).clamp(0.0, 1.0);
+    let prim = packed.light_triangles[first + k][1] as usize;
+    let vertex = |i: usize| Vec4::from(packed.primitives[prim * 4 + i]).truncate();
+    let (a, b, c) = (vertex(1), vertex(2), vertex(3));
+    let normal = (b - a).cross(c - a).normalize();
+    let s = u.sqrt();
+    (
+        (1.0 - s) * a + (u2 * s) * b + (s - u2 * s) * c,
+        normal,
+        prim,
+    )
 }
 
 /// glsl/photon/trace.frag: bounce `bounce` of a photon whose last record is `last`.
@@ -165,22 +209,33 @@ pub fn bounce(
     let mut rng = rng_init(seed, [x, local_y], 0x10000000 + bounce);
     let (u0, u1, u2) = (rng_next(&mut rng), rng_next(&mut rng), rng_next(&mut rng));
     let (mut stored, mut alive) = (false, true);
+    let shape = &scene.shapes[prim];
+    let shaded = shape.normals.is_some();
+    let ms = facing_shading_normal(shape, p, n, d);
+    let mut power = power;
     let next = match material {
         Material::Diffuse { albedo } => {
             stored = bounce >= 2 || scene.photon_map.store_direct;
             alive = !scene.photon_map.caustics_only && u0 < albedo.max_element();
+            if shaded {
+                power *= diffuse_adjoint(d, nf, ms);
+            }
             sample_cosine(nf, u1, u2)
         }
-        Material::Mirror { .. } => reflect(d, nf),
-        Material::Glass { ior } => {
+        Material::Mirror { .. } | Material::Glass { .. } => {
+            let ior = match material {
+                Material::Glass { ior } => ior,
+                _ => 0.0,
+            };
             let entering = n.dot(d) < 0.0;
-            let eta = if entering { 1.0 / ior } else { ior };
-            let cos_i = -d.dot(nf);
-            let (f, cos_t) = fresnel_dielectric(cos_i, eta);
-            if u0 < f {
-                reflect(d, nf)
+            if shaded {
+                let (next, used) = specular_shaded(d, nf, ms, ior, entering, u0);
+                if used {
+                    power *= specular_adjoint(d, next, nf, ms);
+                }
+                next
             } else {
-                eta * d + (eta * cos_i - cos_t) * nf
+                specular_about(d, nf, ior, entering, u0)
             }
         }
         Material::Emitter { .. } => unreachable!(),

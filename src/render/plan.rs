@@ -34,7 +34,10 @@ pub struct PassPlan {
 impl PassPlan {
     pub fn new(scene: &Scene, options: &RenderOptions) -> Self {
         let specular = scene.has_specular();
-        let has_area = scene.lights.iter().any(|l| matches!(l, Light::Area { .. }));
+        let has_area = scene
+            .lights
+            .iter()
+            .any(|l| matches!(l, Light::Area { .. } | Light::Triangles { .. }));
         let shadow_batch = options.shadow_batch.max(1);
         Self {
             width: options.width,

@@ -30,6 +30,28 @@ pub fn source(name: &str) -> Option<&'static str> {
         .map(|(_, text)| *text)
 }
 
+/// The embedded copy of a file a scene refers to (an OBJ or MTL file), by
+/// its path as the loader forms it: `scenes/` then the path under scenes/
+/// (`scenes/cornell_box_obj/cornell_box.obj`; `.` and `..` are resolved).
+pub fn file(path: &Path) -> Option<&'static str> {
+    let mut parts: Vec<String> = Vec::new();
+    for c in path.components() {
+        match c {
+            std::path::Component::Normal(s) => parts.push(s.to_string_lossy().into_owned()),
+            std::path::Component::ParentDir => {
+                parts.pop()?;
+            }
+            std::path::Component::CurDir => {}
+            _ => return None,
+        }
+    }
+    let rest = parts.strip_prefix(&["scenes".to_string()])?.join("/");
+    SCENE_SOURCES
+        .iter()
+        .find(|(p, _)| *p == rest)
+        .map(|(_, text)| *text)
+}
+
 /// An embedded scene by name; errors name it as `scenes/<name>.toml`.
 pub fn load(name: &str) -> Result<Scene, SceneError> {
     let file = format!("scenes/{}.toml", name.trim_end_matches(".toml"));

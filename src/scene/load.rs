@@ -40,14 +40,16 @@ use toml::de::{DeString, DeTable, DeValue, ValueDeserializer};
 use toml::Spanned;
 
 use super::defaults::{
-    default_max_radius, DEFAULT_MESH_SCALE, DEFAULT_MESH_TRANSLATE, DEFAULT_UP, IOR_RANGE,
-    MAX_BOUNCES, MAX_COORDINATE, MAX_PROJECTION_RESOLUTION, MIN_PROJECTION_RESOLUTION, VFOV_RANGE,
+    default_max_radius, DEFAULT_UP, IOR_RANGE, MAX_BOUNCES, MAX_COORDINATE,
+    MAX_PROJECTION_RESOLUTION, MIN_PROJECTION_RESOLUTION, VFOV_RANGE,
 };
 pub use super::defaults::{
     MAX_GRID_SIDE, MAX_IMAGE_SIDE, MAX_K, MAX_PHOTONS_STORED, MAX_SHADOW_RAYS, MAX_SPECULAR_DEPTH,
 };
 use super::rebase::{self, dvec3, Coord, Rebase};
 use super::{Camera, Geometry, Light, Material, PhotonMapParams, RenderParams, Scene, Shape};
+
+mod mesh;
 
 pub use crate::error::SceneError;
 
@@ -127,7 +129,7 @@ const SHAPE_KINDS: &Kinds<ShapeKind> = &[
     (
         "mesh",
         ShapeKind::Mesh,
-        &["file", "material", "scale", "translate"],
+        &["file", "material", "scale", "translate", "object_materials"],
     ),
 ];
 
@@ -286,12 +288,22 @@ fn read_scene(cx: &Cx, root: &DeTable) -> Result<Scene, SceneError> {
     let camera = read_camera(&doc.table("camera", None)?)?;
     let render = read_render(&doc.table("render", Some(&absent))?)?;
     let photon_map = read_photon_map(&doc.table("photon_map", Some(&absent))?)?;
-    let (mut materials, names) = read_materials(&doc.table("materials", Some(&absent))?)?;
-    let mut shapes = Vec::new();
+    let (materials, names) = read_materials(&doc.table("materials", Some(&absent))?)?;
+    let mut model = Model {
+        materials,
+        names,
+        shapes: Vec::new(),
+        lights: Vec::new(),
+    };
     for t in doc.array("shape")? {
-        shapes.extend(read_shape(&t, &names)?);
+        read_shape(&t, &mut model)?;
     }
-    let mut lights = Vec::new();
+    let Model {
+        mut materials,
+        mut shapes,
+        mut lights,
+        ..
+    } = model;
     for t in doc.array("light")? {
         lights.push(read_light(&t, &mut materials, &mut shapes)?);
     }
@@ -299,7 +311,7 @@ fn read_scene(cx: &Cx, root: &DeTable) -> Result<Scene, SceneError> {
         return Err(cx.err(
             0..0,
             "light",
-            "the scene has no [[light]]: nothing would be lit".into(),
+            "the scene has no [[light]] and no emissive mesh material: nothing would be lit".into(),
         ));
     }
     let photon_map = photon_map.finish(cx, &shapes, &materials)?;
@@ -551,11 +563,24 @@ fn read_material(t: &Table) -> Result<Material, SceneError> {
     })
 }
 
+/// What the shapes add to as they are read: meshes bring materials (their
+/// MTL files') and lights (their emissive triangles).
+struct Model {
+    materials: Vec<Material>,
+    names: BTreeMap<String, usize>,
+    shapes: Vec<Shape>,
+    lights: Vec<Light>,
+}
+
 /// One `[[shape]]`: one primitive, or several for polygons and meshes.
-fn read_shape(t: &Table, names: &BTreeMap<String, usize>) -> Result<Vec<Shape>, SceneError> {
+fn read_shape(t: &Table, model: &mut Model) -> Result<(), SceneError> {
     let kind = t.kind(SHAPE_KINDS)?;
-    let one = |geometry: Geometry, material: usize| Ok(vec![Shape { geometry, material }]);
-    match kind {
+    if let ShapeKind::Mesh = kind {
+        return mesh::read_mesh(t, model);
+    }
+    let names = &model.names;
+    let one = |geometry: Geometry, material: usize| Ok(vec![Shape::new(geometry, material)]);
+    let shapes: Vec<Shape> = match kind {
         ShapeKind::Sphere => {
             let center = t.point("center")?;
             let radius = t.positive("radius", None)?;
@@ -616,34 +641,13 @@ fn read_shape(t: &Table, names: &BTreeMap<String, usize>) -> Result<Vec<Shape>, 
                 triangulate_convex_polygon(&v).map_err(|msg| t.cx.err(at.span(), &field, msg))?;
             Ok(triangles
                 .into_iter()
-                .map(|geometry| Shape { geometry, material })
+                .map(|geometry| Shape::new(geometry, material))
                 .collect())
         }
-        ShapeKind::Mesh => read_mesh(t, names),
-    }
-}
-
-fn read_mesh(t: &Table, names: &BTreeMap<String, usize>) -> Result<Vec<Shape>, SceneError> {
-    let file = t.req::<String>("file")?;
-    let material = t.material(names)?;
-    let scale = t.positive("scale", Some(DEFAULT_MESH_SCALE))?;
-    let translate_at = t.or("translate", DEFAULT_MESH_TRANSLATE.map(|c| Coord(c.into())))?;
-    let translate = t.check_point("translate", &translate_at)?;
-    let obj_path = t.cx.base_dir.join(file.get_ref());
-    let triangles =
-        load_obj(&obj_path).map_err(|msg| t.cx.err(file.span(), &t.field("file"), msg))?;
-    let scale = f64::from(scale);
-    Ok(triangles
-        .into_iter()
-        .map(|corners| {
-            // Placed in f64, then rebased.
-            let [v0, v1, v2] = corners.map(|p| t.cx.local(p.as_dvec3() * scale + translate));
-            Shape {
-                geometry: Geometry::Triangle { v0, v1, v2 },
-                material,
-            }
-        })
-        .collect())
+        ShapeKind::Mesh => Ok(Vec::new()),
+    }?;
+    model.shapes.extend(shapes);
+    Ok(())
 }
 
 /// One `[[light]]`. Area lights are also shapes (the camera sees them), of an
@@ -681,15 +685,16 @@ fn read_light(
                 }
             };
             let radiance = t.nonnegative_rgb("radiance")?;
-            shapes.push(Shape {
-                geometry: Geometry::Parallelogram {
-                    corner,
-                    edge1,
-                    edge2,
-                },
-                material: materials.len(),
+            let geometry = Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            };
+            shapes.push(Shape::new(geometry, materials.len()));
+            materials.push(Material::Emitter {
+                radiance,
+                normal: Some(normal),
             });
-            materials.push(Material::Emitter { radiance, normal });
             Ok(Light::Area {
                 corner,
                 edge1,
@@ -747,59 +752,6 @@ fn triangulate_convex_polygon(v: &[Vec3]) -> Result<Vec<Geometry>, String> {
             v2: v[i + 1],
         })
         .collect())
-}
-
-/// Loads an OBJ file's triangles, refusing non-finite or absurd coordinates.
-fn load_obj(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
-    if !path.is_file() {
-        return Err(format!(
-            "cannot read OBJ file {}: no such file",
-            path.display()
-        ));
-    }
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    // tobj panics on some malformed MTL lines (a colour with fewer than three
-    // numbers: found by tests/fuzz_loading.rs); that is a refusal, not a crash.
-    let loaded = std::panic::catch_unwind(|| tobj::load_obj(path, &opts)).map_err(|_| {
-        format!("cannot read OBJ file {}: its MTL file has a malformed line (a colour needs three numbers)", path.display())
-    })?;
-    let (models, _) =
-        loaded.map_err(|e| format!("cannot read OBJ file {}: {e}", path.display()))?;
-    let mut tris = Vec::new();
-    for model in &models {
-        let m = &model.mesh;
-        for (i, &p) in m.positions.iter().enumerate() {
-            if !p.is_finite() || p.abs() > 1e30 {
-                return Err(format!("OBJ file {}: vertex {} of object {:?} has coordinate {p}: coordinates must be finite", path.display(), i / 3 + 1, model.name));
-            }
-        }
-        let vertex = |i: u32| -> Result<Vec3, String> {
-            let i = i as usize * 3;
-            m.positions
-                .get(i..i + 3)
-                .map(Vec3::from_slice)
-                .ok_or_else(|| {
-                    format!(
-                        "OBJ file {}: a face refers to a missing vertex",
-                        path.display()
-                    )
-                })
-        };
-        for f in m.indices.chunks(3) {
-            if f.len() == 3 {
-                tris.push([vertex(f[0])?, vertex(f[1])?, vertex(f[2])?]);
-            }
-        }
-    }
-    if tris.is_empty() {
-        return Err(format!("OBJ file {} holds no triangles", path.display()));
-    }
-    Ok(tris)
 }
 
 // ---- reading one table ---------------------------------------------------------------
@@ -1053,11 +1005,21 @@ impl<'c, 'a> Table<'c, 'a> {
     /// The index of the material the table names.
     fn material(&self, names: &BTreeMap<String, usize>) -> Result<usize, SceneError> {
         let at = self.req::<String>("material")?;
+        self.material_named(names, &at, "material")
+    }
+
+    /// The index of the material named by the value `at` of field `key`.
+    fn material_named(
+        &self,
+        names: &BTreeMap<String, usize>,
+        at: &Spanned<String>,
+        key: &str,
+    ) -> Result<usize, SceneError> {
         names.get(at.get_ref()).copied().ok_or_else(|| {
             let known: Vec<_> = names.keys().cloned().collect();
             self.cx.err(
                 at.span(),
-                &self.field("material"),
+                &self.field(key),
                 format!(
                     "no material named {:?} (defined: {})",
                     at.get_ref(),

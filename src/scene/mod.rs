@@ -8,6 +8,7 @@ pub mod embedded;
 pub mod file;
 pub mod generate;
 pub mod load;
+pub mod obj;
 pub mod pack;
 pub mod rebase;
 
@@ -48,8 +49,14 @@ pub enum Material {
     Mirror { reflectance: Vec3 },
     /// Smooth dielectric in air, exact unpolarised Fresnel, no absorption.
     Glass { ior: f32 },
-    /// An area light's surface: emits `radiance` on the side of `normal`, reflects nothing.
-    Emitter { radiance: Vec3, normal: Vec3 },
+    /// An area light's surface: emits `radiance` on the side of `normal`, reflects
+    /// nothing. `normal` None: each primitive's front face, the side of its
+    /// geometric normal (e1 x e2; counter-clockwise winding), as for the
+    /// emissive triangles of an OBJ mesh.
+    Emitter {
+        radiance: Vec3,
+        normal: Option<Vec3>,
+    },
 }
 
 impl Material {
@@ -128,6 +135,23 @@ impl Geometry {
 pub struct Shape {
     pub geometry: Geometry,
     pub material: usize,
+    /// Vertex normals of a triangle (at v0, v1, v2; unit, on the side of its
+    /// geometric normal), used as shading normals: interpolated across the
+    /// triangle for the BSDF and for mirror and glass directions, while the
+    /// geometric normal still decides sides and ray offsets. None for every
+    /// other shape, and for triangles without them.
+    pub normals: Option<[Vec3; 3]>,
+}
+
+impl Shape {
+    /// A shape without vertex normals.
+    pub fn new(geometry: Geometry, material: usize) -> Self {
+        Shape {
+            geometry,
+            material,
+            normals: None,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,10 +166,24 @@ pub enum Light {
     },
     /// Isotropic point light of radiant intensity I (W/sr); power = 4 pi I.
     Point { position: Vec3, intensity: Vec3 },
+    /// The emissive triangles of one (object, material) group of an OBJ
+    /// mesh: the triangle shapes `shapes[first..first + count]`, each
+    /// emitting constant `radiance` from its front face (the side of its
+    /// geometric normal). One light however many triangles: it is sampled by
+    /// area (a triangle in proportion to its area, then a uniform point in
+    /// it), so its shadow rays and photons cost what one area light's do.
+    /// Power = pi * (total area) * radiance.
+    Triangles {
+        first: usize,
+        count: usize,
+        radiance: Vec3,
+    },
 }
 
 impl Light {
-    pub fn power(&self) -> Vec3 {
+    /// Radiant power (W per channel); `shapes` are the scene's, which
+    /// `Triangles` lights index.
+    pub fn power(&self, shapes: &[Shape]) -> Vec3 {
         match *self {
             Light::Area {
                 edge1,
@@ -154,7 +192,31 @@ impl Light {
                 ..
             } => std::f32::consts::PI * edge1.cross(edge2).length() * radiance,
             Light::Point { intensity, .. } => 4.0 * std::f32::consts::PI * intensity,
+            Light::Triangles { radiance, .. } => {
+                std::f32::consts::PI * self.area(shapes) * radiance
+            }
         }
+    }
+
+    /// The emitting area: a parallelogram's, or the sum of a `Triangles`
+    /// light's triangle areas (in f64, then f32); 0 for a point light.
+    pub fn area(&self, shapes: &[Shape]) -> f32 {
+        match *self {
+            Light::Area { edge1, edge2, .. } => edge1.cross(edge2).length(),
+            Light::Point { .. } => 0.0,
+            Light::Triangles { first, count, .. } => shapes[first..first + count]
+                .iter()
+                .map(|s| f64::from(triangle_area(&s.geometry)))
+                .sum::<f64>() as f32,
+        }
+    }
+}
+
+/// The area of a triangle (0 for any other geometry).
+pub fn triangle_area(g: &Geometry) -> f32 {
+    match *g {
+        Geometry::Triangle { v0, v1, v2 } => 0.5 * (v1 - v0).cross(v2 - v0).length(),
+        _ => 0.0,
     }
 }
 

@@ -3,20 +3,30 @@
 use crate::error::Error;
 use crate::gpu::{Gpu, Result, TexFormat, Texture};
 use crate::layout::{
-    BVH_ROW_TEXELS, LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE,
-    MAT_EMITTER, MAT_GLASS, MAT_MIRROR, PRIMITIVES_PER_ROW, PRIMITIVE_TEXELS, PRIM_CYLINDER,
+    BVH_ROW_TEXELS, LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, LIGHT_TRIANGLES,
+    LIGHT_TRIANGLE_ROW_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE, MAT_EMITTER, MAT_GLASS, MAT_MIRROR,
+    NORMALS_PER_ROW, NORMAL_TEXELS, PRIMITIVES_PER_ROW, PRIMITIVE_TEXELS, PRIM_CYLINDER,
     PRIM_PARALLELOGRAM, PRIM_SPHERE, PRIM_TRIANGLE,
 };
 
 use super::bvh::FlatBvh;
-use super::{Geometry, Light, Material, Scene};
+use super::{triangle_area, Geometry, Light, Material, Scene};
 
 /// RGBA float texels: PRIMITIVE_TEXELS a primitive (PRIMITIVES_PER_ROW to a
-/// row of the texture), one row per material and per light.
+/// row of the texture), one row per material and per light; NORMAL_TEXELS
+/// per triangle with vertex normals; one per emissive triangle of a
+/// `Light::Triangles`.
 pub struct PackedScene {
     pub primitives: Vec<[f32; 4]>,
     pub materials: Vec<[f32; 4]>,
     pub lights: Vec<[f32; 4]>,
+    /// n0, n1, n2 of each triangle with vertex normals, in primitive order;
+    /// a primitive's head texel .z is its record + 1 (0: none).
+    pub normals: Vec<[f32; 4]>,
+    /// For each `Light::Triangles`, its triangles in order: (the cumulative
+    /// fraction of the light's area up to and including this triangle, the
+    /// primitive, 0, 0). The last of a light is exactly 1.
+    pub light_triangles: Vec<[f32; 4]>,
     pub primitive_count: usize,
     pub light_count: usize,
     /// Absolute floor of ray-origin offsets: a millionth of the scene's size (its
@@ -57,29 +67,24 @@ pub fn geometry_kind(g: &Geometry) -> f32 {
 impl PackedScene {
     pub fn new(scene: &Scene) -> Self {
         let mut primitives = Vec::new();
+        let mut normals = Vec::new();
         for s in &scene.shapes {
-            primitives.push([geometry_kind(&s.geometry), s.material as f32, 0.0, 0.0]);
+            let record = match (s.normals, s.geometry) {
+                (Some(n), Geometry::Triangle { .. }) => {
+                    normals.extend(n.map(|n| [n.x, n.y, n.z, 0.0]));
+                    (normals.len() / NORMAL_TEXELS as usize) as f32
+                }
+                _ => 0.0,
+            };
+            primitives.push([geometry_kind(&s.geometry), s.material as f32, record, 0.0]);
             primitives.extend(pack_geometry(&s.geometry));
         }
-        let mut materials = Vec::new();
-        for m in &scene.materials {
-            let (kind, ior, color, normal) = match *m {
-                Material::Diffuse { albedo } => (MAT_DIFFUSE, 1.0, albedo, glam::Vec3::ZERO),
-                Material::Mirror { reflectance } => {
-                    (MAT_MIRROR, 1.0, reflectance, glam::Vec3::ZERO)
-                }
-                Material::Glass { ior } => (MAT_GLASS, ior, glam::Vec3::ONE, glam::Vec3::ZERO),
-                Material::Emitter { radiance, normal } => (MAT_EMITTER, 1.0, radiance, normal),
-            };
-            materials.push([kind as f32, ior, 0.0, 0.0]);
-            materials.push([color.x, color.y, color.z, 0.0]);
-            materials.push([normal.x, normal.y, normal.z, 0.0]);
-        }
+        let materials = scene.materials.iter().flat_map(pack_material).collect();
         // Photon emission picks a light in proportion to its power (sum of channels).
         let weights: Vec<f32> = scene
             .lights
             .iter()
-            .map(|l| l.power().element_sum())
+            .map(|l| l.power(&scene.shapes).element_sum())
             .collect();
         let total: f32 = weights.iter().sum();
         let mut cdf = 0.0;
@@ -88,9 +93,21 @@ impl PackedScene {
             .shapes
             .iter()
             .enumerate()
-            .filter(|(_, s)| matches!(scene.materials[s.material], Material::Emitter { .. }))
+            .filter(|(_, s)| {
+                matches!(
+                    (s.geometry, scene.materials[s.material]),
+                    (
+                        Geometry::Parallelogram { .. },
+                        Material::Emitter {
+                            normal: Some(_),
+                            ..
+                        }
+                    )
+                )
+            })
             .map(|(i, _)| i as f32);
         let mut lights = Vec::new();
+        let mut light_triangles = Vec::new();
         for (l, w) in scene.lights.iter().zip(&weights) {
             let v = |a: glam::Vec3| [a.x, a.y, a.z, 0.0];
             let probability = if total > 0.0 {
@@ -129,6 +146,23 @@ impl PackedScene {
                     ]);
                     -1.0
                 }
+                Light::Triangles {
+                    first,
+                    count,
+                    radiance,
+                } => {
+                    let start = light_triangles.len() as f32;
+                    let area = l.area(&scene.shapes);
+                    light_triangles.extend(area_cdf(scene, first, count));
+                    lights.extend([
+                        [LIGHT_TRIANGLES as f32, 0.0, 0.0, 0.0],
+                        [start, count as f32, area, 0.0],
+                        [0.0; 4],
+                        [0.0; 4],
+                        v(radiance),
+                    ]);
+                    -1.0
+                }
             };
             lights.push([cdf, probability, primitive, 0.0]);
         }
@@ -136,11 +170,56 @@ impl PackedScene {
             primitives,
             materials,
             lights,
+            normals,
+            light_triangles,
             primitive_count: scene.shapes.len(),
             light_count: scene.lights.len(),
             offset_floor: 1e-6 * scene.size(),
         }
     }
+}
+
+/// A material's MATERIAL_TEXELS texels: (kind, ior), colour, and an
+/// emitter's normal (.w = 1: each primitive's front face instead).
+fn pack_material(m: &Material) -> [[f32; 4]; 3] {
+    let z = glam::Vec3::ZERO;
+    let (kind, ior, color, normal, own_face) = match *m {
+        Material::Diffuse { albedo } => (MAT_DIFFUSE, 1.0, albedo, z, 0.0),
+        Material::Mirror { reflectance } => (MAT_MIRROR, 1.0, reflectance, z, 0.0),
+        Material::Glass { ior } => (MAT_GLASS, ior, glam::Vec3::ONE, z, 0.0),
+        Material::Emitter { radiance, normal } => (
+            MAT_EMITTER,
+            1.0,
+            radiance,
+            normal.unwrap_or(z),
+            f32::from(normal.is_none()),
+        ),
+    };
+    [
+        [kind as f32, ior, 0.0, 0.0],
+        [color.x, color.y, color.z, 0.0],
+        [normal.x, normal.y, normal.z, own_face],
+    ]
+}
+
+/// The texels of a `Light::Triangles` over shapes[first..first + count]:
+/// cumulative area fractions (summed in f64; the last exactly 1) and primitives.
+fn area_cdf(scene: &Scene, first: usize, count: usize) -> Vec<[f32; 4]> {
+    let areas: Vec<f64> = scene.shapes[first..first + count]
+        .iter()
+        .map(|s| f64::from(triangle_area(&s.geometry)))
+        .collect();
+    let total: f64 = areas.iter().sum();
+    let mut sum = 0.0;
+    areas
+        .iter()
+        .enumerate()
+        .map(|(k, a)| {
+            sum += a;
+            let cdf = if k + 1 == count { 1.0 } else { sum / total };
+            [cdf as f32, (first + k) as f32, 0.0, 0.0]
+        })
+        .collect()
 }
 
 /// The packed scene on the GPU.
@@ -154,6 +233,9 @@ pub struct SceneTextures {
     pub bvh_node_count: usize,
     pub materials: Texture,
     pub lights: Texture,
+    /// Vertex normals (NORMAL_TEXELS a record) and emissive triangles.
+    pub normals: Texture,
+    pub light_triangles: Texture,
     pub primitive_count: usize,
     pub light_count: usize,
     pub offset_floor: f32,
@@ -207,6 +289,8 @@ impl SceneTextures {
             bvh_node_count: bvh.nodes.len(),
             materials: upload(gpu, &p.materials, MATERIAL_TEXELS)?,
             lights: upload(gpu, &p.lights, LIGHT_TEXELS)?,
+            normals: upload(gpu, &p.normals, NORMAL_TEXELS * NORMALS_PER_ROW)?,
+            light_triangles: upload(gpu, &p.light_triangles, LIGHT_TRIANGLE_ROW_TEXELS)?,
             primitive_count: p.primitive_count,
             light_count: p.light_count,
             offset_floor: p.offset_floor,
@@ -220,6 +304,8 @@ impl SceneTextures {
             .texture("u_bvh_order", &self.bvh_order)
             .texture("u_materials", &self.materials)
             .texture("u_lights", &self.lights)
+            .texture("u_normals", &self.normals)
+            .texture("u_light_triangles", &self.light_triangles)
             .int("u_primitive_count", self.primitive_count as i32)
             .int("u_light_count", self.light_count as i32)
             .float("u_offset_floor", self.offset_floor);

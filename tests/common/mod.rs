@@ -114,3 +114,78 @@ impl Rng {
         }
     }
 }
+
+/// A fresh folder under the system's temporary directory for this test run.
+pub fn tempdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("photonmap-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes a UV sphere of about `triangles` triangles (unit radius, outward
+/// winding) as OBJ to `path`, with its exact normals (the normalised
+/// positions) as `vn` when `normals`.
+pub fn write_sphere_obj(path: &Path, triangles: usize, normals: bool) {
+    let m = photonmap::scene::generate::uv_sphere(triangles, 0.0);
+    let n = m.radial_normals();
+    std::fs::write(path, m.obj_text(normals.then_some(n.as_slice()))).unwrap();
+}
+
+/// Two renderers' images over seeds, compared block by block: each seed's
+/// image is cut into `block` x `block` pixel blocks and each block's mean
+/// (over its pixels and channels) taken; per block, t is the difference of
+/// the means over A's seeds and over B's, over its standard error (from the
+/// seed-to-seed variance of each). Returns (sum of t^2 / blocks, blocks, the bound that
+/// sum may reach when A and B have one expectation).
+///
+/// The bound is derived, not chosen: with n seeds a side, t^2 is at worst
+/// F(1, n - 1) distributed (Welch's t with the fewest degrees of freedom),
+/// of mean v / (v - 2) and variance 2 v^2 (v - 1) / ((v - 2)^2 (v - 4)),
+/// v = n - 1; the mean over B blocks may exceed its mean by 4 of its
+/// standard deviations (sd / sqrt(B), blocks taken as independent).
+pub fn block_chi2(a: &[Image], b: &[Image], block: u32) -> (f64, usize, f64) {
+    let n = a.len().min(b.len());
+    assert!(
+        n >= 6,
+        "at least 6 seeds a side (F(1, n - 1) needs n - 1 > 4)"
+    );
+    let (w, h) = (a[0].width, a[0].height);
+    let (bw, bh) = (w / block, h / block);
+    let value = |img: &Image, bx: u32, by: u32| {
+        let mut s = 0.0f64;
+        for y in by * block..(by + 1) * block {
+            for x in bx * block..(bx + 1) * block {
+                s += img.get(x, y).iter().map(|&v| v as f64).sum::<f64>() / 3.0;
+            }
+        }
+        s / (block * block) as f64
+    };
+    let stats = |imgs: &[Image], bx: u32, by: u32| {
+        let v: Vec<f64> = imgs.iter().map(|i| value(i, bx, by)).collect();
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+        (m, var / v.len() as f64)
+    };
+    let (mut chi2, mut blocks) = (0.0, 0usize);
+    for by in 0..bh {
+        for bx in 0..bw {
+            let (ma, va) = stats(a, bx, by);
+            let (mb, vb) = stats(b, bx, by);
+            if va + vb == 0.0 {
+                // Noiseless (an emitter seen directly): equal, or as far
+                // apart as can be.
+                if ma != mb {
+                    chi2 = f64::INFINITY;
+                }
+                continue;
+            }
+            chi2 += (ma - mb).powi(2) / (va + vb);
+            blocks += 1;
+        }
+    }
+    let v = (n - 1) as f64;
+    let mean = v / (v - 2.0);
+    let var = 2.0 * v * v * (v - 1.0) / ((v - 2.0).powi(2) * (v - 4.0));
+    let bound = mean + 4.0 * (var / blocks as f64).sqrt();
+    (chi2 / blocks as f64, blocks, bound)
+}
