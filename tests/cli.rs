@@ -592,12 +592,40 @@ fn reference_and_accuracy_bench_write_their_results() {
         "accuracy.json",
         "accuracy.svg",
         "accuracy.png",
+        "bias.png",
     ] {
         assert!(results.join(f).is_file(), "{f}");
     }
+    assert!(v["bias_map_scale"].as_f64().unwrap() > 0.0);
     assert!(std::fs::read_to_string(results.join("accuracy.svg"))
         .unwrap()
         .contains("<polyline"));
+    // --only runs the matching rows; matching none is an error that lists them.
+    let only = |text: &str| {
+        photonmap()
+            .args([
+                "bench", "accuracy", "--quiet", "--json", "--seeds", "2", "--only", text, "--scene",
+            ])
+            .arg(scene("glass_ball"))
+            .arg("--reference")
+            .arg(&reference)
+            .arg("--out")
+            .arg(d.join("only"))
+            .output()
+            .unwrap()
+    };
+    let one = only("k x2");
+    let v: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
+    assert_eq!(v["runs"].as_array().unwrap().len(), 1);
+    assert!(
+        v["bias_map_scale"].is_null(),
+        "no defaults run, no bias map"
+    );
+    let none = only("no such run");
+    assert!(
+        !none.status.success()
+            && String::from_utf8_lossy(&none.stderr).contains("scene defaults, photons x")
+    );
     // Without a reference it says how to make one.
     let none = photonmap()
         .args(["bench", "accuracy", "--scene"])

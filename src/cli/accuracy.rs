@@ -41,6 +41,10 @@ pub struct AccuracyArgs {
     /// Seeds per configuration (2..=64; default 4, or 2 with --quick).
     #[arg(long, value_parser = super::args::in_range(2, 64))]
     pub seeds: Option<u32>,
+    /// Only the runs whose label contains this text (e.g. "scene defaults",
+    /// "SPPM", "max radius").
+    #[arg(long, value_name = "TEXT")]
+    pub only: Option<String>,
     #[arg(long)]
     pub json: bool,
     #[arg(long)]
@@ -85,6 +89,13 @@ pub struct AccuracyReport {
     pub runs: Vec<AccuracyRun>,
     /// The front's fastest run within 10% of the least RMSE.
     pub recommended: String,
+    /// `bias.png`'s full scale: a pixel is fully red (blue) where the scene
+    /// defaults' mean over the seeds is this much brighter (darker) than the
+    /// reference, in luminance. Half the reference's mean luminance.
+    pub bias_map_scale: Option<f64>,
+    /// `bias.png`, where the scene defaults' run is biased (when it ran).
+    #[serde(skip)]
+    pub bias_map: Option<Image>,
 }
 
 #[derive(Clone)]
@@ -204,6 +215,7 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
         &reference,
         a.quick,
         seeds,
+        a.only.as_deref(),
         &super::progress_lines(a.quiet),
     )?;
     let dir = a
@@ -219,6 +231,9 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
     )?;
     write("accuracy.svg", svg_plot(&report).as_bytes())?;
     write("accuracy.png", &png_plot(&report))?;
+    if let Some(map) = &report.bias_map {
+        write("bias.png", &map.png_bytes()?)?;
+    }
     if a.json {
         super::print_json(&report)?;
     } else {
@@ -305,6 +320,7 @@ pub fn bench_accuracy(
     reference: &Path,
     quick: bool,
     seeds: u32,
+    only: Option<&str>,
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
     let (reference_img, info) = read_reference(reference)?;
@@ -319,8 +335,19 @@ pub fn bench_accuracy(
         );
     }
     let scale = scene.camera.width / reference_img.width;
-    let configs = sweep(scene, quick);
+    let mut configs = sweep(scene, quick);
+    if let Some(text) = only {
+        let labels: Vec<String> = configs.iter().map(|c| c.run.label.clone()).collect();
+        configs.retain(|c| c.run.label.contains(text));
+        if configs.is_empty() {
+            bail!(
+                "--only {text:?} matches no run; the runs are: {}",
+                labels.join(", ")
+            );
+        }
+    }
     let mut runs = Vec::new();
+    let mut bias = None;
     for (i, c) in configs.iter().enumerate() {
         progress(&format!("{} ({}/{})", c.run.label, i + 1, configs.len()));
         let mut images = Vec::new();
@@ -342,6 +369,9 @@ pub fn bench_accuracy(
         run.rel_mse = one.iter().map(|m| m.rel_mse).sum::<f64>() / n;
         run.ssim = one.iter().map(|m| m.ssim).sum::<f64>() / n;
         (run.bias_rmse, run.noise_rmse) = split;
+        if run.label == "scene defaults" {
+            bias = Some(bias_map(&Image::average(&images), &reference_img));
+        }
         runs.push(run);
     }
     mark_front(&mut runs);
@@ -359,7 +389,42 @@ pub fn bench_accuracy(
         seeds,
         runs,
         recommended,
+        bias_map_scale: bias.as_ref().map(|b| b.1),
+        bias_map: bias.map(|b| b.0),
     })
+}
+
+/// Where `mean` is biased against `reference`: the reference in dim grey,
+/// turning red where the mean is brighter and blue where it is darker, fully
+/// at a luminance difference of the returned scale (half the reference's
+/// mean luminance).
+fn bias_map(mean: &Image, reference: &Image) -> (Image, f64) {
+    let luminance = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let mean_luminance =
+        reference.pixels.iter().map(luminance).sum::<f32>() / reference.pixels.len().max(1) as f32;
+    let scale = if mean_luminance > 0.0 {
+        0.5 * mean_luminance
+    } else {
+        1.0
+    };
+    let mut out = Image::new(reference.width, reference.height);
+    for ((o, m), r) in out
+        .pixels
+        .iter_mut()
+        .zip(&mean.pixels)
+        .zip(&reference.pixels)
+    {
+        let grey = 0.15 * (luminance(r) / (4.0 * scale)).clamp(0.0, 1.0);
+        let d = (luminance(m) - luminance(r)) / scale;
+        let t = d.abs().clamp(0.0, 1.0);
+        let colour = if d > 0.0 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 0.2, 1.0]
+        };
+        *o = colour.map(|c| grey * (1.0 - t) + c * t);
+    }
+    (out, scale as f64)
 }
 
 /// Bias and noise of one render, as RMS over pixels: noise from the per-pixel
