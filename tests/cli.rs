@@ -601,27 +601,28 @@ fn reference_and_accuracy_bench_write_their_results() {
         .unwrap()
         .contains("<polyline"));
     // --only runs the matching rows; matching none is an error that lists them.
-    let only = |text: &str| {
+    let only = |texts: &[&str]| {
         photonmap()
             .args([
-                "bench", "accuracy", "--quiet", "--json", "--seeds", "2", "--only", text, "--scene",
+                "bench", "accuracy", "--quiet", "--json", "--seeds", "2", "--scene",
             ])
             .arg(scene("glass_ball"))
             .arg("--reference")
             .arg(&reference)
             .arg("--out")
             .arg(d.join("only"))
+            .args(texts.iter().flat_map(|t| ["--only", t]))
             .output()
             .unwrap()
     };
-    let one = only("k x2");
+    let one = only(&["k x2", "k x0.5"]);
     let v: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
-    assert_eq!(v["runs"].as_array().unwrap().len(), 1);
+    assert_eq!(v["runs"].as_array().unwrap().len(), 2, "{v}");
     assert!(
         v["bias_map_scale"].is_null(),
         "no defaults run, no bias map"
     );
-    let none = only("no such run");
+    let none = only(&["no such run"]);
     assert!(
         !none.status.success()
             && String::from_utf8_lossy(&none.stderr).contains("scene defaults, photons x")

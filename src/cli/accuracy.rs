@@ -42,9 +42,9 @@ pub struct AccuracyArgs {
     #[arg(long, value_parser = super::args::in_range(2, 64))]
     pub seeds: Option<u32>,
     /// Only the runs whose label contains this text (e.g. "scene defaults",
-    /// "SPPM", "max radius").
+    /// "SPPM", "max radius"); repeat it for the runs matching any.
     #[arg(long, value_name = "TEXT")]
-    pub only: Option<String>,
+    pub only: Vec<String>,
     #[arg(long)]
     pub json: bool,
     #[arg(long)]
@@ -215,7 +215,7 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
         &reference,
         a.quick,
         seeds,
-        a.only.as_deref(),
+        &a.only,
         &super::progress_lines(a.quiet),
     )?;
     let dir = a
@@ -320,7 +320,7 @@ pub fn bench_accuracy(
     reference: &Path,
     quick: bool,
     seeds: u32,
-    only: Option<&str>,
+    only: &[String],
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
     let (reference_img, info) = read_reference(reference)?;
@@ -336,12 +336,12 @@ pub fn bench_accuracy(
     }
     let scale = scene.camera.width / reference_img.width;
     let mut configs = sweep(scene, quick);
-    if let Some(text) = only {
+    if !only.is_empty() {
         let labels: Vec<String> = configs.iter().map(|c| c.run.label.clone()).collect();
-        configs.retain(|c| c.run.label.contains(text));
+        configs.retain(|c| only.iter().any(|text| c.run.label.contains(text.as_str())));
         if configs.is_empty() {
             bail!(
-                "--only {text:?} matches no run; the runs are: {}",
+                "--only {only:?} matches no run; the runs are: {}",
                 labels.join(", ")
             );
         }
