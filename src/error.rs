@@ -1,7 +1,7 @@
 //! The one error type of the library. Every variant says what went wrong in
 //! words a user can act on; the binary adds context with anyhow and nothing else.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
@@ -24,6 +24,17 @@ pub struct SceneError {
     /// Dotted path of the offending field, e.g. `shape[2].radius`.
     pub field: String,
     pub message: String,
+}
+
+impl SceneError {
+    pub fn new(file: &Path, line: usize, field: &str, message: String) -> Self {
+        SceneError {
+            file: file.to_path_buf(),
+            line,
+            field: field.into(),
+            message,
+        }
+    }
 }
 
 #[derive(Debug, thiserror::Error)]

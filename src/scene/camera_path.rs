@@ -43,14 +43,14 @@ pub fn load_camera_path(
     base: &Camera,
     origin: DVec3,
 ) -> Result<Vec<Camera>, SceneError> {
-    let err = |line: usize, field: &str, message: String| SceneError {
-        file: path.to_path_buf(),
-        line,
-        field: field.into(),
-        message,
-    };
-    let text = super::file::read_stable(path)
-        .map_err(|e| err(0, "(file)", format!("cannot read the camera path: {e}")))?;
+    let text = super::file::read_stable(path).map_err(|e| {
+        SceneError::new(
+            path,
+            0,
+            "(file)",
+            format!("cannot read the camera path: {e}"),
+        )
+    })?;
     camera_path_from_str(&text, path, base, origin)
 }
 
@@ -61,16 +61,9 @@ pub fn camera_path_from_str(
     base: &Camera,
     origin: DVec3,
 ) -> Result<Vec<Camera>, SceneError> {
-    let err = |line: usize, field: &str, message: String| SceneError {
-        file: path.to_path_buf(),
-        line,
-        field: field.into(),
-        message,
-    };
+    let err = |line, field: &str, message| SceneError::new(path, line, field, message);
     let file: PathFile = toml::from_str(text).map_err(|e| {
-        let line = e.span().map_or(0, |s| {
-            text[..s.start.min(text.len())].matches('\n').count() + 1
-        });
+        let line = e.span().map_or(0, |s| super::load::line_of(text, s.start));
         err(line, "(camera path)", e.message().to_string())
     })?;
     if file.key.is_empty() {

@@ -57,15 +57,15 @@ pub fn load(name: &str) -> Result<Scene, SceneError> {
     let file = format!("scenes/{}.toml", name.trim_end_matches(".toml"));
     match source(name) {
         Some(text) => load_scene_str(text, Path::new(&file)),
-        None => Err(SceneError {
-            file: file.into(),
-            line: 0,
-            field: "(file)".into(),
-            message: format!(
+        None => Err(SceneError::new(
+            Path::new(&file),
+            0,
+            "(file)",
+            format!(
                 "no such embedded scene (embedded: {})",
                 names().collect::<Vec<_>>().join(", ")
             ),
-        }),
+        )),
     }
 }
 
@@ -87,11 +87,8 @@ pub fn text_for(arg: &Path) -> Result<(String, std::path::PathBuf), SceneError> 
             return Ok((text.to_string(), file.into()));
         }
     }
-    let text = super::file::read_stable(arg).map_err(|e| SceneError {
-        file: arg.to_path_buf(),
-        line: 0,
-        field: "(file)".into(),
-        message: format!("cannot read the scene file: {e}"),
+    let text = super::file::read_stable(arg).map_err(|e| {
+        SceneError::new(arg, 0, "(file)", format!("cannot read the scene file: {e}"))
     })?;
     Ok((text, arg.to_path_buf()))
 }

@@ -151,11 +151,13 @@ const LIGHT_KINDS: &Kinds<LightKind> = &[
 // ---- loading -------------------------------------------------------------------
 
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = super::file::read_stable(path).map_err(|e| SceneError {
-        file: path.to_path_buf(),
-        line: 0,
-        field: "(file)".into(),
-        message: format!("cannot read the scene file: {e}"),
+    let text = super::file::read_stable(path).map_err(|e| {
+        SceneError::new(
+            path,
+            0,
+            "(file)",
+            format!("cannot read the scene file: {e}"),
+        )
     })?;
     load_scene_str(&text, path)
 }
@@ -1238,7 +1240,7 @@ impl<'a> Cx<'a> {
 }
 
 /// 1-based line of a byte offset.
-fn line_of(text: &str, offset: usize) -> usize {
+pub(super) fn line_of(text: &str, offset: usize) -> usize {
     let end = offset.min(text.len());
     text.as_bytes()[..end]
         .iter()
@@ -1246,6 +1248,11 @@ fn line_of(text: &str, offset: usize) -> usize {
         .count()
         + 1
 }
+
+/// What ends the text before a key on its line: a comma, or the brace that
+/// opens an inline table. (A constant, so that no brace sits unbalanced
+/// inside a function's body for tools that count braces.)
+const BEFORE_KEY: [char; 2] = [',', '\u{7b}'];
 
 /// For a syntax error at a value, the key on the same line (`vfov = = 1` -> vfov).
 fn key_before(text: &str, offset: usize) -> Option<String> {
@@ -1255,7 +1262,7 @@ fn key_before(text: &str, offset: usize) -> Option<String> {
         .rposition(|&b| b == b'\n')
         .map_or(0, |i| i + 1);
     let line = text.get(start..end)?;
-    let key = line.rsplit_once('=')?.0.rsplit([',', '{']).next()?.trim();
+    let key = line.rsplit_once('=')?.0.rsplit(BEFORE_KEY).next()?.trim();
     (!key.is_empty()).then(|| key.to_string())
 }
 
