@@ -357,7 +357,8 @@ pub fn bench_accuracy(
             images.push(img);
             seconds += s;
         }
-        let split = bias_and_noise(&images, &reference_img, info.residual_noise_rmse)?;
+        let mean = Image::average(&images);
+        let split = bias_and_noise(&images, &mean, &reference_img, info.residual_noise_rmse)?;
         let one: Vec<_> = images
             .iter()
             .map(|img| compare(img, &reference_img, None))
@@ -370,7 +371,7 @@ pub fn bench_accuracy(
         run.ssim = one.iter().map(|m| m.ssim).sum::<f64>() / n;
         (run.bias_rmse, run.noise_rmse) = split;
         if run.label == "scene defaults" {
-            bias = Some(bias_map(&Image::average(&images), &reference_img));
+            bias = Some(bias_map(&mean, &reference_img));
         }
         runs.push(run);
     }
@@ -430,14 +431,18 @@ fn bias_map(mean: &Image, reference: &Image) -> (Image, f64) {
 /// Bias and noise of one render, as RMS over pixels: noise from the per-pixel
 /// spread of the seeds, bias from the seeds' mean against the reference with
 /// the mean's own noise and the reference's removed.
-fn bias_and_noise(images: &[Image], reference: &Image, reference_noise: f64) -> Result<(f64, f64)> {
+fn bias_and_noise(
+    images: &[Image],
+    mean: &Image,
+    reference: &Image,
+    reference_noise: f64,
+) -> Result<(f64, f64)> {
     let n = images.len() as f64;
-    let mean = Image::average(images);
     // The per-pixel sample variance (photonmap::regress), averaged over channels.
-    let var = photonmap::regress::variance(images, &mean);
+    let var = photonmap::regress::variance(images, mean);
     let variance =
         var.pixels.iter().flatten().map(|&v| v as f64).sum::<f64>() / (var.pixels.len() * 3) as f64;
-    let mean_error = photonmap::metrics::rmse(&mean, reference)?;
+    let mean_error = photonmap::metrics::rmse(mean, reference)?;
     let bias2 = mean_error * mean_error - variance / n - reference_noise * reference_noise;
     Ok((bias2.max(0.0).sqrt(), variance.sqrt()))
 }
