@@ -11,6 +11,15 @@ fn photonmap() -> Command {
     Command::new(env!("CARGO_BIN_EXE_photonmap"))
 }
 
+/// The command succeeded; if not, its stderr says why.
+fn assert_ok(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("photonmap-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -35,11 +44,7 @@ fn render_writes_png_and_exr_the_same_way_up() {
         .arg(&exr)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let linear = Image::read_exr(&exr).unwrap();
     assert_eq!((linear.width, linear.height), (48, 40));
     let srgb = image::open(&png).unwrap().to_rgb8();
@@ -167,11 +172,7 @@ fn photons_json(name: &str, extra: &[&str]) -> serde_json::Value {
         .arg(scene(name))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -229,11 +230,7 @@ fn bench_build_prints_json_rows() {
         ])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 2);
@@ -266,11 +263,7 @@ fn snapshots_record_the_running_estimate_and_end_with_the_final_image() {
         .arg(&snaps)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let index: serde_json::Value =
         serde_json::from_slice(&std::fs::read(snaps.join("snapshots.json")).unwrap()).unwrap();
     let list = index.as_array().unwrap();
@@ -315,11 +308,7 @@ fn bench_mask_reports_each_masking() {
         ])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 6);
@@ -336,11 +325,7 @@ fn tables_quick_produces_every_table_with_sane_values() {
         .arg(&d)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     // Table 1: 3 scenes x 2 builds x 4 stages, positive times, the paper's figures beside them.
     let t1 = v["table1"].as_array().unwrap();
@@ -457,11 +442,7 @@ fn compare_prints_metrics_writes_a_difference_image_and_checks_its_inputs() {
             .args(extra)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ok(&out);
         serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
     };
     let same = metrics(&a, &a, &[]);
@@ -521,11 +502,7 @@ fn reference_and_accuracy_bench_write_their_results() {
         .arg(scene("glass_ball"))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let info: serde_json::Value =
         serde_json::from_slice(&std::fs::read(reference.with_extension("json")).unwrap()).unwrap();
     assert_eq!(
@@ -555,11 +532,7 @@ fn reference_and_accuracy_bench_write_their_results() {
         .arg(&results)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let runs = v["runs"].as_array().unwrap();
     assert!(runs.len() >= 10, "{} runs", runs.len());
@@ -911,11 +884,7 @@ fn mask_zero_is_refused_and_camera_paths_need_no_output_image() {
         .arg(&frames)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("frames.png"), "{err}");
     assert!(!frames.join("frames.png").exists());
@@ -940,11 +909,7 @@ fn outputs_by_extension_all_at_once_with_provenance() {
         .arg(&pfm)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let linear = Image::read_exr(&exr).unwrap();
     assert_eq!((linear.width, linear.height), (32, 24));
     assert!(image::open(&png).is_ok());
@@ -972,11 +937,7 @@ fn outputs_by_extension_all_at_once_with_provenance() {
         .arg(&plain)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert_ne!(
         Image::read_exr(&plain).unwrap(),
         linear,
@@ -1107,11 +1068,7 @@ fn compare_fails_a_perturbed_image_and_passes_an_identical_one() {
             .arg(path)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ok(&out);
     };
     render(&a, &[]);
     render(&b, &["--set", "light[0].radiance=[80.0, 80.0, 80.0]"]);
@@ -1248,11 +1205,7 @@ fn threads_do_not_change_the_image() {
             .arg(d.join(format!("t{n}.exr")))
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ok(&out);
     }
     let one = std::fs::read(d.join("t1.exr")).unwrap();
     for n in ["2", "3"] {
@@ -1285,11 +1238,7 @@ fn bench_meshes_reports_every_size_with_rates_renders_and_a_plot() {
         .arg(&d)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = report["rows"].as_array().unwrap();
     // The analytic ball, then the meshes as generated (the UV sphere rounds the count).
