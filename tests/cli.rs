@@ -2,7 +2,7 @@
 
 mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use photonmap::render::Image;
@@ -573,7 +573,24 @@ fn reference_and_accuracy_bench_write_their_results() {
     assert!(std::fs::read_to_string(results.join("accuracy.svg"))
         .unwrap()
         .contains("<polyline"));
-    // --only runs the matching rows; matching none is an error that lists them.
+    accuracy_only_runs_the_matching_rows(&reference, &d.join("only"));
+    // Without a reference it says how to make one.
+    let none = photonmap()
+        .args(["bench", "accuracy", "--scene"])
+        .arg(scene("ring"))
+        .args(["--reference"])
+        .arg(d.join("none.exr"))
+        .output()
+        .unwrap();
+    assert!(
+        !none.status.success()
+            && String::from_utf8_lossy(&none.stderr).contains("photonmap reference")
+    );
+}
+
+/// `bench accuracy --only` runs the matching rows; matching none is an error
+/// that lists them.
+fn accuracy_only_runs_the_matching_rows(reference: &Path, out: &Path) {
     let only = |texts: &[&str]| {
         photonmap()
             .args([
@@ -581,9 +598,9 @@ fn reference_and_accuracy_bench_write_their_results() {
             ])
             .arg(scene("glass_ball"))
             .arg("--reference")
-            .arg(&reference)
+            .arg(reference)
             .arg("--out")
-            .arg(d.join("only"))
+            .arg(out)
             .args(texts.iter().flat_map(|t| ["--only", t]))
             .output()
             .unwrap()
@@ -599,18 +616,6 @@ fn reference_and_accuracy_bench_write_their_results() {
     assert!(
         !none.status.success()
             && String::from_utf8_lossy(&none.stderr).contains("scene defaults, photons x")
-    );
-    // Without a reference it says how to make one.
-    let none = photonmap()
-        .args(["bench", "accuracy", "--scene"])
-        .arg(scene("ring"))
-        .args(["--reference"])
-        .arg(d.join("none.exr"))
-        .output()
-        .unwrap();
-    assert!(
-        !none.status.success()
-            && String::from_utf8_lossy(&none.stderr).contains("photonmap reference")
     );
 }
 
