@@ -57,6 +57,10 @@ pub const RANDOM_PER_PHOTON_FRAME: usize = 8;
 /// fraction of the maximum radius from the query's tangent plane are not its own.
 pub const DISC_THICKNESS: f32 = 0.1;
 
+/// The random stream of final-gather ray g of a pixel is GATHER_STREAM | g
+/// (glsl/render/gather_rays.frag; the eye side's other streams use other top bits).
+pub const GATHER_STREAM: u32 = 0x5000_0000;
+
 /// pi as every shader writes it (the same f32 as `std::f32::consts::PI`).
 const PI_GLSL: &str = "3.14159265358979";
 
@@ -92,6 +96,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ),
         ("PI", PI_GLSL.into()),
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
+        ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
     ]
 }
 

@@ -271,7 +271,7 @@ intensity = [0.0, 0.0, 0.0]
     est.run(
         &out.state.textures,
         &map,
-        &out.state.direct,
+        out.state.direct.queries(),
         k,
         max_r,
         &Default::default(),

@@ -1,6 +1,7 @@
 //! Plain-Rust twins of the GPU kernels, for tests and the paper's software column.
 
 pub mod bvh;
+pub mod final_gather;
 pub mod intersect;
 pub mod knn;
 pub mod path_trace;

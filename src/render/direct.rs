@@ -76,6 +76,14 @@ impl DirectLight {
             .draw_fullscreen(&self.target, &DrawState::ADDITIVE)
     }
 
+    /// The first diffuse hits, as the radiance estimate's queries.
+    pub fn queries(&self) -> super::radiance_estimate::QueryPoints<'_> {
+        super::radiance_estimate::QueryPoints {
+            position: &self.diffuse_position,
+            normal: &self.diffuse_normal,
+        }
+    }
+
     pub fn read_radiance(&self) -> Image {
         Image::from_gl_rgba(
             self.radiance.width,

@@ -5,6 +5,7 @@
 
 pub mod direct;
 pub mod explain;
+pub mod final_gather;
 pub mod observer;
 pub mod plan;
 pub mod radiance_estimate;
@@ -23,6 +24,7 @@ pub use crate::image::Image;
 pub use crate::timing::{StageTiming, Timings};
 pub use direct::DirectLight;
 pub use explain::ExplainLine;
+pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
 pub use observer::{EstimatePass, Progress, RenderObserver};
 pub use plan::PassPlan;
 pub use radiance_estimate::{EstimateMode, EstimateOptions, EstimateStats, RadianceEstimate};
@@ -48,6 +50,9 @@ pub struct RenderOptions {
 pub struct GlobalIllumination {
     pub photons: PhotonConfig,
     pub estimate: EstimateOptions,
+    /// Final gather (section 4.5): a caustic map at the first hits and a global
+    /// map at the gather rays' hits, instead of the one map visualised directly.
+    pub final_gather: Option<FinalGatherOptions>,
 }
 
 impl RenderOptions {
@@ -77,8 +82,12 @@ pub struct RenderOutput {
     pub passes: usize,
     /// The ray tracer's passes as planned for the scene.
     pub plan: PassPlan,
-    /// How the photon map was made (None: direct light only).
+    /// How the photon map visualised at the first hits was made (None: direct
+    /// light only, or final gather in a scene with nothing specular).
     pub photons: Option<PhotonReport>,
+    /// Final gather's global map, and each eye sample's gather.
+    pub gather_photons: Option<PhotonReport>,
+    pub gathers: Vec<GatherStats>,
     /// The last radiance estimate, and every one (view by view, sample by sample).
     pub estimate: Option<EstimateStats>,
     pub estimates: Vec<EstimateStats>,
@@ -102,6 +111,9 @@ pub struct RenderState {
     pub direct: DirectLight,
     pub map: Option<PhotonMap>,
     pub estimate: Option<RadianceEstimate>,
+    /// Final gather's global map, and its textures (the last batch's gather hits).
+    pub gather_map: Option<PhotonMap>,
+    pub gather: Option<FinalGather>,
 }
 
 /// Renders a scene: the paper's ray tracer (direct light, specular paths) and,
@@ -142,25 +154,30 @@ pub fn render_views(
     let direct = DirectLight::new(gpu, w, h)?;
     let mut timings = Timings::default();
     let wall = std::time::Instant::now();
-    // Photons first: one map serves every view and every eye sample.
-    let built = match &options.global {
-        None => None,
+    // Photons first: one map (or final gather's two) serves every view and
+    // every eye sample.
+    let (built, global_map) = match &options.global {
+        None => (None, None),
         Some(gi) => {
             observer.progress(&Progress::stage("photons", 0, 1));
-            Some(photon::build_map(
-                gpu,
-                scene,
-                &textures,
-                &gi.photons,
-                options.seed,
-                &mut timings,
-            )?)
+            build_maps(gpu, scene, &textures, gi, options.seed, &mut timings)?
         }
     };
     let estimate = built
         .as_ref()
         .map(|_| RadianceEstimate::new(gpu, w, h))
         .transpose()?;
+    let gather = match (&options.global, &global_map) {
+        (
+            Some(GlobalIllumination {
+                final_gather: Some(fg),
+                ..
+            }),
+            Some(_),
+        ) => Some(FinalGather::new(gpu, w, h, fg.rays)?),
+        _ => None,
+    };
+    let mut gathers = Vec::new();
     let mut estimates = Vec::new();
     let mut image = None;
     for (view, camera) in cameras.iter().enumerate() {
@@ -206,6 +223,22 @@ pub fn render_views(
                 }
                 _ => direct.read_radiance(),
             };
+            let mut sampled = sampled;
+            if let (Some(gi), Some(global), Some(gather)) = (&options.global, &global_map, &gather)
+            {
+                let run = GatherRun {
+                    scene,
+                    textures: &textures,
+                    direct: &direct,
+                    global: &global.map,
+                    gather,
+                    options: gi,
+                    at,
+                };
+                let stats = run.gather(eye.seed, &mut timings, observer)?;
+                sampled.add(&gather.read_indirect());
+                gathers.push(stats);
+            }
             sum.add(&sampled);
         }
         let view_image = sum.mean();
@@ -213,7 +246,7 @@ pub fn render_views(
         image = Some(view_image);
     }
     timings.wall_seconds = wall.elapsed().as_secs_f64();
-    Ok(finish(
+    let mut output = finish(
         image.expect("at least one camera"),
         timings,
         plan,
@@ -225,8 +258,17 @@ pub fn render_views(
             direct,
             map: None,
             estimate,
+            gather_map: None,
+            gather: None,
         },
-    ))
+    );
+    output.state.gather = gather;
+    if let Some(g) = global_map {
+        output.gather_photons = Some(report_of(&g, options));
+        output.state.gather_map = Some(g.map);
+    }
+    output.gathers = gathers;
+    Ok(output)
 }
 
 /// Refuses what no render can do before any GPU work.
@@ -255,18 +297,7 @@ fn finish(
 ) -> RenderOutput {
     let passes = timings.stages.iter().map(|s| s.passes).sum();
     let photons = built.map(|b| {
-        let report = PhotonReport {
-            trace: b.trace,
-            frames_traced: b.frames_traced,
-            grid: b.grid,
-            grid_fitted: b.grid_fitted,
-            build_stages: b.build_stages,
-            config: options
-                .global
-                .as_ref()
-                .map(|g| g.photons.clone())
-                .unwrap_or_default(),
-        };
+        let report = report_of(&b, options);
         state.map = Some(b.map);
         report
     });
@@ -277,8 +308,106 @@ fn finish(
         passes,
         plan,
         photons,
+        gather_photons: None,
+        gathers: Vec::new(),
         estimate: estimates.last().cloned(),
         estimates,
+    }
+}
+
+/// The photon stage's report of a built map.
+fn report_of(b: &BuiltMap, options: &RenderOptions) -> PhotonReport {
+    PhotonReport {
+        trace: b.trace.clone(),
+        frames_traced: b.frames_traced,
+        grid: b.grid,
+        grid_fitted: b.grid_fitted,
+        build_stages: b.build_stages.clone(),
+        config: options
+            .global
+            .as_ref()
+            .map(|g| g.photons.clone())
+            .unwrap_or_default(),
+    }
+}
+
+/// The maps of a render: the one visualised at the first hits, and final
+/// gather's global map. Under final gather the first is the caustic map, and
+/// a scene with nothing specular has none.
+fn build_maps(
+    gpu: &Gpu,
+    scene: &Scene,
+    textures: &SceneTextures,
+    gi: &GlobalIllumination,
+    seed: u32,
+    timings: &mut Timings,
+) -> Result<(Option<BuiltMap>, Option<BuiltMap>)> {
+    if gi.final_gather.is_none() {
+        let map = photon::build_map(gpu, scene, textures, &gi.photons, seed, timings)?;
+        return Ok((Some(map), None));
+    }
+    let (caustic, global) = final_gather::map_scenes(scene)?;
+    let caustic = if scene.has_specular() {
+        Some(photon::build_map(
+            gpu,
+            &caustic,
+            textures,
+            &gi.photons,
+            seed,
+            timings,
+        )?)
+    } else {
+        None
+    };
+    // Another seed: the two maps' photons are independent.
+    let global_seed = crate::random::pcg_hash(seed ^ crate::layout::GATHER_STREAM);
+    let global = photon::build_map(gpu, &global, textures, &gi.photons, global_seed, timings)?;
+    Ok((caustic, Some(global)))
+}
+
+/// One eye sample's final gather: the global map, the first diffuse hits and
+/// the gather's textures.
+struct GatherRun<'a> {
+    scene: &'a Scene,
+    textures: &'a SceneTextures,
+    direct: &'a DirectLight,
+    global: &'a PhotonMap,
+    gather: &'a FinalGather,
+    options: &'a GlobalIllumination,
+    at: At,
+}
+
+impl GatherRun<'_> {
+    fn gather(
+        &self,
+        seed: u32,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<GatherStats> {
+        let fg = self
+            .options
+            .final_gather
+            .as_ref()
+            .expect("a gather run has final-gather options");
+        let estimate = EstimateOptions {
+            float_addressing: self.options.photons.faithful,
+            ..self.options.estimate.clone()
+        };
+        let at = self.at;
+        self.gather.run(
+            self.textures,
+            self.direct,
+            self.global,
+            fg,
+            &estimate,
+            self.scene.photon_map.max_radius,
+            self.scene.render.max_specular_depth,
+            seed,
+            timings,
+            &mut |done, total| {
+                observer.progress(&Progress::at("final gather", done as u64, total as u64, at))
+            },
+        )
     }
 }
 
@@ -390,7 +519,7 @@ impl EstimateRun<'_> {
         let stats = self.estimate.run(
             self.textures,
             self.map,
-            self.direct,
+            self.direct.queries(),
             k,
             max_radius,
             &options,

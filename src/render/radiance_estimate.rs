@@ -92,6 +92,16 @@ pub struct EstimateStats {
     pub wall_seconds: f64,
 }
 
+/// The points a search serves: positions (w = 1 where a query exists) and
+/// normals facing the incoming ray (w = material + 1), the same size as the
+/// estimate. An eye sample's first diffuse hits (`DirectLight::queries`), or
+/// final gather's hits.
+#[derive(Clone, Copy)]
+pub struct QueryPoints<'a> {
+    pub position: &'a Texture,
+    pub normal: &'a Texture,
+}
+
 /// Seen after every pass: for progress and snapshots.
 pub struct PassReport<'a> {
     pub pass: u32,
@@ -192,7 +202,7 @@ impl RadianceEstimate {
         &self,
         scene: &SceneTextures,
         map: &PhotonMap,
-        direct: &DirectLight,
+        queries: QueryPoints<'_>,
         k: u32,
         max_radius: f32,
         options: &EstimateOptions,
@@ -205,7 +215,7 @@ impl RadianceEstimate {
         let mut stats = EstimateStats::default();
         self.init
             .bind()
-            .texture("u_query_position", &direct.diffuse_position)
+            .texture("u_query_position", queries.position)
             .draw_fullscreen(&self.target, &DrawState::PLAIN)?;
         self.target.clear_depth_stencil(1.0, 0);
         self.gpu.texture_barrier();
@@ -213,7 +223,7 @@ impl RadianceEstimate {
             scene,
             leak: options.leak,
             map,
-            direct,
+            queries,
             k,
             max_radius,
             budget: options.budget,
@@ -283,12 +293,12 @@ impl RadianceEstimate {
         }
         grid.bind(b);
         if q.leak != LeakTest::None {
-            b.texture("u_query_normal", &q.direct.diffuse_normal);
+            b.texture("u_query_normal", q.queries.normal);
         }
         if matches!(q.leak, LeakTest::Visibility | LeakTest::DiscAndVisibility) {
             q.scene.bind(b);
         }
-        b.texture("u_query_position", &q.direct.diffuse_position)
+        b.texture("u_query_position", q.queries.position)
             .texture("u_state_flux", &self.flux)
             .texture("u_state_cursor", &self.cursor)
             .texture("u_state_done", &self.done)
@@ -365,7 +375,7 @@ struct SearchQuery<'a> {
     scene: &'a SceneTextures,
     leak: LeakTest,
     map: &'a PhotonMap,
-    direct: &'a DirectLight,
+    queries: QueryPoints<'a>,
     k: u32,
     max_radius: f32,
     budget: u32,

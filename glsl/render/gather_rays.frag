@@ -1,0 +1,79 @@
+#version 450 core
+// Final gather (section 4.5; Jensen's two maps): the gather rays of one batch.
+// The target is width x (height * batch): texel (x, y + j * height) holds gather
+// ray j of pixel (x, y). Each ray leaves the pixel's first diffuse hit
+// cosine-distributed about its viewer-facing normal, follows mirrors and glass
+// as eye paths do (glass chooses by Fresnel, so no weight), and ends at the
+// first diffuse hit, which becomes a query of the global photon map. A ray that
+// leaves the scene or meets an emitter gathers nothing: direct light is the
+// shadow rays', and light reaching the pixel by specular paths alone is the
+// caustic map's. src/reference/final_gather.rs is the twin.
+#include "common/scene.glsl"
+#include "common/random.glsl"
+#include "common/sampling.glsl"
+#include "common/specular.glsl"
+
+uniform sampler2D u_diffuse_position;   // the pixel's first diffuse hit, w = 1 where one exists
+uniform sampler2D u_diffuse_normal;     // facing the viewer, w = material + 1
+uniform uint u_seed;
+uniform int u_first_ray;                // index of this batch's ray 0 among the pixel's rays
+uniform int u_batch_rays;               // rays in this batch: slots past them hold no query
+uniform int u_image_height;
+uniform int u_max_depth;                // specular bounces a gather ray may take
+
+layout(location = 0) out vec4 o_position;   // the gather hit, w = 1 where it is a query
+layout(location = 1) out vec4 o_normal;     // facing the gather ray, w = material + 1
+layout(location = 2) out vec4 o_throughput; // of the specular chain (1 without one)
+
+void main() {
+    ivec2 texel = ivec2(gl_FragCoord.xy);
+    int j = texel.y / u_image_height;
+    ivec2 px = ivec2(texel.x, texel.y - j * u_image_height);
+    o_position = vec4(0.0);
+    o_normal = vec4(0.0);
+    o_throughput = vec4(0.0);
+    vec4 first = texelFetch(u_diffuse_position, px, 0);
+    if (first.w <= 0.0 || j >= u_batch_rays) return;
+    vec3 n1 = texelFetch(u_diffuse_normal, px, 0).xyz;
+    uint rng = rng_init(u_seed, uvec2(px), GATHER_STREAM | uint(u_first_ray + j));
+    float u1 = rng_next(rng), u2 = rng_next(rng);
+    vec3 d = sample_cosine(n1, u1, u2);
+    vec3 o = offset_origin(first.xyz, n1, d);
+    vec3 throughput = vec3(1.0);
+    for (int depth = 0; depth <= u_max_depth; ++depth) {
+        vec4 hit;
+        int prim = closest_hit(o, d, hit);
+        if (prim < 0) return;
+        int mat = primitive_material(prim);
+        int kind = material_kind(mat);
+        if (kind == MAT_EMITTER) return;
+        vec3 n;
+        vec3 p = surface_point(prim, o, d, hit, n);
+        bool entering = dot(n, d) < 0.0;
+        vec3 nf = entering ? n : -n;
+        if (kind == MAT_DIFFUSE) {
+            o_position = vec4(p, 1.0);
+            o_normal = vec4(nf, float(mat + 1));
+            o_throughput = vec4(throughput, 0.0);
+            return;
+        }
+        float ior = 0.0;
+        float u = 0.0;
+        if (kind == MAT_MIRROR) {
+            throughput *= material_texel(mat, 1).rgb;
+        } else {
+            ior = material_texel(mat, 0).y;
+            u = rng_next(rng);
+        }
+        vec3 next;
+        if (has_shading_normal(prim)) {
+            vec3 ms = shading_normal(prim, p, n) * (entering ? 1.0 : -1.0);
+            bool used;
+            next = specular_shaded(d, nf, ms, ior, entering, u, used);
+        } else {
+            next = specular_about(d, nf, ior, entering, u);
+        }
+        d = normalize(next);
+        o = offset_origin(p, nf, d);
+    }
+}

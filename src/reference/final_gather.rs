@@ -1,0 +1,97 @@
+//! Final gather on the CPU, the twin of glsl/render/gather_rays.frag and
+//! gather_accumulate.frag: the same gather rays from the same random numbers,
+//! traced by the CPU ray tracer, and the global map's estimate at their hits by
+//! the CPU kNN-grid.
+
+use glam::Vec3;
+
+use crate::scene::{Material, Scene};
+
+use super::knn::{knn_grid, CpuPhotonMap};
+use super::random::{rng_init, rng_next};
+use super::ray_trace::{closest_hit, offset_scale};
+use super::shading::{facing_shading_normal, specular_about, specular_shaded};
+
+/// Where a gather ray ends: the diffuse hit that queries the global map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GatherHit {
+    pub position: Vec3,
+    /// Facing the gather ray.
+    pub normal: Vec3,
+    pub material: usize,
+    /// Of the specular chain before the hit (1 without one).
+    pub throughput: Vec3,
+}
+
+fn offset_origin(p: Vec3, n: Vec3, dir: Vec3, floor: f32) -> Vec3 {
+    let s = offset_scale(p, floor);
+    p + if dir.dot(n) >= 0.0 { s } else { -s } * n
+}
+
+/// Gather ray `ray` of pixel `px` from its first diffuse hit at `first` with
+/// viewer-facing normal `n1`.
+pub fn gather_ray(
+    scene: &Scene,
+    first: Vec3,
+    n1: Vec3,
+    seed: u32,
+    px: [u32; 2],
+    ray: u32,
+    max_depth: u32,
+) -> Option<GatherHit> {
+    let floor = 1e-6 * scene.size();
+    let mut rng = rng_init(seed, px, crate::layout::GATHER_STREAM | ray);
+    let (u1, u2) = (rng_next(&mut rng), rng_next(&mut rng));
+    let mut d = crate::sampling::sample_cosine(n1, u1, u2);
+    let mut o = offset_origin(first, n1, d, floor);
+    let mut throughput = Vec3::ONE;
+    for _ in 0..=max_depth {
+        let (shape, _, p, n) = closest_hit(scene, o, d)?;
+        let material = scene.shapes[shape].material;
+        let entering = n.dot(d) < 0.0;
+        let nf = if entering { n } else { -n };
+        let ior = match scene.materials[material] {
+            Material::Emitter { .. } => return None,
+            Material::Diffuse { .. } => {
+                return Some(GatherHit {
+                    position: p,
+                    normal: nf,
+                    material,
+                    throughput,
+                })
+            }
+            Material::Mirror { reflectance } => {
+                throughput *= reflectance;
+                0.0
+            }
+            Material::Glass { ior } => ior,
+        };
+        let u = if ior > 0.0 { rng_next(&mut rng) } else { 0.0 };
+        let next = if scene.shapes[shape].normals.is_some() {
+            let ms = facing_shading_normal(&scene.shapes[shape], p, n, d);
+            specular_shaded(d, nf, ms, ior, entering, u).0
+        } else {
+            specular_about(d, nf, ior, entering, u)
+        }
+        .normalize();
+        d = next;
+        o = offset_origin(p, nf, d, floor);
+    }
+    None
+}
+
+/// The radiance a gather ray brings back: the global map's estimate at its
+/// hit, throughput * albedo / pi * sum(power) / (pi r^2), r as compose.frag takes it.
+pub fn gathered_radiance(
+    scene: &Scene,
+    map: &CpuPhotonMap,
+    hit: &GatherHit,
+    k: u32,
+    max_radius: f32,
+) -> Vec3 {
+    let Material::Diffuse { albedo } = scene.materials[hit.material] else {
+        return Vec3::ZERO;
+    };
+    let irradiance = knn_grid(map, hit.position, k, max_radius).irradiance(k, max_radius);
+    hit.throughput * albedo / std::f32::consts::PI * irradiance
+}

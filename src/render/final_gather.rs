@@ -1,0 +1,238 @@
+//! Final gather, the paper's first proposal of section 4.5, as Jensen's photon
+//! mapping uses it: at each eye path's first diffuse hit, cosine-distributed
+//! gather rays sample the incident light, and a *global* photon map (every
+//! diffuse hit, direct ones included) estimates the light only where those
+//! rays land. Caustics at the first hit come from a separate *caustic* map,
+//! visualised directly, and direct light from the shadow rays, so each light
+//! path is counted once.
+//!
+//! Gather rays go in batches of fragment passes, like the shadow rays: a batch
+//! of B rays per pixel is one `gather_rays` pass into a width x (height x B)
+//! texture of queries, one kNN-grid estimate over it (the same search, tiles and
+//! occlusion queries as the first hits'), and one `gather_accumulate` pass that
+//! adds the batch to each pixel with additive blending.
+
+use crate::error::Error;
+use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
+use crate::photon::PhotonMap;
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+
+use super::radiance_estimate::QueryPoints;
+use super::{DirectLight, EstimateOptions, Image, RadianceEstimate, Timings};
+
+/// Gather-ray queries in one batch are capped near this many texels (the
+/// estimate state is three RGBA textures of that size).
+const BATCH_TEXELS: u64 = 1 << 20;
+
+/// How final gather runs.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FinalGatherOptions {
+    /// Gather rays per pixel per eye sample.
+    pub rays: u32,
+    /// k of the global map's estimate at each gather ray's hit.
+    pub k: u32,
+}
+
+/// What one eye sample's gather did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct GatherStats {
+    pub rays_per_pixel: u32,
+    pub batches: u32,
+    /// Gather rays that reached a diffuse surface (queries of the global map).
+    pub queries: u64,
+    pub estimate_passes: u32,
+}
+
+/// The textures and programs of final gather at one image size.
+pub struct FinalGather {
+    gpu: Gpu,
+    width: u32,
+    height: u32,
+    /// Gather rays per pixel in one batch.
+    pub batch: u32,
+    pub position: Texture,
+    pub normal: Texture,
+    pub throughput: Texture,
+    rays_target: Target,
+    pub estimate: RadianceEstimate,
+    pub indirect: Texture,
+    indirect_target: Target,
+    rays: Program,
+    accumulate: Program,
+}
+
+/// Rays per batch for an image of width x height: as many of `rays` as fit
+/// `BATCH_TEXELS` and the driver's texture height, at least one.
+pub fn batch_size(width: u32, height: u32, rays: u32, max_texture: u32) -> u32 {
+    let by_texels = (BATCH_TEXELS / (width as u64 * height as u64).max(1)) as u32;
+    let by_height = max_texture / height.max(1);
+    rays.min(by_texels).min(by_height).max(1)
+}
+
+impl FinalGather {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, rays: u32) -> Result<Self> {
+        let batch = batch_size(width, height, rays, gpu.max_texture_size());
+        let t = || Texture::new(gpu, width, height * batch, TexFormat::Rgba32F);
+        let (position, normal, throughput) = (t()?, t()?, t()?);
+        let rays_target = Target::new(gpu, &[&position, &normal, &throughput])?;
+        let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let indirect_target = Target::new(gpu, &[&indirect])?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            width,
+            height,
+            batch,
+            rays_target,
+            position,
+            normal,
+            throughput,
+            estimate: RadianceEstimate::new(gpu, width, height * batch)?,
+            indirect,
+            indirect_target,
+            rays: Program::fullscreen(gpu, "render/gather_rays.frag")?,
+            accumulate: Program::fullscreen(gpu, "render/gather_accumulate.frag")?,
+        })
+    }
+
+    /// The gather hits of the last batch, as the estimate's queries.
+    pub fn queries(&self) -> QueryPoints<'_> {
+        QueryPoints {
+            position: &self.position,
+            normal: &self.normal,
+        }
+    }
+
+    /// Traces gather rays `rays` (at most `batch` of them) of every pixel from
+    /// its first diffuse hit; the batch's unused slots hold no query.
+    pub fn trace_batch(
+        &self,
+        scene: &SceneTextures,
+        direct: &DirectLight,
+        rays: std::ops::Range<u32>,
+        max_depth: u32,
+        seed: u32,
+    ) -> Result<()> {
+        let mut b = self.rays.bind();
+        scene.bind(&mut b);
+        b.texture("u_diffuse_position", &direct.diffuse_position)
+            .texture("u_diffuse_normal", &direct.diffuse_normal)
+            .uint("u_seed", seed)
+            .int("u_first_ray", rays.start as i32)
+            .int("u_batch_rays", rays.len() as i32)
+            .int("u_image_height", self.height as i32)
+            .int("u_max_depth", max_depth as i32)
+            .draw_fullscreen(&self.rays_target, &DrawState::PLAIN)
+    }
+
+    /// Adds the finished batch (`rays` of them) to each pixel's indirect light.
+    fn accumulate_batch(
+        &self,
+        scene: &SceneTextures,
+        direct: &DirectLight,
+        rays: u32,
+        k: u32,
+        max_radius: f32,
+        total_rays: u32,
+    ) -> Result<()> {
+        let mut b = self.accumulate.bind();
+        scene.bind(&mut b);
+        b.texture("u_diffuse_normal", &direct.diffuse_normal)
+            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
+            .texture("u_gather_normal", &self.normal)
+            .texture("u_gather_throughput", &self.throughput)
+            .texture("u_state_flux", &self.estimate.flux)
+            .texture("u_state_cursor", &self.estimate.cursor)
+            .int("u_k", k as i32)
+            .float("u_max_radius", max_radius)
+            .int("u_batch", rays as i32)
+            .int("u_image_height", self.height as i32)
+            .float("u_total_rays", total_rays as f32)
+            .draw_fullscreen(&self.indirect_target, &DrawState::ADDITIVE)
+    }
+
+    /// All gather rays of one eye sample: the indirect light of each pixel's
+    /// first diffuse hit, left in `indirect`. Adds the stages "gather rays"
+    /// and "gather estimate" to `timings`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        scene: &SceneTextures,
+        direct: &DirectLight,
+        global: &PhotonMap,
+        options: &FinalGatherOptions,
+        estimate: &EstimateOptions,
+        max_radius: f32,
+        max_depth: u32,
+        seed: u32,
+        timings: &mut Timings,
+        on_batch: &mut dyn FnMut(u32, u32),
+    ) -> Result<GatherStats> {
+        self.indirect_target.clear([0.0; 4]);
+        let mut stats = GatherStats {
+            rays_per_pixel: options.rays,
+            ..Default::default()
+        };
+        let mut first = 0;
+        while first < options.rays {
+            crate::interrupt::check()?;
+            let rays = self.batch.min(options.rays - first);
+            self.gpu.finish();
+            let t0 = std::time::Instant::now();
+            self.trace_batch(scene, direct, first..first + rays, max_depth, seed)?;
+            self.gpu.finish();
+            timings.add_both("gather rays", 0.0, t0.elapsed().as_secs_f64(), 1);
+            let run = self.estimate.run(
+                scene,
+                global,
+                self.queries(),
+                options.k,
+                max_radius,
+                estimate,
+                &mut |_| {},
+            )?;
+            timings.add_both(
+                "gather estimate",
+                run.gpu_seconds,
+                run.wall_seconds,
+                run.passes as usize,
+            );
+            let t0 = std::time::Instant::now();
+            self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays)?;
+            self.gpu.finish();
+            timings.add_both("gather rays", 0.0, t0.elapsed().as_secs_f64(), 1);
+            stats.batches += 1;
+            stats.queries += run.query_pixels;
+            stats.estimate_passes += run.passes;
+            first += rays;
+            on_batch(first, options.rays);
+        }
+        self.gpu.check("final gather")?;
+        Ok(stats)
+    }
+
+    pub fn read_indirect(&self) -> Image {
+        Image::from_gl_rgba(self.width, self.height, &self.indirect.read_f32())
+    }
+}
+
+/// The two scenes whose photon maps final gather uses: the caustic map (paths
+/// of only specular bounces from the light, stored at their first diffuse hit)
+/// and the global map (every diffuse hit, the first included). A scene that
+/// stores caustics only has no diffuse interreflection to gather.
+pub fn map_scenes(scene: &Scene) -> Result<(Scene, Scene)> {
+    if scene.photon_map.caustics_only {
+        return Err(Error::InvalidOption(format!(
+            "final gather samples diffuse interreflection, which {} leaves out \
+             (photon_map.caustics_only = true); render it without --final-gather",
+            scene.name
+        )));
+    }
+    let mut caustic = scene.clone();
+    caustic.photon_map.caustics_only = true;
+    caustic.photon_map.store_direct = false;
+    let mut global = scene.clone();
+    global.photon_map.caustics_only = false;
+    global.photon_map.store_direct = true;
+    Ok((caustic, global))
+}
