@@ -156,29 +156,7 @@ pub fn render_views(
     let wall = std::time::Instant::now();
     // Photons first: one map (or final gather's two) serves every view and
     // every eye sample.
-    let (built, global_map) = match &options.global {
-        None => (None, None),
-        Some(gi) => {
-            observer.progress(&Progress::stage("photons", 0, 1));
-            build_maps(gpu, scene, &textures, gi, options.seed, &mut timings)?
-        }
-    };
-    let estimate = built
-        .as_ref()
-        .map(|_| RadianceEstimate::new(gpu, w, h))
-        .transpose()?;
-    let gather = match (&options.global, &global_map) {
-        (
-            Some(GlobalIllumination {
-                final_gather: Some(fg),
-                ..
-            }),
-            Some(_),
-        ) => Some(FinalGather::new(gpu, w, h, fg.rays)?),
-        _ => None,
-    };
-    let mut gathers = Vec::new();
-    let mut estimates = Vec::new();
+    let mut global = GlobalPart::new(gpu, scene, &textures, options, &mut timings, observer)?;
     let mut image = None;
     for (view, camera) in cameras.iter().enumerate() {
         let mut sum = ImageSum::default();
@@ -206,46 +184,29 @@ pub fn render_views(
                 observer,
                 at,
             )?;
-            let sampled = match (&options.global, &built, &estimate) {
-                (Some(gi), Some(built), Some(estimate)) => {
-                    let run = EstimateRun {
-                        scene,
-                        textures: &textures,
-                        direct: &direct,
-                        map: &built.map,
-                        estimate,
-                        options: gi,
-                        at,
-                    };
-                    let (img, stats) = run.estimate(&mut timings, observer)?;
-                    estimates.push(stats);
-                    img
-                }
-                _ => direct.read_radiance(),
+            let frame = SampleFrame {
+                scene,
+                textures: &textures,
+                direct: &direct,
+                options,
+                seed: eye.seed,
+                at,
             };
-            let mut sampled = sampled;
-            if let (Some(gi), Some(global), Some(gather)) = (&options.global, &global_map, &gather)
-            {
-                let run = GatherRun {
-                    scene,
-                    textures: &textures,
-                    direct: &direct,
-                    global: &global.map,
-                    gather,
-                    options: gi,
-                    at,
-                };
-                let stats = run.gather(eye.seed, &mut timings, observer)?;
-                sampled.add(&gather.read_indirect());
-                gathers.push(stats);
-            }
-            sum.add(&sampled);
+            sum.add(&global.sample(&frame, &mut timings, observer)?);
         }
         let view_image = sum.mean();
         observer.frame(view, &view_image)?;
         image = Some(view_image);
     }
     timings.wall_seconds = wall.elapsed().as_secs_f64();
+    let GlobalPart {
+        built,
+        global_map,
+        estimate,
+        gather,
+        estimates,
+        gathers,
+    } = global;
     let mut output = finish(
         image.expect("at least one camera"),
         timings,
@@ -259,16 +220,121 @@ pub fn render_views(
             map: None,
             estimate,
             gather_map: None,
-            gather: None,
+            gather,
         },
     );
-    output.state.gather = gather;
     if let Some(g) = global_map {
         output.gather_photons = Some(report_of(&g, options));
         output.state.gather_map = Some(g.map);
     }
     output.gathers = gathers;
     Ok(output)
+}
+
+/// One eye sample's first hits, ready for the global half.
+struct SampleFrame<'a> {
+    scene: &'a Scene,
+    textures: &'a SceneTextures,
+    direct: &'a DirectLight,
+    options: &'a RenderOptions,
+    seed: u32,
+    at: At,
+}
+
+/// The photon-mapping half of a frame: the maps, the estimators' textures and
+/// what each eye sample's estimate and gather did.
+struct GlobalPart {
+    built: Option<BuiltMap>,
+    global_map: Option<BuiltMap>,
+    estimate: Option<RadianceEstimate>,
+    gather: Option<FinalGather>,
+    estimates: Vec<EstimateStats>,
+    gathers: Vec<GatherStats>,
+}
+
+impl GlobalPart {
+    fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        textures: &SceneTextures,
+        options: &RenderOptions,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Self> {
+        let (w, h) = (options.width, options.height);
+        let (built, global_map) = match &options.global {
+            None => (None, None),
+            Some(gi) => {
+                observer.progress(&Progress::stage("photons", 0, 1));
+                build_maps(gpu, scene, textures, gi, options.seed, timings)?
+            }
+        };
+        let estimate = built
+            .as_ref()
+            .map(|_| RadianceEstimate::new(gpu, w, h))
+            .transpose()?;
+        let rays = options
+            .global
+            .as_ref()
+            .and_then(|g| g.final_gather.as_ref())
+            .map(|fg| fg.rays);
+        let gather = match (rays, &global_map) {
+            (Some(rays), Some(_)) => Some(FinalGather::new(gpu, w, h, rays)?),
+            _ => None,
+        };
+        Ok(Self {
+            built,
+            global_map,
+            estimate,
+            gather,
+            estimates: Vec::new(),
+            gathers: Vec::new(),
+        })
+    }
+
+    /// One eye sample's image: its direct light, plus the estimate at its
+    /// first hits and (final gather) the gathered indirect light.
+    fn sample(
+        &mut self,
+        f: &SampleFrame<'_>,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Image> {
+        let Some(gi) = &f.options.global else {
+            return Ok(f.direct.read_radiance());
+        };
+        let mut image = match (&self.built, &self.estimate) {
+            (Some(built), Some(estimate)) => {
+                let run = EstimateRun {
+                    scene: f.scene,
+                    textures: f.textures,
+                    direct: f.direct,
+                    map: &built.map,
+                    estimate,
+                    options: gi,
+                    at: f.at,
+                };
+                let (img, stats) = run.estimate(timings, observer)?;
+                self.estimates.push(stats);
+                img
+            }
+            _ => f.direct.read_radiance(),
+        };
+        if let (Some(global), Some(gather)) = (&self.global_map, &self.gather) {
+            let run = GatherRun {
+                scene: f.scene,
+                textures: f.textures,
+                direct: f.direct,
+                global: &global.map,
+                gather,
+                options: gi,
+                at: f.at,
+            };
+            self.gathers.push(run.gather(f.seed, timings, observer)?);
+            image.add(&gather.read_indirect());
+        }
+        Ok(image)
+    }
 }
 
 /// Refuses what no render can do before any GPU work.
