@@ -61,6 +61,11 @@ pub const DISC_THICKNESS: f32 = 0.1;
 /// (glsl/render/gather_rays.frag; the eye side's other streams use other top bits).
 pub const GATHER_STREAM: u32 = 0x5000_0000;
 
+/// Adaptive sampling interpolates a pixel only from corners whose first-hit
+/// normal is within this cosine of its own (about 18 degrees) and whose
+/// material is the same (glsl/render/adaptive_plan.glsl).
+pub const ADAPTIVE_NORMAL_COS: f32 = 0.95;
+
 /// pi as every shader writes it (the same f32 as `std::f32::consts::PI`).
 const PI_GLSL: &str = "3.14159265358979";
 
@@ -97,6 +102,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PI", PI_GLSL.into()),
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
+        ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
     ]
 }
 

@@ -166,31 +166,34 @@ fn the_knn_grid_holds_the_true_k_nearest() {
 #[test]
 fn tiled_full_screen_and_masked_runs_give_identical_images() {
     let scene = common::paper_scene("glass_ball");
+    // 100 x 70: the last column and row of 16-pixel tiles are cut to 4 and 6
+    // pixels, less than half a tile, so their points' centres fall outside the
+    // image (such tiles were once clipped whole and their pixels never searched).
     let tiled = render_gi(
         &scene,
-        96,
-        72,
+        100,
+        70,
         BuildMethod::Bitonic,
         EstimateMode::Tiled { tile: 16 },
     );
     let tiled8 = render_gi(
         &scene,
-        96,
-        72,
+        100,
+        70,
         BuildMethod::Bitonic,
         EstimateMode::Tiled { tile: 8 },
     );
     let full = render_gi(
         &scene,
-        96,
-        72,
+        100,
+        70,
         BuildMethod::Bitonic,
         EstimateMode::FullScreen,
     );
     let masked = render_gi(
         &scene,
-        96,
-        72,
+        100,
+        70,
         BuildMethod::Bitonic,
         EstimateMode::Masked { every: 2 },
     );

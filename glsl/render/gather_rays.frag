@@ -15,6 +15,8 @@
 
 uniform sampler2D u_diffuse_position;   // the pixel's first diffuse hit, w = 1 where one exists
 uniform sampler2D u_diffuse_normal;     // facing the viewer, w = material + 1
+uniform isampler2D u_pixel;             // packed first hits: each texel's pixel index
+uniform int u_packed;                   // 1: the first hits are packed (adaptive sampling)
 uniform uint u_seed;
 uniform int u_first_ray;                // index of this batch's ray 0 among the pixel's rays
 uniform int u_batch_rays;               // rays in this batch: slots past them hold no query
@@ -35,7 +37,14 @@ void main() {
     vec4 first = texelFetch(u_diffuse_position, px, 0);
     if (first.w <= 0.0 || j >= u_batch_rays) return;
     vec3 n1 = texelFetch(u_diffuse_normal, px, 0).xyz;
-    uint rng = rng_init(u_seed, uvec2(px), GATHER_STREAM | uint(u_first_ray + j));
+    // A packed hit draws its own pixel's random numbers.
+    ivec2 own = px;
+    if (u_packed != 0) {
+        int i = texelFetch(u_pixel, px, 0).x;
+        int width = textureSize(u_diffuse_position, 0).x;
+        own = ivec2(i % width, i / width);
+    }
+    uint rng = rng_init(u_seed, uvec2(own), GATHER_STREAM | uint(u_first_ray + j));
     float u1 = rng_next(rng), u2 = rng_next(rng);
     vec3 d = sample_cosine(n1, u1, u2);
     vec3 o = offset_origin(first.xyz, n1, d);

@@ -38,12 +38,19 @@ uniform int u_k;
 uniform float u_max_radius;
 uniform int u_budget;
 
+#ifdef TILED
+flat in ivec4 v_tile; // render/tile.vert: this draw's tile; a cut tile's point covers more
+#endif
+
 layout(location = 0) out vec4 o_flux;
 layout(location = 1) out ivec4 o_cursor;
 layout(location = 2) out ivec4 o_done;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef TILED
+    if (any(lessThan(px, v_tile.xy)) || any(greaterThanEqual(px, v_tile.zw))) discard;
+#endif
     ivec4 done = texelFetch(u_state_done, px, 0);
     if (done.x != 0) discard;
     vec4 flux = texelFetch(u_state_flux, px, 0);

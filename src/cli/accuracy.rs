@@ -16,7 +16,7 @@ use photonmap::metrics::compare;
 use photonmap::photon::BuildMethod;
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
-use photonmap::render::{render, EstimateMode, Image};
+use photonmap::render::{render, EstimateMode, FinalGatherOptions, Image};
 use photonmap::scene::{embedded, Light, Scene};
 
 use super::reference::{read_reference, reference_options, ReferenceInfo};
@@ -55,7 +55,7 @@ pub struct AccuracyArgs {
 #[derive(Serialize, Clone, Debug)]
 pub struct AccuracyRun {
     pub label: String,
-    /// "paper" (the one-shot kNN estimate) or "sppm".
+    /// "paper" (the one-shot kNN estimate), "final-gather" or "sppm".
     pub method: String,
     pub photons_stored: u32,
     pub k: u32,
@@ -66,6 +66,8 @@ pub struct AccuracyRun {
     pub tile: u32,
     pub spp: u32,
     pub sppm_iterations: u32,
+    /// Final gather's rays per pixel (0: the one map visualised directly).
+    pub gather_rays: u32,
     /// Wall seconds of one render (mean over the seeds).
     pub seconds: f64,
     /// RMSE of one render against the reference (mean over the seeds).
@@ -118,6 +120,7 @@ impl Config {
                 tile: 16,
                 spp: 1,
                 sppm_iterations: 0,
+                gather_rays: 0,
                 seconds: 0.0,
                 rmse: 0.0,
                 bias_rmse: 0.0,
@@ -180,6 +183,15 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     }
     for spp in if quick { vec![4] } else { vec![4, 16] } {
         out.push(base.with(format!("{spp} spp"), |r| r.spp = spp));
+    }
+    // Final gather needs diffuse interreflection, which caustics-only scenes leave out.
+    if !scene.photon_map.caustics_only {
+        for rays in if quick { vec![4] } else { vec![4, 16, 64] } {
+            out.push(base.with(format!("final gather {rays} rays"), |r| {
+                r.method = "final-gather".into();
+                r.gather_rays = rays;
+            }));
+        }
     }
     for it in if quick {
         vec![4, 16]
@@ -301,6 +313,10 @@ fn render_config(
     } else {
         EstimateMode::Tiled { tile: c.tile }
     };
+    gi.final_gather = (c.gather_rays > 0).then(|| FinalGatherOptions {
+        rays: c.gather_rays,
+        ..FinalGatherOptions::default()
+    });
     let wall = std::time::Instant::now();
     let image = if c.method == "sppm" {
         let sppm = SppmOptions {
@@ -461,10 +477,10 @@ fn mark_front(runs: &mut [AccuracyRun]) {
 }
 
 pub fn csv(r: &AccuracyReport) -> String {
-    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,tile,spp,sppm_iterations,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
+    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,tile,spp,sppm_iterations,gather_rays,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
     for x in &r.runs {
         s += &format!(
-            "{},{},{},{},{},{:?},{},{:?},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
+            "{},{},{},{},{},{:?},{},{:?},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
             x.label,
             x.method,
             x.photons_stored,
@@ -476,6 +492,7 @@ pub fn csv(r: &AccuracyReport) -> String {
             x.tile,
             x.spp,
             x.sppm_iterations,
+            x.gather_rays,
             x.seconds,
             x.rmse,
             x.bias_rmse,

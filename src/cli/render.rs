@@ -11,8 +11,8 @@ use photonmap::gpu::Platform;
 use photonmap::image::{check_writable, write_all_atomically, write_atomically};
 use photonmap::provenance::Provenance;
 use photonmap::render::{
-    self, EstimatePass, FinalGatherOptions, GlobalIllumination, Image, PassPlan, Progress,
-    RenderObserver, RenderOptions,
+    self, AdaptiveOptions, EstimatePass, FinalGatherOptions, GlobalIllumination, Image, PassPlan,
+    Progress, RenderObserver, RenderOptions,
 };
 use photonmap::scene::Scene;
 
@@ -71,6 +71,20 @@ pub struct RenderArgs {
     /// secondary lookups; it was not tuned against any reference.
     #[arg(long, default_value_t = 50, value_parser = in_range(1, 4096), requires = "final_gather")]
     pub gather_k: u32,
+    /// Final gather: the leak test of the global map's estimates at the gather
+    /// hits (none, as Jensen's secondary lookups; --leak-test sets the first hits').
+    #[arg(long, value_enum, default_value_t = LeakTest::None, requires = "final_gather")]
+    pub gather_leak_test: LeakTest,
+    /// Adaptive sampling (section 4.5): compute global light on every 8th pixel,
+    /// then at each finer level interpolate it where the coarser pixels around
+    /// agree (same material, similar normal, light within --adaptive-threshold)
+    /// and compute it elsewhere. Direct light stays at full resolution.
+    #[arg(long, conflicts_with = "direct_only")]
+    pub adaptive: bool,
+    /// Adaptive sampling: interpolate where the corners' light spans at most
+    /// this fraction of its mean (0 < F < 10; 0.1 a priori).
+    #[arg(long, value_name = "F", default_value_t = 0.1, value_parser = threshold, requires = "adaptive")]
+    pub adaptive_threshold: f32,
     #[command(flatten)]
     pub sppm: SppmArgs,
     #[command(flatten)]
@@ -119,6 +133,14 @@ fn parse_every(text: &str) -> Result<SnapshotEvery, String> {
         _ => Err(format!(
             "--every {text}: give seconds (0.5s) or a number of passes (10, at least 1)"
         )),
+    }
+}
+
+/// `--adaptive-threshold`: a fraction in (0, 10).
+fn threshold(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 10.0 => Ok(v),
+        _ => Err(format!("{s}: the allowed range is 0 < F < 10")),
     }
 }
 
@@ -226,6 +248,10 @@ impl RenderArgs {
             final_gather: self.final_gather.map(|rays| FinalGatherOptions {
                 rays,
                 k: self.gather_k,
+                leak: self.gather_leak_test,
+            }),
+            adaptive: self.adaptive.then_some(AdaptiveOptions {
+                threshold: self.adaptive_threshold,
             }),
         });
         options
@@ -283,6 +309,8 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "estimates": out.estimates,
                 "final_gather": options.global.as_ref().and_then(|g| g.final_gather.clone()),
                 "gathers": out.gathers,
+                "adaptive": options.global.as_ref().and_then(|g| g.adaptive.clone()),
+                "adaptive_samples": out.adaptive,
             }),
         })?;
     }
@@ -450,6 +478,20 @@ fn print_summary(
             g.batches,
             if g.batches == 1 { "" } else { "es" },
             g.queries
+        );
+    }
+    if !out.adaptive.is_empty() {
+        let computed: u64 = out.adaptive.iter().map(|a| a.computed).sum();
+        let all: u64 = out.adaptive.iter().map(|a| a.pixels_with_hits).sum();
+        let levels: Vec<String> = out.adaptive[0]
+            .levels
+            .iter()
+            .map(|(s, c, i)| format!("stride {s}: {c} computed, {i} interpolated"))
+            .collect();
+        eprintln!(
+            "adaptive sampling: global light computed at {computed} of {all} pixels with a diffuse hit ({:.1}%); {}",
+            100.0 * computed as f64 / all.max(1) as f64,
+            levels.join("; ")
         );
     }
     for (p, _) in written {

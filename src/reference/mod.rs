@@ -1,5 +1,6 @@
 //! Plain-Rust twins of the GPU kernels, for tests and the paper's software column.
 
+pub mod adaptive;
 pub mod bvh;
 pub mod final_gather;
 pub mod intersect;

@@ -15,7 +15,7 @@ pub struct DirectLight {
     pub diffuse_normal: Texture,
     /// Path throughput up to that hit.
     pub diffuse_throughput: Texture,
-    target: Target,
+    pub(crate) target: Target,
     program: Program,
 }
 
@@ -81,6 +81,7 @@ impl DirectLight {
         super::radiance_estimate::QueryPoints {
             position: &self.diffuse_position,
             normal: &self.diffuse_normal,
+            pixel: None,
         }
     }
 

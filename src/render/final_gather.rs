@@ -18,7 +18,7 @@ use crate::photon::PhotonMap;
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
-use super::radiance_estimate::QueryPoints;
+use super::radiance_estimate::{LeakTest, QueryPoints};
 use super::{DirectLight, EstimateOptions, Image, RadianceEstimate, Timings};
 
 /// Gather-ray queries in one batch are capped near this many texels (the
@@ -32,6 +32,21 @@ pub struct FinalGatherOptions {
     pub rays: u32,
     /// k of the global map's estimate at each gather ray's hit.
     pub k: u32,
+    /// The leak test of those estimates (the first hits' caustic estimate
+    /// keeps the render's own).
+    pub leak: LeakTest,
+}
+
+impl Default for FinalGatherOptions {
+    /// 16 rays; k = 50 and no leak test, as Jensen's secondary lookups (chosen
+    /// a priori, not tuned against any reference).
+    fn default() -> Self {
+        Self {
+            rays: 16,
+            k: 50,
+            leak: LeakTest::None,
+        }
+    }
 }
 
 /// What one eye sample's gather did.
@@ -60,6 +75,8 @@ pub struct FinalGather {
     indirect_target: Target,
     rays: Program,
     accumulate: Program,
+    /// Bound as u_pixel when the first hits are in place (never read).
+    no_pixels: Texture,
 }
 
 /// Rays per batch for an image of width x height: as many of `rays` as fit
@@ -92,6 +109,7 @@ impl FinalGather {
             indirect_target,
             rays: Program::fullscreen(gpu, "render/gather_rays.frag")?,
             accumulate: Program::fullscreen(gpu, "render/gather_accumulate.frag")?,
+            no_pixels: Texture::new(gpu, 1, 1, TexFormat::R32I)?,
         })
     }
 
@@ -100,6 +118,7 @@ impl FinalGather {
         QueryPoints {
             position: &self.position,
             normal: &self.normal,
+            pixel: None,
         }
     }
 
@@ -108,15 +127,17 @@ impl FinalGather {
     pub fn trace_batch(
         &self,
         scene: &SceneTextures,
-        direct: &DirectLight,
+        first: QueryPoints<'_>,
         rays: std::ops::Range<u32>,
         max_depth: u32,
         seed: u32,
     ) -> Result<()> {
         let mut b = self.rays.bind();
         scene.bind(&mut b);
-        b.texture("u_diffuse_position", &direct.diffuse_position)
-            .texture("u_diffuse_normal", &direct.diffuse_normal)
+        b.texture("u_diffuse_position", first.position)
+            .texture("u_diffuse_normal", first.normal)
+            .texture("u_pixel", first.pixel.unwrap_or(&self.no_pixels))
+            .int("u_packed", first.pixel.is_some() as i32)
             .uint("u_seed", seed)
             .int("u_first_ray", rays.start as i32)
             .int("u_batch_rays", rays.len() as i32)
@@ -151,14 +172,16 @@ impl FinalGather {
             .draw_fullscreen(&self.indirect_target, &DrawState::ADDITIVE)
     }
 
-    /// All gather rays of one eye sample: the indirect light of each pixel's
-    /// first diffuse hit, left in `indirect`. Adds the stages "gather rays"
-    /// and "gather estimate" to `timings`.
+    /// All gather rays of one eye sample from the first hits `first` (all of
+    /// them, or the pixels adaptive sampling computes): the indirect light of
+    /// each, left in `indirect`. Adds the stages "gather rays" and "gather
+    /// estimate" to `timings`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
         scene: &SceneTextures,
         direct: &DirectLight,
+        first: QueryPoints<'_>,
         global: &PhotonMap,
         options: &FinalGatherOptions,
         estimate: &EstimateOptions,
@@ -173,13 +196,13 @@ impl FinalGather {
             rays_per_pixel: options.rays,
             ..Default::default()
         };
-        let mut first = 0;
-        while first < options.rays {
+        let mut done = 0;
+        while done < options.rays {
             crate::interrupt::check()?;
-            let rays = self.batch.min(options.rays - first);
+            let rays = self.batch.min(options.rays - done);
             self.gpu.finish();
             let t0 = std::time::Instant::now();
-            self.trace_batch(scene, direct, first..first + rays, max_depth, seed)?;
+            self.trace_batch(scene, first, done..done + rays, max_depth, seed)?;
             self.gpu.finish();
             timings.add_both("gather rays", 0.0, t0.elapsed().as_secs_f64(), 1);
             let run = self.estimate.run(
@@ -204,8 +227,8 @@ impl FinalGather {
             stats.batches += 1;
             stats.queries += run.query_pixels;
             stats.estimate_passes += run.passes;
-            first += rays;
-            on_batch(first, options.rays);
+            done += rays;
+            on_batch(done, options.rays);
         }
         self.gpu.check("final gather")?;
         Ok(stats)

@@ -3,6 +3,7 @@
 //! trace the scene and take the radiance estimate at each first diffuse hit,
 //! and average the samples into the image.
 
+pub mod adaptive;
 pub mod direct;
 pub mod explain;
 pub mod final_gather;
@@ -22,12 +23,15 @@ use crate::scene::{Camera, Scene};
 
 pub use crate::image::Image;
 pub use crate::timing::{StageTiming, Timings};
+pub use adaptive::{Adaptive, AdaptiveOptions, AdaptiveStats};
 pub use direct::DirectLight;
 pub use explain::ExplainLine;
 pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
 pub use observer::{EstimatePass, Progress, RenderObserver};
 pub use plan::PassPlan;
-pub use radiance_estimate::{EstimateMode, EstimateOptions, EstimateStats, RadianceEstimate};
+pub use radiance_estimate::{
+    EstimateMode, EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate,
+};
 pub use ray_trace::{HitBuffers, RayBuffers, RayTracer};
 
 /// How one render runs (what the scene file does not fix).
@@ -53,6 +57,9 @@ pub struct GlobalIllumination {
     /// Final gather (section 4.5): a caustic map at the first hits and a global
     /// map at the gather rays' hits, instead of the one map visualised directly.
     pub final_gather: Option<FinalGatherOptions>,
+    /// Adaptive sampling (section 4.5): global light computed on a pyramid of
+    /// pixel lattices and interpolated where it is smooth.
+    pub adaptive: Option<AdaptiveOptions>,
 }
 
 impl RenderOptions {
@@ -88,6 +95,8 @@ pub struct RenderOutput {
     /// Final gather's global map, and each eye sample's gather.
     pub gather_photons: Option<PhotonReport>,
     pub gathers: Vec<GatherStats>,
+    /// Each eye sample's adaptive sampling.
+    pub adaptive: Vec<AdaptiveStats>,
     /// The last radiance estimate, and every one (view by view, sample by sample).
     pub estimate: Option<EstimateStats>,
     pub estimates: Vec<EstimateStats>,
@@ -206,6 +215,8 @@ pub fn render_views(
         gather,
         estimates,
         gathers,
+        adaptive,
+        ..
     } = global;
     let mut output = finish(
         image.expect("at least one camera"),
@@ -228,10 +239,12 @@ pub fn render_views(
         output.state.gather_map = Some(g.map);
     }
     output.gathers = gathers;
+    output.adaptive = adaptive;
     Ok(output)
 }
 
 /// One eye sample's first hits, ready for the global half.
+#[derive(Clone, Copy)]
 struct SampleFrame<'a> {
     scene: &'a Scene,
     textures: &'a SceneTextures,
@@ -250,6 +263,8 @@ struct GlobalPart {
     gather: Option<FinalGather>,
     estimates: Vec<EstimateStats>,
     gathers: Vec<GatherStats>,
+    pyramid: Option<Adaptive>,
+    adaptive: Vec<AdaptiveStats>,
 }
 
 impl GlobalPart {
@@ -282,6 +297,10 @@ impl GlobalPart {
             (Some(rays), Some(_)) => Some(FinalGather::new(gpu, w, h, rays)?),
             _ => None,
         };
+        let adaptive = options
+            .global
+            .as_ref()
+            .is_some_and(|g| g.adaptive.is_some());
         Ok(Self {
             built,
             global_map,
@@ -289,11 +308,14 @@ impl GlobalPart {
             gather,
             estimates: Vec::new(),
             gathers: Vec::new(),
+            pyramid: adaptive.then(|| Adaptive::new(gpu, w, h)).transpose()?,
+            adaptive: Vec::new(),
         })
     }
 
     /// One eye sample's image: its direct light, plus the estimate at its
-    /// first hits and (final gather) the gathered indirect light.
+    /// first hits and (final gather) the gathered indirect light, computed at
+    /// every pixel or (adaptive) on the pyramid.
     fn sample(
         &mut self,
         f: &SampleFrame<'_>,
@@ -303,12 +325,65 @@ impl GlobalPart {
         let Some(gi) = &f.options.global else {
             return Ok(f.direct.read_radiance());
         };
+        // Taken for the levels and put back: global_light borrows self.
+        let Some(pyramid) = self.pyramid.take() else {
+            return self.global_light(f, gi, f.direct.queries(), true, timings, observer);
+        };
+        let options = gi.adaptive.clone().unwrap_or_default();
+        pyramid.clear();
+        let mut stats = AdaptiveStats::default();
+        for level in 0..adaptive::STRIDES.len() {
+            let (computed, interpolated) = pyramid.select(f.direct, level, &options)?;
+            if computed > 0 {
+                // The estimate and gather run on the packed first hits.
+                let packed = SampleFrame {
+                    direct: &pyramid.packed,
+                    ..*f
+                };
+                let queries = pyramid.queries();
+                self.global_light(&packed, gi, queries, false, timings, observer)?;
+            }
+            pyramid.store(
+                self.estimate
+                    .as_ref()
+                    .filter(|_| self.built.is_some())
+                    .map(|e| &e.image),
+                self.gather.as_ref().map(|g| &g.indirect),
+            )?;
+            stats.computed += computed;
+            stats.interpolated += interpolated;
+            stats
+                .levels
+                .push((adaptive::STRIDES[level], computed, interpolated));
+        }
+        stats.pixels_with_hits = stats.computed + stats.interpolated;
+        self.adaptive.push(stats);
+        let mut image = f.direct.read_radiance();
+        image.add(&pyramid.read_value());
+        self.pyramid = Some(pyramid);
+        Ok(image)
+    }
+
+    /// The estimate and the gather at `queries`: the composed image (with
+    /// direct light, or without it), and the gather's indirect light in its
+    /// texture, also added to the image.
+    fn global_light(
+        &mut self,
+        f: &SampleFrame<'_>,
+        gi: &GlobalIllumination,
+        queries: QueryPoints<'_>,
+        include_direct: bool,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Image> {
         let mut image = match (&self.built, &self.estimate) {
             (Some(built), Some(estimate)) => {
                 let run = EstimateRun {
                     scene: f.scene,
                     textures: f.textures,
                     direct: f.direct,
+                    queries,
+                    include_direct,
                     map: &built.map,
                     estimate,
                     options: gi,
@@ -318,13 +393,15 @@ impl GlobalPart {
                 self.estimates.push(stats);
                 img
             }
-            _ => f.direct.read_radiance(),
+            _ if include_direct => f.direct.read_radiance(),
+            _ => Image::new(f.options.width, f.options.height),
         };
         if let (Some(global), Some(gather)) = (&self.global_map, &self.gather) {
             let run = GatherRun {
                 scene: f.scene,
                 textures: f.textures,
                 direct: f.direct,
+                queries,
                 global: &global.map,
                 gather,
                 options: gi,
@@ -376,6 +453,7 @@ fn finish(
         photons,
         gather_photons: None,
         gathers: Vec::new(),
+        adaptive: Vec::new(),
         estimate: estimates.last().cloned(),
         estimates,
     }
@@ -437,6 +515,8 @@ struct GatherRun<'a> {
     scene: &'a Scene,
     textures: &'a SceneTextures,
     direct: &'a DirectLight,
+    /// The first hits to gather at.
+    queries: QueryPoints<'a>,
     global: &'a PhotonMap,
     gather: &'a FinalGather,
     options: &'a GlobalIllumination,
@@ -457,12 +537,14 @@ impl GatherRun<'_> {
             .expect("a gather run has final-gather options");
         let estimate = EstimateOptions {
             float_addressing: self.options.photons.faithful,
+            leak: fg.leak,
             ..self.options.estimate.clone()
         };
         let at = self.at;
         self.gather.run(
             self.textures,
             self.direct,
+            self.queries,
             self.global,
             fg,
             &estimate,
@@ -557,6 +639,8 @@ struct EstimateRun<'a> {
     scene: &'a Scene,
     textures: &'a SceneTextures,
     direct: &'a DirectLight,
+    queries: QueryPoints<'a>,
+    include_direct: bool,
     map: &'a PhotonMap,
     estimate: &'a RadianceEstimate,
     options: &'a GlobalIllumination,
@@ -577,15 +661,21 @@ impl EstimateRun<'_> {
             ..self.options.estimate.clone()
         };
         let compose = || {
-            self.estimate
-                .compose(self.textures, self.direct, k, max_radius, true, true)
+            self.estimate.compose(
+                self.textures,
+                self.direct,
+                k,
+                max_radius,
+                self.include_direct,
+                true,
+            )
         };
         let mut observed = 0.0;
         let mut failure = None;
         let stats = self.estimate.run(
             self.textures,
             self.map,
-            self.direct.queries(),
+            self.queries,
             k,
             max_radius,
             &options,

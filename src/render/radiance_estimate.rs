@@ -100,6 +100,9 @@ pub struct EstimateStats {
 pub struct QueryPoints<'a> {
     pub position: &'a Texture,
     pub normal: &'a Texture,
+    /// Packed queries (adaptive sampling): each texel's pixel index (R32I),
+    /// so that what a query draws at random is its pixel's. None: in place.
+    pub pixel: Option<&'a Texture>,
 }
 
 /// Seen after every pass: for progress and snapshots.
@@ -146,6 +149,9 @@ fn search_program(
         defines.push(("FLOAT_ADDRESSING", "1".into()));
     }
     defines.extend(leak.defines());
+    if tiles {
+        defines.push(("TILED", "1".into()));
+    }
     let vertex = if tiles {
         "render/tile.vert"
     } else {

@@ -189,3 +189,83 @@ pub fn block_chi2(a: &[Image], b: &[Image], block: u32) -> (f64, usize, f64) {
     let bound = mean + 4.0 * (var / blocks as f64).sqrt();
     (chi2 / blocks as f64, blocks, bound)
 }
+
+/// A closed box with a mirror ball and a glass ball (gather rays follow both),
+/// a point light and an area light.
+pub const MIRROR_BOX: &str = r#"
+[camera]
+position = [0.5, 0.5, 1.4]
+look_at = [0.5, 0.45, 0.0]
+vfov = 55.0
+width = 24
+height = 24
+[render]
+shadow_rays = 4
+max_specular_depth = 6
+[photon_map]
+photons_stored = 20000
+grid_resolution = [16, 16, 24]
+k = 40
+max_radius = 0.15
+[materials]
+white = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
+red = { type = "diffuse", albedo = [0.7, 0.2, 0.2] }
+mirror = { type = "mirror", reflectance = [0.9, 0.9, 0.9] }
+glass = { type = "glass", ior = 1.5 }
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [0.0, 0.0, 1.5]
+edge2 = [1.0, 0.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 1.0, 0.0]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 1.5]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 1.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 1.5]
+edge1 = [0.0, 1.0, 0.0]
+edge2 = [1.0, 0.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [0.0, 1.0, 0.0]
+edge2 = [0.0, 0.0, 1.5]
+material = "red"
+[[shape]]
+type = "parallelogram"
+corner = [1.0, 0.0, 0.0]
+edge1 = [0.0, 0.0, 1.5]
+edge2 = [0.0, 1.0, 0.0]
+material = "white"
+[[shape]]
+type = "sphere"
+center = [0.3, 0.2, 0.5]
+radius = 0.18
+material = "mirror"
+[[shape]]
+type = "sphere"
+center = [0.72, 0.2, 0.6]
+radius = 0.16
+material = "glass"
+[[light]]
+type = "point"
+position = [0.5, 0.85, 0.7]
+intensity = [0.4, 0.4, 0.4]
+[[light]]
+type = "area"
+corner = [0.4, 0.999, 0.4]
+edge1 = [0.2, 0.0, 0.0]
+edge2 = [0.0, 0.0, 0.2]
+radiance = [5.0, 5.0, 5.0]
+"#;
