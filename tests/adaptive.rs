@@ -5,6 +5,7 @@
 mod common;
 
 use glam::Vec3;
+use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::reference::adaptive::{adaptive_light, FirstHits};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::{
@@ -13,11 +14,15 @@ use photonmap::render::{
 };
 use photonmap::scene::load_scene_str;
 
-fn options(w: u32, h: u32, gather: bool, adaptive: bool) -> RenderOptions {
+fn options(w: u32, h: u32, gather: bool, adaptive: bool, build: BuildMethod) -> RenderOptions {
     let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
     let mut o = RenderOptions::for_scene(&scene);
     (o.width, o.height, o.seed) = (w, h, 3);
     o.global = Some(GlobalIllumination {
+        photons: PhotonConfig {
+            build,
+            ..PhotonConfig::default()
+        },
         estimate: EstimateOptions {
             leak: LeakTest::None,
             ..EstimateOptions::default()
@@ -27,7 +32,6 @@ fn options(w: u32, h: u32, gather: bool, adaptive: bool) -> RenderOptions {
             ..FinalGatherOptions::default()
         }),
         adaptive: adaptive.then(AdaptiveOptions::default),
-        ..GlobalIllumination::default()
     });
     o
 }
@@ -63,12 +67,12 @@ fn first_hits(out: &RenderOutput) -> FirstHits {
 /// the twin, given the full render's light at the pixels it computes, must
 /// plan the same levels and give the adaptive image. Plans may differ only
 /// where a corner contrast sits on the threshold to rounding.
-fn check(gather: bool) {
+fn check(gather: bool, build: BuildMethod) {
     let gpu = common::gpu();
     let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
     let (w, h) = (40, 36);
-    let full = render(&gpu, &scene, &options(w, h, gather, false), &mut ()).unwrap();
-    let ad = render(&gpu, &scene, &options(w, h, gather, true), &mut ()).unwrap();
+    let full = render(&gpu, &scene, &options(w, h, gather, false, build), &mut ()).unwrap();
+    let ad = render(&gpu, &scene, &options(w, h, gather, true, build), &mut ()).unwrap();
     let full_light = global_light(&full);
     let threshold = AdaptiveOptions::default().threshold;
     let (twin, levels) = adaptive_light(&first_hits(&ad), &|i| full_light[i], threshold);
@@ -81,7 +85,7 @@ fn check(gather: bool) {
         .count();
     let saved = 1.0 - stats.computed as f64 / stats.pixels_with_hits as f64;
     eprintln!(
-        "adaptive (final gather {gather}): GPU levels {:?}, twin {levels:?}; {apart} of {} pixels apart; {:.0}% of pixels interpolated",
+        "adaptive (final gather {gather}, {build:?}): GPU levels {:?}, twin {levels:?}; {apart} of {} pixels apart; {:.0}% of pixels interpolated",
         stats.levels,
         got.len(),
         100.0 * saved
@@ -99,10 +103,15 @@ fn check(gather: bool) {
 
 #[test]
 fn adaptive_estimate_equals_its_cpu_twin() {
-    check(false);
+    check(false, BuildMethod::Bitonic);
 }
 
 #[test]
 fn adaptive_final_gather_equals_its_cpu_twin() {
-    check(true);
+    check(true, BuildMethod::Bitonic);
+}
+
+#[test]
+fn adaptive_final_gather_on_stencil_routing_equals_its_cpu_twin() {
+    check(true, BuildMethod::Stencil);
 }

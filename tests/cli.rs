@@ -1282,3 +1282,70 @@ fn bench_meshes_reports_every_size_with_rates_renders_and_a_plot() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("8"));
 }
+
+/// Final gather and adaptive sampling as a user runs them: the JSON reports
+/// the gather and the pyramid's levels; a caustics-only scene, SPPM, and
+/// --gather-k or a threshold without their switch are refused with a reason,
+/// and write nothing.
+#[test]
+fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
+    let d = tmp("final-gather");
+    let png = d.join("fg.png");
+    let out = photonmap()
+        .args([
+            "render", "--quiet", "--json", "--width", "40", "--height", "36",
+        ])
+        .args([
+            "--final-gather",
+            "3",
+            "--adaptive",
+            "--set",
+            "photon_map.photons_stored=4000",
+        ])
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    assert!(png.exists());
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["method"], "final-gather");
+    assert_eq!(json["final_gather"]["rays"], 3);
+    assert_eq!(json["gathers"][0]["rays_per_pixel"], 3);
+    let levels = json["adaptive_samples"][0]["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 4, "{levels:?}");
+    let computed = json["adaptive_samples"][0]["computed"].as_u64().unwrap();
+    let all = json["adaptive_samples"][0]["pixels_with_hits"]
+        .as_u64()
+        .unwrap();
+    assert!(0 < computed && computed < all, "{computed} of {all}");
+    let refused: [(&[&str], &str); 4] = [
+        (
+            &["--final-gather", "2", "--scene-name-ring"],
+            "caustics_only",
+        ),
+        (
+            &["--final-gather", "2", "--method", "sppm"],
+            "--final-gather",
+        ),
+        (&["--gather-k", "10"], "--final-gather"),
+        (&["--adaptive-threshold", "0.2"], "--adaptive"),
+    ];
+    for (args, says) in refused {
+        let bad = d.join("bad.png");
+        let ring = args.contains(&"--scene-name-ring");
+        let out = photonmap()
+            .args(["render", "--quiet", "--width", "16", "--height", "16"])
+            .args(args.iter().filter(|a| !a.starts_with("--scene-name")))
+            .arg(scene(if ring { "ring" } else { "cornell_box" }))
+            .arg("-o")
+            .arg(&bad)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} ran");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(!bad.exists(), "{args:?} wrote an image");
+    }
+}

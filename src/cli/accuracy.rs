@@ -16,7 +16,7 @@ use photonmap::metrics::compare;
 use photonmap::photon::BuildMethod;
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
-use photonmap::render::{render, EstimateMode, FinalGatherOptions, Image};
+use photonmap::render::{render, AdaptiveOptions, EstimateMode, FinalGatherOptions, Image};
 use photonmap::scene::{embedded, Light, Scene};
 
 use super::reference::{read_reference, reference_options, ReferenceInfo};
@@ -68,6 +68,8 @@ pub struct AccuracyRun {
     pub sppm_iterations: u32,
     /// Final gather's rays per pixel (0: the one map visualised directly).
     pub gather_rays: u32,
+    /// Adaptive sampling of the global light (its default threshold).
+    pub adaptive: bool,
     /// Wall seconds of one render (mean over the seeds).
     pub seconds: f64,
     /// RMSE of one render against the reference (mean over the seeds).
@@ -121,6 +123,7 @@ impl Config {
                 spp: 1,
                 sppm_iterations: 0,
                 gather_rays: 0,
+                adaptive: false,
                 seconds: 0.0,
                 rmse: 0.0,
                 bias_rmse: 0.0,
@@ -192,7 +195,17 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
                 r.gather_rays = rays;
             }));
         }
+        out.push(base.with("final gather 16 rays, adaptive".into(), |r| {
+            r.method = "final-gather".into();
+            r.gather_rays = 16;
+            r.adaptive = true;
+        }));
     }
+    out.push(base.with("adaptive".into(), |r| r.adaptive = true));
+    out.push(base.with("4 spp, adaptive".into(), |r| {
+        r.spp = 4;
+        r.adaptive = true;
+    }));
     for it in if quick {
         vec![4, 16]
     } else {
@@ -317,6 +330,7 @@ fn render_config(
         rays: c.gather_rays,
         ..FinalGatherOptions::default()
     });
+    gi.adaptive = c.adaptive.then(AdaptiveOptions::default);
     let wall = std::time::Instant::now();
     let image = if c.method == "sppm" {
         let sppm = SppmOptions {
@@ -477,10 +491,10 @@ fn mark_front(runs: &mut [AccuracyRun]) {
 }
 
 pub fn csv(r: &AccuracyReport) -> String {
-    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,tile,spp,sppm_iterations,gather_rays,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
+    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,tile,spp,sppm_iterations,gather_rays,adaptive,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
     for x in &r.runs {
         s += &format!(
-            "{},{},{},{},{},{:?},{},{:?},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
+            "{},{},{},{},{},{:?},{},{:?},{},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
             x.label,
             x.method,
             x.photons_stored,
@@ -493,6 +507,7 @@ pub fn csv(r: &AccuracyReport) -> String {
             x.spp,
             x.sppm_iterations,
             x.gather_rays,
+            x.adaptive,
             x.seconds,
             x.rmse,
             x.bias_rmse,
