@@ -46,9 +46,16 @@ impl RenderOutput {
     /// The passes this render ran and skipped, with why.
     pub fn explain(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
         let mut lines = self.ray_tracing_lines(scene);
+        // Final gather's maps are made from two views of the scene.
+        let views = options
+            .global
+            .as_ref()
+            .filter(|g| g.final_gather.is_some())
+            .and_then(|_| super::final_gather::map_scenes(scene).ok());
         match (&options.global, &self.photons) {
             (Some(gi), Some(p)) => {
-                lines.extend(self.photon_lines(scene, p));
+                let caustic = views.as_ref().map_or(scene, |v| &v.0);
+                lines.extend(self.photon_lines(caustic, p));
                 let (k, r) = (scene.photon_map.k, scene.photon_map.max_radius);
                 let pixels = options.width as u64 * options.height as u64;
                 let many = self.estimates.len() > 1;
@@ -68,12 +75,56 @@ impl RenderOutput {
                     ));
                 }
             }
+            (Some(gi), None) if gi.final_gather.is_some() => lines.push(line(
+                "caustic map, estimate",
+                0,
+                false,
+                "skipped: final gather's caustic map needs a mirror or glass, and the scene has none".into(),
+            )),
             _ => lines.push(line(
                 "photons, map, estimate",
                 0,
                 false,
                 "skipped: direct light only".into(),
             )),
+        }
+        let global = views.as_ref().map_or(scene, |v| &v.1);
+        lines.extend(self.section_4_5_lines(global, options));
+        lines
+    }
+
+    /// Final gather and adaptive sampling (section 4.5), when chosen.
+    fn section_4_5_lines(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
+        let mut lines = Vec::new();
+        let Some(gi) = &options.global else {
+            return lines;
+        };
+        if let (Some(fg), Some(p)) = (&gi.final_gather, &self.gather_photons) {
+            lines.extend(self.photon_lines(scene, p));
+            let passes: u32 = self.gathers.iter().map(|g| g.estimate_passes).sum();
+            let queries: u64 = self.gathers.iter().map(|g| g.queries).sum();
+            lines.push(line(
+                "final gather",
+                passes as usize,
+                true,
+                format!(
+                    "the photon map above the gather is the caustic map (specular paths only), visualised at the first hits; the one here is the global map (every diffuse hit), estimated only where {} gather rays a pixel land (k = {}, leak test {:?}): {queries} gather hits in all",
+                    fg.rays, fg.k, fg.leak
+                ),
+            ));
+        }
+        if let Some(a) = &gi.adaptive {
+            let computed: u64 = self.adaptive.iter().map(|s| s.computed).sum();
+            let all: u64 = self.adaptive.iter().map(|s| s.pixels_with_hits).sum();
+            lines.push(line(
+                "adaptive sampling",
+                4 * self.adaptive.len(),
+                true,
+                format!(
+                    "global light computed at {computed} of {all} pixels with a diffuse hit, interpolated at the rest (strides 8, 4, 2, 1; threshold {})",
+                    a.threshold
+                ),
+            ));
         }
         lines
     }
