@@ -40,7 +40,7 @@ void main() {
     vec4 incoming = texelFetch(u_incoming, t, 0);
 #endif
     int photon = (t.y % u_frame_height) * u_record_width + t.x;
-    int cell = grid_cell(position.xyz);
+    int cell = grid_key(position.xyz); // the slot: the cell, or its hash bucket
     gl_PointSize = float(u_block);
     v_position = vec4(position.xyz, 1.0);
     v_power = power;

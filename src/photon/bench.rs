@@ -159,6 +159,7 @@ pub fn paper_grid() -> Grid {
         min: Vec3::ZERO,
         max: Vec3::ONE,
         resolution: [40, 40, 40],
+        storage: super::GridStorage::Uniform,
     }
 }
 
