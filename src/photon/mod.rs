@@ -18,7 +18,7 @@ use crate::scene::Scene;
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
 pub use build::{build_map, check_storage, BuiltMap, PhotonConfig};
 pub use projection::ProjectionMaps;
-pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
+pub use stencil_routing::{LostPower, RoutedPhotonMap, StencilRouting, VertexFeed};
 pub use trace::{PhotonBatch, PhotonFrames, PhotonTracer, RandomSource, TraceConfig, TraceReport};
 
 /// The grid photons are sorted or routed into.
