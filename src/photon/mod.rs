@@ -204,10 +204,25 @@ impl PhotonMap {
         }
     }
 
-    /// Photons destined to each cell (read back): the sorted map's cell
-    /// ranges, or stencil routing's exact counts (which may exceed m^2).
+    /// Texels of the grid's own structure: the sorted map's first-index
+    /// texture (slots + 1 entries, as laid out), or stencil routing's
+    /// routing buffer plus its count textures (the memory §4.4 is about).
+    pub fn grid_texels(&self) -> u64 {
+        match self {
+            PhotonMap::Sorted(m) => m.grid_first.texel_count() as u64,
+            PhotonMap::Routed(m) => {
+                (m.position.texel_count()
+                    + m.counts.texel_count()
+                    + m.cell_counts.as_ref().map_or(0, |c| c.texel_count())) as u64
+            }
+        }
+    }
+
+    /// Photons destined to each slot (read back): the sorted map's slot
+    /// ranges, or stencil routing's exact counts (which may exceed m^2). A
+    /// slot is a cell of a uniform grid, or a bucket of a hashed one.
     pub fn photons_per_cell(&self) -> Vec<u32> {
-        let cells = self.grid().cell_count() as usize;
+        let cells = self.grid().slot_count() as usize;
         match self {
             PhotonMap::Sorted(m) => {
                 let first: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
