@@ -96,8 +96,8 @@ pub struct SppmState {
 }
 
 enum Builder {
-    Bitonic(BitonicBuild),
-    Stencil(StencilRouting, u32),
+    Bitonic(Box<BitonicBuild>),
+    Stencil(Box<StencilRouting>, u32),
 }
 
 /// A progressive render in progress: call `iterate` as often as wanted.
@@ -158,11 +158,12 @@ impl Sppm {
         )?;
         let batch = photons.batch(&scene, sppm.photons_per_iteration)?;
         let builder = match config.build {
-            BuildMethod::Bitonic => {
-                Builder::Bitonic(BitonicBuild::with_addressing(gpu, config.faithful)?)
-            }
+            BuildMethod::Bitonic => Builder::Bitonic(Box::new(BitonicBuild::with_addressing(
+                gpu,
+                config.faithful,
+            )?)),
             BuildMethod::Stencil => {
-                Builder::Stencil(StencilRouting::new(gpu)?, config.stencil_block)
+                Builder::Stencil(Box::new(StencilRouting::new(gpu)?), config.stencil_block)
             }
         };
         let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
