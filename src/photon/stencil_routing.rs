@@ -72,6 +72,15 @@ pub struct LostPower {
 }
 
 impl LostPower {
+    /// The same with power scaled (raw power to the map's).
+    pub fn scaled(self, s: f32) -> Self {
+        Self {
+            power: self.power.map(|c| c * s),
+            routed_power: self.routed_power.map(|c| c * s),
+            ..self
+        }
+    }
+
     /// Lost power over routed power, summed over the channels (0 if none routed).
     pub fn fraction(&self) -> f64 {
         let sum = |v: [f32; 3]| v.iter().map(|&c| c as f64).sum::<f64>();
@@ -262,16 +271,8 @@ impl StencilRouting {
         let power = t(width, height)?;
         let power_target = Target::new(&self.gpu, &[&power])?;
         let clock = StageClock::start(&self.gpu, &query);
-        let mut b = match &cell_counts {
-            Some(c) => {
-                let mut b = self.redistribute_hashed.bind();
-                grid.bind(&mut b);
-                b.texture("u_cell_counts", c);
-                b
-            }
-            None => self.redistribute.bind(),
-        };
-        b.texture("u_routed_position", &position)
+        self.bind_redistribute(grid, cell_counts.as_ref())
+            .texture("u_routed_position", &position)
             .texture("u_routed_power", &raw_power)
             .texture("u_counts", &counts)
             .int("u_block", block as i32)
@@ -287,17 +288,30 @@ impl StencilRouting {
             incoming,
             counts,
             cell_counts,
-            lost: lost.map(|l: LostPower| LostPower {
-                power: l.power.map(|c| c * frames.power_scale),
-                routed_power: l.routed_power.map(|c| c * frames.power_scale),
-                ..l
-            }),
+            lost: lost.map(|l: LostPower| l.scaled(frames.power_scale)),
             count_width,
             block,
             blocks_per_row: per_row,
             grid: *grid,
         };
         Ok((map, stencil))
+    }
+
+    /// The redistribution's program, bound with what only a hashed grid reads.
+    fn bind_redistribute<'a>(
+        &'a self,
+        grid: &Grid,
+        cell_counts: Option<&'a Texture>,
+    ) -> crate::gpu::Bindings<'a> {
+        match cell_counts {
+            Some(c) => {
+                let mut b = self.redistribute_hashed.bind();
+                grid.bind(&mut b);
+                b.texture("u_cell_counts", c);
+                b
+            }
+            None => self.redistribute.bind(),
+        }
     }
 
     /// Hashed grids: each cell's destined count and power at its first kept

@@ -16,18 +16,21 @@ case_run() { # name scene grid(uniform|hash) [--set ...]
   fi
 }
 # 1. GLASS BALL, its own grid (250 x 1 x 250 over the floor).
-case_run glass_ball_scene_grid glass_ball uniform
-case_run glass_ball_scene_grid glass_ball hash
+# Every render at the SPPM references' size (--scale 2 of the scene's).
+G="--width 256 --height 192"
+case_run glass_ball_scene_grid glass_ball uniform $G
+case_run glass_ball_scene_grid glass_ball hash $G
 # 2. GLASS BALL, the whole scene box at fine cells (256 x 150 x 256 = 9.8M cells).
-FINE="--set photon_map.grid_min=[-3.0,0.0,-3.0] --set photon_map.grid_max=[3.0,3.5,3.0] --set photon_map.grid_resolution=[256,150,256]"
+FINE="--set photon_map.grid_min=[-3.0,0.0,-3.0] --set photon_map.grid_max=[3.0,3.5,3.0] --set photon_map.grid_resolution=[256,150,256] $G"
 case_run glass_ball_fine glass_ball uniform $FINE
 case_run glass_ball_fine glass_ball hash $FINE
-# 3. CORNELL BOX at 1024^3 over its box: uniform is refused; hashed renders at 128 x 96 with
+# 3. CORNELL BOX at 1024^3 over its box: uniform is refused; hashed renders with
 #    max_radius 0.02 (10 cells), set beside the same render on the scene's own grid.
-C1024="--set photon_map.grid_resolution=[1024,1024,1024] --set photon_map.max_radius=0.02 --width 128 --height 96"
+C1024="--set photon_map.grid_resolution=[1024,1024,1024] --set photon_map.max_radius=0.02 --width 256 --height 256"
 case_run cornell_1024 cornell_box uniform $C1024
 case_run cornell_1024 cornell_box hash $C1024
-case_run cornell_own_r002 cornell_box uniform --set photon_map.max_radius=0.02 --width 128 --height 96
+case_run cornell_own_r002 cornell_box uniform --set photon_map.max_radius=0.02 --width 256 --height 256
+case_run cornell_own cornell_box uniform --width 256 --height 256
 # 4. A mesh scene with empty space: the OBJ Cornell box (about 550 units a side)
 #    with a 256^3 grid fitted to its photons, max_radius 8 (about 4 cells).
 M256="--set photon_map.grid_resolution=[256,256,256] --set photon_map.max_radius=8.0 --width 128 --height 96"
