@@ -9,7 +9,14 @@ T=${TMPDIR:-/tmp}/hash_grid_images
 mkdir -p "$T"
 case_run() { # name scene grid(uniform|hash) [--set ...]
   name=$1; scene=$2; grid=$3; shift 3
-  $P photons "$scene" --grid "$grid" --json "$@" > "$D/$name.$grid.photons.json" 2> "$D/$name.$grid.photons.err"
+  # photons takes no image size: drop --width N and --height N for it.
+  ph=""; skip=0
+  for a in "$@"; do
+    if [ $skip = 1 ]; then skip=0; continue; fi
+    case "$a" in --width|--height) skip=1 ;; *) ph="$ph $a" ;; esac
+  done
+  $P photons "$scene" --grid "$grid" --json $ph > "$D/$name.$grid.photons.json" 2> "$D/$name.$grid.photons.err"
+  [ "${PHOTONS_ONLY:-0}" = 1 ] && return
   $P render "$scene" --grid "$grid" --quiet --json -o "$T/$name.$grid.exr" "$@" > "$D/$name.$grid.render.json" 2> "$D/$name.$grid.render.err"
   if [ -f "reference_images/$scene.sppm.exr" ] && [ -f "$T/$name.$grid.exr" ]; then
     $P compare "$T/$name.$grid.exr" "reference_images/$scene.sppm.exr" --json > "$D/$name.$grid.compare.json" 2> "$D/$name.$grid.compare.err"
@@ -36,3 +43,11 @@ case_run cornell_own cornell_box uniform --width 256 --height 256
 M256="--set photon_map.grid_resolution=[256,256,256] --set photon_map.max_radius=8.0 --width 128 --height 96"
 case_run cornell_obj_256 cornell_box_obj uniform $M256
 case_run cornell_obj_256 cornell_box_obj hash $M256
+# 5. Stencil routing (m = 4), photons only: grid texels and the power a hashed
+#    routing loses (cells whose full bucket kept none of their photons).
+for g in uniform hash; do
+  $P photons glass_ball --build stencil --grid $g --json > "$D/stencil_glass_ball.$g.photons.json"
+  $P photons cornell_box --build stencil --grid $g --json > "$D/stencil_cornell.$g.photons.json"
+done
+$P photons cornell_box --build stencil --grid hash --hash-buckets 4096 --json > "$D/stencil_cornell_4096.hash.photons.json"
+$P photons cornell_box --build stencil --grid hash --json --set 'photon_map.grid_resolution=[1024,1024,1024]' > "$D/stencil_cornell_1024.hash.photons.json"
