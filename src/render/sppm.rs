@@ -103,6 +103,8 @@ enum Builder {
 /// A progressive render in progress: call `iterate` as often as wanted.
 pub struct Sppm {
     gpu: Gpu,
+    /// Each iteration's grid storage (`--grid`): uniform, or hashed (§4.4).
+    storage: crate::photon::GridStorage,
     /// The scene as SPPM traces it (bounces, shadow rays, first-hit storage).
     scene: Scene,
     options: SppmOptions,
@@ -189,6 +191,7 @@ impl Sppm {
             photons,
             batch,
             builder,
+            storage: config.storage(sppm.photons_per_iteration),
             state: SppmState {
                 flux,
                 sums,
@@ -263,7 +266,8 @@ impl Sppm {
             frames.frames as usize,
         );
         let wall = std::time::Instant::now();
-        let grid = Grid::over_scene(&self.scene, self.cell, self.max_cells());
+        let grid =
+            Grid::over_scene(&self.scene, self.cell, self.max_cells()).with_storage(self.storage);
         let mut stages = Timings::default();
         let map = match &self.builder {
             Builder::Bitonic(b) => PhotonMap::Sorted(b.build(frames, &grid, &mut stages)?),
