@@ -200,6 +200,41 @@ fn photons_reports_the_stored_count_for_both_builds() {
 }
 
 #[test]
+fn the_hash_grid_reaches_photons_and_its_limits_are_named() {
+    let uniform = photons_json("glass_ball", &["--build", "stencil"]);
+    let hashed = photons_json("glass_ball", &["--build", "stencil", "--grid", "hash"]);
+    assert_eq!(uniform["grid_storage"], "uniform");
+    assert_eq!(
+        hashed["grid_storage"]["hashed"]["buckets"], 8192,
+        "{hashed}"
+    );
+    assert!(hashed["grid_texels"].as_u64() < uniform["grid_texels"].as_u64());
+    let lost = hashed["lost_power_fraction"].as_f64().unwrap();
+    assert!((0.0..0.01).contains(&lost), "{hashed}");
+    let refused = |args: &[&str], says: &str| {
+        let out = photonmap()
+            .args(["photons"])
+            .args(args)
+            .arg(scene("ring"))
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    };
+    refused(&["--grid", "hash", "--hash-buckets", "0"], "1..=16777216");
+    refused(
+        &["--set", "photon_map.grid_resolution=[1025,1,1]"],
+        "1..=1024",
+    );
+    refused(
+        &["--set", "photon_map.grid_resolution=[1024,1024,1024]"],
+        "--grid hash",
+    );
+}
+
+#[test]
 fn faithful_photons_match_the_default_ones() {
     let a = photons_json("cornell_box", &["--build", "stencil"]);
     let b = photons_json("cornell_box", &["--build", "stencil", "--faithful"]);

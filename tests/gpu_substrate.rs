@@ -196,7 +196,9 @@ fn every_glsl_file_compiles() {
     // built each way the program builds them.
     let vertices_of = |frag: &str| -> Vec<&str> {
         match frag {
-            "photon/route.frag" | "photon/count.frag" => vec!["photon/route.vert"],
+            "photon/route.frag" | "photon/count.frag" | "photon/count_cell.frag" => {
+                vec!["photon/route.vert"]
+            }
             "render/knn_search.frag" => vec!["common/fullscreen.vert", "render/tile.vert"],
             _ => vec!["common/fullscreen.vert"],
         }
@@ -206,6 +208,11 @@ fn every_glsl_file_compiles() {
             "photon/route.frag" | "photon/count.frag" => {
                 vec![vec![], vec![("READBACK", "1".into())]]
             }
+            "photon/count_cell.frag" => vec![
+                vec![("CELL_COUNT", "1".into())],
+                vec![("CELL_COUNT", "1".into()), ("READBACK", "1".into())],
+            ],
+            "photon/redistribute.frag" => vec![vec![], vec![("HASHED", "1".into())]],
             "render/knn_search.frag" => vec![
                 vec![],
                 vec![("ROUTED", "1".into())],

@@ -8,7 +8,7 @@ use common::Rng;
 
 use photonmap::gpu::{Gpu, TexFormat, Texture};
 use photonmap::photon::bitonic::{pass_count, sort_texture_size, BitonicBuild, INVALID_KEY};
-use photonmap::photon::{Grid, PhotonFrames, StencilRouting, VertexFeed};
+use photonmap::photon::{Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
 use photonmap::reference::photon::route;
 use photonmap::render::Timings;
 
@@ -277,6 +277,7 @@ fn stencil_routing_equals_a_cpu_simulation_of_the_draw_order() {
         min: glam::Vec3::ZERO,
         max: glam::Vec3::ONE,
         resolution: [5, 4, 3],
+        storage: GridStorage::Uniform,
     };
     let mut rng = Rng(7);
     let mut points: Vec<[f32; 3]> = (0..3000)
@@ -300,6 +301,7 @@ fn stencil_routing_counts_past_255_and_never_overwrites() {
         min: glam::Vec3::ZERO,
         max: glam::Vec3::ONE,
         resolution: [2, 1, 1],
+        storage: GridStorage::Uniform,
     };
     // 300 photons into cell 0 and 5 into cell 1, at distinct points.
     let mut points: Vec<[f32; 3]> = (0..300)
@@ -334,6 +336,7 @@ fn routed_power_equals_destined_power_when_photons_are_alike() {
         min: glam::Vec3::ZERO,
         max: glam::Vec3::ONE,
         resolution: [3, 1, 2],
+        storage: GridStorage::Uniform,
     };
     let mut rng = Rng(99);
     let points: Vec<[f32; 3]> = (0..5000)
@@ -380,6 +383,7 @@ fn the_stencil_pattern_and_saturation_are_as_the_paper_describes() {
         min: glam::Vec3::ZERO,
         max: glam::Vec3::ONE,
         resolution: [1, 1, 1],
+        storage: GridStorage::Uniform,
     };
     for n in [10usize, 300] {
         let points: Vec<[f32; 3]> = (0..n).map(|i| [0.001 * i as f32, 0.5, 0.5]).collect();

@@ -1,39 +1,52 @@
 // Access to a built photon map, whichever build made it: the photons of a grid
-// cell as a range [0, count) and the i-th photon's position and power.
-// ROUTED: stencil routing's m x m blocks; otherwise the sorted map.
+// cell's slot as a range [0, count) and the i-th photon's position and power.
+// ROUTED: stencil routing's m x m blocks; otherwise the sorted map. In a hash
+// grid (u_hash_buckets > 0, section 4.4) the slot is the cell's bucket and
+// holds other cells' photons too: photon_in_cell rejects them, and a search
+// counts them as examined (the paper's collision overhead).
 // src/reference/knn.rs reads the same layouts.
 #include "common/addressing.glsl"
+#include "common/grid.glsl"
 
 uniform sampler2D u_map_position;  // xyz, w = 1 valid
-uniform sampler2D u_map_power;     // rgb (stencil routing: redistributed)
+uniform sampler2D u_map_power;     // rgb (stencil routing: redistributed; hashed: w = weight)
 #ifdef ROUTED
-uniform sampler2D u_map_counts;    // photons destined to each cell (x)
+uniform sampler2D u_map_counts;    // photons destined to each slot (x)
 uniform int u_count_width;
 uniform int u_block;               // m
 uniform int u_blocks_per_row;
 #else
-uniform isampler2D u_grid_first;   // first sorted index of each cell
+uniform isampler2D u_grid_first;   // first sorted index of each slot
 uniform int u_grid_width;
 uniform int u_sorted_width;
 #endif
 
-// Photons stored in `cell`, and the offset that photon_texel takes.
+// Photons stored in `cell`'s slot, and the offset that photon_texel takes.
 int cell_photon_count(int cell, out int base) {
+    int slot = grid_slot(cell);
 #ifdef ROUTED
-    base = cell;
-    float destined = texelFetch(u_map_counts, texel_of_index(cell, u_count_width), 0).x;
+    base = slot;
+    float destined = texelFetch(u_map_counts, texel_of_index(slot, u_count_width), 0).x;
     return min(int(destined), u_block * u_block);
 #else
-    base = texelFetch(u_grid_first, texel_of_index(cell, u_grid_width), 0).x;
-    return texelFetch(u_grid_first, texel_of_index(cell + 1, u_grid_width), 0).x - base;
+    base = texelFetch(u_grid_first, texel_of_index(slot, u_grid_width), 0).x;
+    return texelFetch(u_grid_first, texel_of_index(slot + 1, u_grid_width), 0).x - base;
 #endif
 }
 
-// How many photons each stored photon of `cell` stands for: 1 in the sorted
-// map; destined / kept in stencil routing, whose redistributed power already
-// carries it (progressive gathers count photons with it too).
-float cell_photon_weight(int cell) {
+// Whether the photon at p belongs to `cell`: always in a uniform grid; in a
+// hash grid only if its own cell is `cell` (the same grid_cell that keyed it).
+bool photon_in_cell(vec3 p, int cell) {
+    return u_hash_buckets == 0 || grid_cell(p) == cell;
+}
+
+// How many photons the stored photon at texel t of `cell` stands for: 1 in
+// the sorted map; destined / kept in stencil routing, whose redistributed
+// power already carries it (progressive gathers count photons with it too).
+// A hashed routing keeps it per photon (power .w): a bucket's cells differ.
+float photon_weight(int cell, ivec2 t) {
 #ifdef ROUTED
+    if (u_hash_buckets > 0) return texelFetch(u_map_power, t, 0).w;
     float destined = texelFetch(u_map_counts, texel_of_index(cell, u_count_width), 0).x;
     return destined / max(1.0, min(destined, float(u_block * u_block)));
 #else
@@ -41,10 +54,10 @@ float cell_photon_weight(int cell) {
 #endif
 }
 
-// The texel of the i-th photon of the cell whose `base` cell_photon_count gave.
+// The texel of the i-th photon of the slot whose `base` cell_photon_count gave.
 ivec2 photon_texel(int base, int i) {
 #ifdef ROUTED
-    // The k-th photon of a cell sits in slot m^2 - 1 - k, row by row in its block.
+    // The k-th photon of a slot sits in slot m^2 - 1 - k, row by row in its block.
     int slot = u_block * u_block - 1 - i;
     ivec2 block = texel_of_index(base, u_blocks_per_row);
     return block * u_block + ivec2(slot % u_block, slot / u_block);

@@ -1,9 +1,9 @@
 #version 450 core
-// The uniform grid: for each cell, the index of its first photon in the sorted
-// order (a lower bound by binary search, unrolled). An empty cell gets the
-// first index of the next non-empty cell, so cell c's photons are
-// [first(c), first(c + 1)). One extra entry past the last cell holds the
-// number of valid photons.
+// For each slot (a cell of the uniform grid, or a hash bucket), the index of
+// its first photon in the sorted order (a lower bound by binary search,
+// unrolled). An empty slot gets the first index of the next non-empty one, so
+// slot c's photons are [first(c), first(c + 1)). One extra entry past the last
+// slot holds the number of valid photons.
 #include "common/addressing.glsl"
 
 uniform isampler2D u_sorted;

@@ -42,5 +42,5 @@ void main() {
     }
     int record = index_of_texel(t, textureSize(u_pyramid, 0).x);
     vec3 p = texelFetch(u_position, texel_of_index(record, u_record_width), 0).xyz;
-    o_pair = ivec4(grid_cell(p), record, 0, 0);
+    o_pair = ivec4(grid_key(p), record, 0, 0);
 }

@@ -1,5 +1,5 @@
 #version 450 core
-// (grid cell, photon record) pairs for the sort: one per texel of the sort
+// (grid slot, photon record) pairs (the slot: the cell, or its hash bucket) for the sort: one per texel of the sort
 // texture. Records that are not stored photons, that belong to photons past the
 // emitted count in use, or that fall outside the grid get the key INT_MAX, so
 // they sort last.
@@ -25,6 +25,6 @@ void main() {
     int photon = (t.y % u_frame_height) * u_record_width + t.x;
     if (photon >= u_photons_used) return;
     if (texelFetch(u_power, t, 0).w == 0.0) return; // not a stored photon
-    int cell = grid_cell(texelFetch(u_position, t, 0).xyz);
-    if (cell >= 0) o_key.x = cell;
+    int key = grid_key(texelFetch(u_position, t, 0).xyz);
+    if (key >= 0) o_key.x = key;
 }

@@ -3,10 +3,20 @@
 // (routing), or as one texel of the per-cell count texture (COUNT). Records
 // that are not stored photons, are past the emitted count in use, or fall
 // outside the grid are moved off screen.
+// CELL_COUNT (hashed grids, section 4.4): a point of size 1 at the slot of
+// the first photon its bucket kept of the photon's own cell (u_split = 0), or
+// at texel 0 when there is none, else texel 1 (u_split = 1: lost and kept power).
 // READBACK: the paper's way, records read back to the CPU and drawn from a
 // vertex buffer; otherwise the vertex stage fetches them from the photon textures.
 #include "common/addressing.glsl"
 #include "common/grid.glsl"
+#ifdef CELL_COUNT
+#include "common/routed_cells.glsl"
+uniform sampler2D u_routed_position;
+uniform int u_route_block;      // m of the routing
+uniform int u_route_per_row;    // blocks per row of the routing buffer
+uniform int u_split;
+#endif
 
 uniform int u_record_width;
 uniform int u_frame_height;
@@ -40,7 +50,7 @@ void main() {
     vec4 incoming = texelFetch(u_incoming, t, 0);
 #endif
     int photon = (t.y % u_frame_height) * u_record_width + t.x;
-    int cell = grid_cell(position.xyz);
+    int cell = grid_key(position.xyz); // the slot: the cell, or its hash bucket
     gl_PointSize = float(u_block);
     v_position = vec4(position.xyz, 1.0);
     v_power = power;
@@ -49,6 +59,19 @@ void main() {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // clipped: not drawn
         return;
     }
+#ifdef CELL_COUNT
+    int own = grid_cell(position.xyz);
+    ivec3 found = cell_in_block(u_routed_position, cell, own, u_route_block, u_route_per_row);
+    ivec2 texel = found.xy;
+    if (u_split == 1) texel = ivec2(found.x < 0 ? 0 : 1, 0);
+    else if (found.x < 0) {
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // lost: counted by the split
+        return;
+    }
+    gl_PointSize = 1.0;
+    gl_Position = vec4((vec2(texel) + 0.5) / vec2(u_target_size) * 2.0 - 1.0, 0.0, 1.0);
+    return;
+#endif
     ivec2 block = texel_of_index(cell, u_blocks_per_row);
     // The centre of the block: a point of even size m centred on a pixel corner
     // covers exactly the m x m pixels around it.

@@ -31,9 +31,6 @@ uniform sampler2D u_query_normal;    // facing the eye, w = material + 1
 uniform sampler2D u_state_flux;      // rgb sum of accepted power, w = radius^2
 uniform isampler2D u_state_cursor;   // accepted, ring, cube cursor, photon cursor
 uniform isampler2D u_state_done;     // done, photons examined
-uniform vec3 u_grid_min;
-uniform vec3 u_grid_max;
-uniform ivec3 u_grid_resolution;
 uniform int u_k;
 uniform float u_max_radius;
 uniform int u_budget;
@@ -106,9 +103,11 @@ void main() {
         int count = cell_photon_count(cell_index, base);
         if (p >= count) { j += 1; p = 0; continue; }
         ivec2 t = photon_texel(base, p);
-        vec3 offset = texelFetch(u_map_position, t, 0).xyz - x;
+        vec3 photon = texelFetch(u_map_position, t, 0).xyz;
+        vec3 offset = photon - x;
         float dist2 = dot(offset, offset);
-        bool candidate = dist2 <= max_r2 && (accepted < u_k || dist2 <= r2);
+        // A hash bucket's photons of other cells are examined and rejected.
+        bool candidate = dist2 <= max_r2 && (accepted < u_k || dist2 <= r2) && photon_in_cell(photon, cell_index);
 #ifdef DISC_TEST
         // A disc, not a sphere: photons off the query's tangent plane (another
         // wall at a corner) are not its photons.

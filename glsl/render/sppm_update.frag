@@ -28,9 +28,6 @@ uniform sampler2D u_diffuse_position;   // x, w = 1 where there is one
 uniform sampler2D u_diffuse_normal;     // facing the eye, w = material + 1
 uniform sampler2D u_diffuse_throughput; // path weight up to x
 uniform sampler2D u_map_incoming;       // each photon's direction of arrival
-uniform vec3 u_grid_min;
-uniform vec3 u_grid_max;
-uniform ivec3 u_grid_resolution;
 uniform float u_alpha;
 // A pixel that has gathered nothing yet (N = 0) takes its first radius lazily:
 // at most the grid's cell, so its gather stays within 2 cells per axis.
@@ -72,11 +69,12 @@ void main() {
                 int cell = cx + u_grid_resolution.x * (cy + u_grid_resolution.y * cz);
                 int base;
                 int count = cell_photon_count(cell, base);
-                float w = cell_photon_weight(cell);
                 for (int i = 0; i < count; ++i) {
                     ivec2 t = photon_texel(base, i);
-                    vec3 offset = texelFetch(u_map_position, t, 0).xyz - x;
+                    vec3 photon = texelFetch(u_map_position, t, 0).xyz;
+                    vec3 offset = photon - x;
                     if (dot(offset, offset) >= r2) continue;
+                    if (!photon_in_cell(photon, cell)) continue; // a hash bucket's other cells
                     if (dot(texelFetch(u_map_incoming, t, 0).xyz, nf) >= 0.0) continue;
 #ifdef DISC_TEST
                     if (abs(dot(offset, nf)) > DISC_THICKNESS * u_disc_radius) continue;
@@ -85,7 +83,7 @@ void main() {
                     if (!photon_visible(x, nf, x + offset)) continue;
 #endif
                     gathered += texelFetch(u_map_power, t, 0).rgb;
-                    m += w;
+                    m += photon_weight(cell, t);
                 }
             }
     if (m > 0.0) {

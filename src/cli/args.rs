@@ -3,7 +3,8 @@
 
 use clap::Args;
 
-use photonmap::photon::{BuildMethod, PhotonConfig, VertexFeed};
+use photonmap::photon::build::MAX_HASH_BUCKETS;
+use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{DirectLighting, SppmOptions};
 use photonmap::render::{EstimateMode, EstimateOptions};
@@ -46,6 +47,15 @@ pub struct PhotonMapArgs {
     /// Trace all max_bounces photon bounces even when none is left alive.
     #[arg(long)]
     pub all_bounces: bool,
+    /// How the grid stores its cells: one slot per cell (uniform), or a hash
+    /// table keyed by the cell's address (hash, section 4.4: memory follows
+    /// the photons, so grids up to 1024^3 fit).
+    #[arg(long, value_enum, default_value_t = GridKind::Uniform)]
+    pub grid: GridKind,
+    /// Hash buckets of `--grid hash` (1..=16777216; default: the next power
+    /// of two at or above the photons stored).
+    #[arg(long, value_name = "N", value_parser = in_range(1, MAX_HASH_BUCKETS))]
+    pub hash_buckets: Option<u32>,
 }
 
 impl From<&PhotonMapArgs> for PhotonConfig {
@@ -57,6 +67,8 @@ impl From<&PhotonMapArgs> for PhotonConfig {
             faithful: a.faithful,
             all_bounces: a.all_bounces,
             projection_maps: !a.no_projection_map,
+            grid: a.grid,
+            hash_buckets: a.hash_buckets,
         }
     }
 }

@@ -65,6 +65,12 @@ pub struct BuildArgs {
     /// Stencil routing m (the paper: a 1024 x 1024 buffer of about 40^3 cells; 1..=16).
     #[arg(long, default_value_t = 4, value_parser = in_range(1, 16))]
     pub stencil_m: u32,
+    /// The grid's storage: uniform, or a hash table (section 4.4).
+    #[arg(long, value_enum, default_value_t = photonmap::photon::GridKind::Uniform)]
+    pub grid: photonmap::photon::GridKind,
+    /// Hash buckets of `--grid hash` (1..=16777216; default: the next power of two >= the photons).
+    #[arg(long, value_name = "N", value_parser = in_range(1, photonmap::photon::build::MAX_HASH_BUCKETS))]
+    pub hash_buckets: Option<u32>,
     #[arg(long)]
     pub json: bool,
     #[arg(long)]
@@ -86,7 +92,18 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
                 );
             }
             let gpu = super::gpu(platform)?;
-            let bench = run_build_bench(&gpu, a.min_log2, a.max_log2, a.stencil_m, !a.quiet)?;
+            let config = photonmap::photon::PhotonConfig {
+                grid: a.grid,
+                hash_buckets: a.hash_buckets,
+                ..Default::default()
+            };
+            let bench = run_build_bench(
+                &gpu,
+                (a.min_log2, a.max_log2),
+                a.stencil_m,
+                &config,
+                !a.quiet,
+            )?;
             if a.json {
                 super::print_json(&bench)
             } else {
@@ -174,9 +191,9 @@ pub struct BuildBench {
 
 pub fn run_build_bench(
     gpu: &Gpu,
-    min_log2: u32,
-    max_log2: u32,
+    (min_log2, max_log2): (u32, u32),
     block: u32,
+    config: &photonmap::photon::PhotonConfig,
     progress: bool,
 ) -> Result<BuildBench> {
     let caps = gpu.capabilities();
@@ -188,7 +205,10 @@ pub fn run_build_bench(
     let mut rows = Vec::new();
     for k in min_log2..=max_log2 {
         bar.set_message(format!("n = 2^{k}"));
-        rows.push(bench_size(gpu, 1u64 << k, &paper_grid(), block)?);
+        let n = 1u64 << k;
+        let grid = paper_grid().with_storage(config.storage(n as u32));
+        photonmap::photon::check_storage(&grid)?;
+        rows.push(bench_size(gpu, n, &grid, block)?);
         bar.inc(1);
     }
     bar.finish_and_clear();

@@ -53,11 +53,20 @@ pub struct PhotonReport {
     pub grid_resolution: [u32; 3],
     pub grid_min: [f32; 3],
     pub grid_max: [f32; 3],
+    /// Uniform (a slot per cell) or hashed (a slot per bucket; section 4.4).
+    pub grid_storage: photonmap::photon::GridStorage,
+    /// Texels of the grid's structure (`PhotonMap::grid_texels`).
+    pub grid_texels: u64,
+    /// Hashed stencil routing: photons of cells their full bucket kept none
+    /// of, and the fraction of the routed power they carried (lost).
+    pub lost_photons: Option<u64>,
+    pub lost_power_fraction: Option<f64>,
     /// Photons in the map (bitonic: valid sorted records; stencil: records in slots).
     pub photons_in_map: u64,
     /// Photons destined to the grid (inside its bounds).
     pub photons_in_grid: u64,
     pub cells: u32,
+    /// Slots (cells, or hash buckets) holding photons, and the most in one.
     pub cells_with_photons: u32,
     pub max_photons_in_a_cell: u32,
     /// Stencil routing only: cells destined more photons than their m^2 slots.
@@ -101,6 +110,10 @@ pub fn trace_and_build(
     gpu.finish();
     timings.wall_seconds = wall.elapsed().as_secs_f64();
     let grid = built.grid;
+    let lost = match &built.map {
+        PhotonMap::Routed(m) => m.lost,
+        PhotonMap::Sorted(_) => None,
+    };
     Ok(PhotonReport {
         provenance: None,
         scene: scene.name.clone(),
@@ -112,6 +125,10 @@ pub fn trace_and_build(
         grid_resolution: grid.resolution,
         grid_min: grid.min.to_array(),
         grid_max: grid.max.to_array(),
+        grid_storage: grid.storage,
+        grid_texels: built.map.grid_texels(),
+        lost_photons: lost.map(|l| l.photons),
+        lost_power_fraction: lost.map(|l| l.fraction()),
         photons_in_map: in_map,
         photons_in_grid: in_grid,
         cells: grid.cell_count(),
@@ -147,6 +164,20 @@ pub fn print_report(r: &PhotonReport) {
         r.grid_min[0], r.grid_min[1], r.grid_min[2], r.grid_max[0], r.grid_max[1], r.grid_max[2],
         r.photons_in_grid, r.photons_in_map, r.cells_with_photons, r.cells, r.max_photons_in_a_cell
     );
+    if let photonmap::photon::GridStorage::Hashed { buckets } = r.grid_storage {
+        println!(
+            "  hashed into {buckets} buckets (section 4.4): the counts above are per bucket; {} grid texels",
+            r.grid_texels
+        );
+    } else {
+        println!("  uniform grid: {} grid texels", r.grid_texels);
+    }
+    if let (Some(n), Some(f)) = (r.lost_photons, r.lost_power_fraction) {
+        println!(
+            "  {n} photons of cells their full bucket kept none of: {:.3}% of the routed power is lost",
+            100.0 * f
+        );
+    }
     if let Some(p) = &r.trace.projection {
         println!(
             "  caustics only, aimed by projection maps: {} of {} cells kept ({}x{} a light), {:.2}% of the lights' power",

@@ -126,7 +126,7 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     let mut readback = Timings::default();
     routing.build(&frames, grid, block, VertexFeed::Readback, &mut readback)?;
     let gpu_part = |t: &Timings| {
-        ["route", "count", "redistribute"]
+        ["route", "count", "count cells", "redistribute"]
             .iter()
             .map(|s| stage(t, s))
             .sum::<f64>()
@@ -159,6 +159,7 @@ pub fn paper_grid() -> Grid {
         min: Vec3::ZERO,
         max: Vec3::ONE,
         resolution: [40, 40, 40],
+        storage: super::GridStorage::Uniform,
     }
 }
 

@@ -22,7 +22,7 @@ pub struct SortedPhotonMap {
     pub position: Texture,
     pub power: Texture,
     pub incoming: Texture,
-    /// First sorted index of each cell, and one entry past the last cell.
+    /// First sorted index of each slot (cell, or hash bucket), and one entry past the last.
     pub grid_first: Texture,
     pub grid_width: u32,
     pub grid: Grid,
@@ -145,7 +145,7 @@ impl BitonicBuild {
         Ok((if current == 0 { a } else { b }, passes))
     }
 
-    /// For each cell 0..=cells, the lower bound of the cell in the sorted pairs.
+    /// For each slot 0..=slots (cells, or hash buckets), its lower bound in the sorted pairs.
     pub fn binary_search(&self, sorted: &Texture, cells: u32) -> Result<(Texture, u32)> {
         let entries = cells as u64 + 1;
         let grid_width = (entries as f64).sqrt().ceil() as u32;
@@ -242,7 +242,7 @@ impl BitonicBuild {
         let (sorted, passes) = self.sort(pairs)?;
         clock.stop(timings, "bitonic sort", passes as usize);
         let clock = StageClock::start(&self.gpu, &query);
-        let (grid_first, grid_width) = self.binary_search(&sorted, grid.cell_count())?;
+        let (grid_first, grid_width) = self.binary_search(&sorted, grid.slot_count())?;
         clock.stop(timings, "binary search", 1);
 
         let t = || Texture::new(&self.gpu, w, h, TexFormat::Rgba32F);

@@ -10,8 +10,8 @@ use crate::timing::Timings;
 
 use super::trace::{TraceConfig, TraceReport};
 use super::{
-    fit, BitonicBuild, BuildMethod, Grid, PhotonMap, PhotonTracer, RandomSource, StencilRouting,
-    VertexFeed,
+    fit, BitonicBuild, BuildMethod, Grid, GridKind, GridStorage, PhotonMap, PhotonTracer,
+    RandomSource, StencilRouting, VertexFeed,
 };
 
 /// How photons are traced and the map built (what the scene file does not fix).
@@ -28,6 +28,10 @@ pub struct PhotonConfig {
     pub all_bounces: bool,
     /// Aim photons by projection maps when the scene stores caustics only.
     pub projection_maps: bool,
+    /// Uniform grid, or a hash table of cells (section 4.4).
+    pub grid: GridKind,
+    /// Hash buckets (None: the next power of two >= the photons stored).
+    pub hash_buckets: Option<u32>,
 }
 
 impl Default for PhotonConfig {
@@ -39,6 +43,8 @@ impl Default for PhotonConfig {
             faithful: false,
             all_bounces: false,
             projection_maps: true,
+            grid: GridKind::Uniform,
+            hash_buckets: None,
         }
     }
 }
@@ -57,6 +63,18 @@ impl PhotonConfig {
         }
     }
 
+    /// How the grid stores its cells for a scene storing `photons_stored`.
+    pub fn storage(&self, photons_stored: u32) -> GridStorage {
+        match self.grid {
+            GridKind::Uniform => GridStorage::Uniform,
+            GridKind::Hash => GridStorage::Hashed {
+                buckets: self
+                    .hash_buckets
+                    .unwrap_or_else(|| default_hash_buckets(photons_stored)),
+            },
+        }
+    }
+
     /// How records reach stencil routing: `--faithful` reads them back.
     pub fn feed(&self) -> VertexFeed {
         if self.faithful {
@@ -64,6 +82,37 @@ impl PhotonConfig {
         } else {
             self.feed
         }
+    }
+}
+
+/// The most hash buckets (`--hash-buckets`): the photons a map may store.
+pub const MAX_HASH_BUCKETS: u32 = crate::scene::defaults::MAX_PHOTONS_STORED as u32;
+
+/// `--hash-buckets`' default: the next power of two >= the photons stored
+/// (a load factor of at most 1).
+pub fn default_hash_buckets(photons_stored: u32) -> u32 {
+    super::next_power_of_two(photons_stored as u64).min(MAX_HASH_BUCKETS as u64) as u32
+}
+
+/// Refuses a grid its storage cannot hold: a uniform grid of more than
+/// MAX_UNIFORM_GRID_CELLS, a hash table of 0 or more than MAX_HASH_BUCKETS buckets.
+pub fn check_storage(grid: &Grid) -> Result<()> {
+    use crate::error::Error;
+    use crate::scene::defaults::MAX_UNIFORM_GRID_CELLS;
+    let [x, y, z] = grid.resolution;
+    match grid.storage {
+        GridStorage::Uniform if grid.cells_u64() > MAX_UNIFORM_GRID_CELLS => {
+            Err(Error::InvalidOption(format!(
+                "a uniform grid of {x} x {y} x {z} = {} cells: a uniform grid stores at most {MAX_UNIFORM_GRID_CELLS} cells (512^3), one texel each; use --grid hash, whose memory follows the photons, not the cells",
+                grid.cells_u64()
+            )))
+        }
+        GridStorage::Hashed { buckets } if !(1..=MAX_HASH_BUCKETS).contains(&buckets) => {
+            Err(Error::InvalidOption(format!(
+                "{buckets} hash buckets: the allowed range is 1..={MAX_HASH_BUCKETS}"
+            )))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -107,7 +156,9 @@ pub fn build_map(
         frames.frames as usize,
     );
     // The scene's grid bounds, or (when it fixes none) the box of the photons.
-    let grid = fit::grid_for(gpu, scene, &frames)?;
+    let grid = fit::grid_for(gpu, scene, &frames)?
+        .with_storage(config.storage(scene.photon_map.photons_stored));
+    check_storage(&grid)?;
     let mut build_stages = Timings::default();
     let t0 = std::time::Instant::now();
     let map = match config.build {

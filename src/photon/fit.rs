@@ -4,6 +4,8 @@
 
 use glam::Vec3;
 
+use crate::scene::defaults::MAX_GRID_SIDE;
+
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 
 use super::{Grid, PhotonFrames};
@@ -90,6 +92,7 @@ pub fn fitted_grid(
         min: lo,
         max: hi,
         resolution: std::array::from_fn(|a| shaped[a].min(cap(a))),
+        storage: super::GridStorage::Uniform,
     }
 }
 
@@ -119,7 +122,7 @@ pub fn shaped_resolution(extent: Vec3, cells: f64) -> [u32; 3] {
     }
     std::array::from_fn(|a| {
         if active[a] && side > 0.0 {
-            ((e[a] / side).round() as u32).clamp(1, 512)
+            ((e[a] / side).round() as u32).clamp(1, MAX_GRID_SIDE as u32)
         } else {
             1
         }

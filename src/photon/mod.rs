@@ -16,17 +16,50 @@ use crate::gpu::Bindings;
 use crate::scene::Scene;
 
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
-pub use build::{build_map, BuiltMap, PhotonConfig};
+pub use build::{build_map, check_storage, BuiltMap, PhotonConfig};
 pub use projection::ProjectionMaps;
-pub use stencil_routing::{RoutedPhotonMap, StencilRouting, VertexFeed};
+pub use stencil_routing::{LostPower, RoutedPhotonMap, StencilRouting, VertexFeed};
 pub use trace::{PhotonBatch, PhotonFrames, PhotonTracer, RandomSource, TraceConfig, TraceReport};
 
-/// The uniform grid photons are sorted or routed into.
+/// The grid photons are sorted or routed into.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     pub min: Vec3,
     pub max: Vec3,
     pub resolution: [u32; 3],
+    /// Where the photons of a cell are kept: in the cell's own slot, or in a
+    /// hash table's bucket (section 4.4).
+    pub storage: GridStorage,
+}
+
+/// How a grid stores its cells (`--grid`, `--hash-buckets`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GridStorage {
+    /// One slot per cell (cells + 1 first indices, or a block per cell):
+    /// every empty cell costs its slot.
+    Uniform,
+    /// Section 4.4: photons kept in `buckets` hash buckets by their cell's
+    /// address (`cell_slot`); a search rejects bucket-mates of other cells.
+    Hashed { buckets: u32 },
+}
+
+/// The `--grid` choice, before the bucket count is known.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GridKind {
+    /// One slot per cell (the paper's uniform grid).
+    #[default]
+    Uniform,
+    /// A hash table of buckets keyed by the cell's address (section 4.4).
+    Hash,
+}
+
+/// The bucket of `cell` in a table of `buckets`: the PCG hash of the cell's
+/// index, modulo the bucket count. grid_slot in glsl/common/grid.glsl is the
+/// same arithmetic (uint, wrapping).
+pub fn hash_bucket(cell: u32, buckets: u32) -> u32 {
+    crate::random::pcg_hash(cell) % buckets
 }
 
 impl Grid {
@@ -42,7 +75,40 @@ impl Grid {
             min,
             max,
             resolution: scene.photon_map.grid_resolution,
+            storage: GridStorage::Uniform,
         }
+    }
+
+    /// The same cells stored as `storage` says.
+    pub fn with_storage(self, storage: GridStorage) -> Self {
+        Self { storage, ..self }
+    }
+
+    /// Hash buckets, or None for a uniform grid.
+    pub fn buckets(&self) -> Option<u32> {
+        match self.storage {
+            GridStorage::Uniform => None,
+            GridStorage::Hashed { buckets } => Some(buckets),
+        }
+    }
+
+    /// Slots the map keeps: one per cell, or one per bucket. The sorted map's
+    /// first-index texture has slots + 1 entries; stencil routing a block per slot.
+    pub fn slot_count(&self) -> u32 {
+        self.buckets().unwrap_or_else(|| self.cell_count())
+    }
+
+    /// The slot holding `cell`'s photons: the cell itself, or its bucket.
+    pub fn slot_of_cell(&self, cell: u32) -> u32 {
+        match self.storage {
+            GridStorage::Uniform => cell,
+            GridStorage::Hashed { buckets } => hash_bucket(cell, buckets),
+        }
+    }
+
+    /// The slot of point p (None outside the grid): the sort key of grid.glsl's grid_key.
+    pub fn slot_of(&self, p: Vec3) -> Option<u32> {
+        self.cell_of(p).map(|c| self.slot_of_cell(c))
     }
 
     /// A grid over the whole scene (its box padded by a thousandth of its
@@ -63,6 +129,7 @@ impl Grid {
                     min,
                     max,
                     resolution,
+                    storage: GridStorage::Uniform,
                 };
             }
             cell *= 1.25;
@@ -71,6 +138,12 @@ impl Grid {
 
     pub fn cell_count(&self) -> u32 {
         self.resolution.iter().product()
+    }
+
+    /// Cells as u64 (a grid of 1024^3 cells still fits u32; the product of
+    /// three unchecked sides might not).
+    pub fn cells_u64(&self) -> u64 {
+        self.resolution.iter().map(|&r| r as u64).product()
     }
 
     /// The cell of p, or None outside the closed bounds: the arithmetic of
@@ -94,7 +167,8 @@ impl Grid {
         let r = self.resolution.map(|v| v as i32);
         b.vec3("u_grid_min", self.min.to_array())
             .vec3("u_grid_max", self.max.to_array())
-            .ivec3("u_grid_resolution", r);
+            .ivec3("u_grid_resolution", r)
+            .int("u_hash_buckets", self.buckets().unwrap_or(0) as i32);
     }
 }
 
@@ -130,10 +204,25 @@ impl PhotonMap {
         }
     }
 
-    /// Photons destined to each cell (read back): the sorted map's cell
-    /// ranges, or stencil routing's exact counts (which may exceed m^2).
+    /// Texels of the grid's own structure: the sorted map's first-index
+    /// texture (slots + 1 entries, as laid out), or stencil routing's
+    /// routing buffer plus its count textures (the memory §4.4 is about).
+    pub fn grid_texels(&self) -> u64 {
+        match self {
+            PhotonMap::Sorted(m) => m.grid_first.texel_count() as u64,
+            PhotonMap::Routed(m) => {
+                (m.position.texel_count()
+                    + m.counts.texel_count()
+                    + m.cell_counts.as_ref().map_or(0, |c| c.texel_count())) as u64
+            }
+        }
+    }
+
+    /// Photons destined to each slot (read back): the sorted map's slot
+    /// ranges, or stencil routing's exact counts (which may exceed m^2). A
+    /// slot is a cell of a uniform grid, or a bucket of a hashed one.
     pub fn photons_per_cell(&self) -> Vec<u32> {
-        let cells = self.grid().cell_count() as usize;
+        let cells = self.grid().slot_count() as usize;
         match self {
             PhotonMap::Sorted(m) => {
                 let first: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();

@@ -10,6 +10,15 @@
 //! - the stencil cannot count past 255 destined photons, so a separate pass
 //!   counts photons per cell with additive blending into a float texture, and
 //!   the power of stored photons is scaled by destined / stored from that count.
+//!
+//! A hashed grid (section 4.4) routes by bucket: a block is a bucket's, shared
+//! by the cells that hash to it. A second count pass (`count cells`) adds each
+//! photon, kept or not, at the slot of the first photon its bucket kept of the
+//! photon's own cell, so that slot holds the cell's destined count; the
+//! redistribution scales each kept photon by destined / kept of its own cell
+//! and keeps that factor in power .w. A cell whose bucket filled before any of
+//! its photons arrived has no slot to carry its power: that power is lost, and
+//! counted (`LostPower`; README, "The hash grid").
 
 use crate::error::Error;
 use crate::gpu::{
@@ -18,7 +27,7 @@ use crate::gpu::{
 };
 use crate::timing::Timings;
 
-use super::{Grid, PhotonFrames, StageClock};
+use super::{Grid, GridStorage, PhotonFrames, StageClock};
 
 /// How photon records reach the vertex stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -38,13 +47,50 @@ pub struct RoutedPhotonMap {
     /// Power after redistribution (and the emitted-count scale).
     pub power: Texture,
     pub incoming: Texture,
-    /// Photons destined to each cell (x), exact.
+    /// Photons destined to each slot (cell, or hash bucket) (x), exact.
     pub counts: Texture,
+    /// Hashed grids: photons (x) and raw power (yzw) destined to each cell,
+    /// at the texel of the cell's first kept photon (routing buffer's size).
+    pub cell_counts: Option<Texture>,
+    /// Hashed grids: what the full buckets could not represent.
+    pub lost: Option<LostPower>,
     pub count_width: u32,
     /// m: a cell's block is m x m slots.
     pub block: u32,
     pub blocks_per_row: u32,
     pub grid: Grid,
+}
+
+/// Photons of cells that got no slot in their (full) bucket, whose power no
+/// kept photon can carry; power scaled like the map's (per emitted photon).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LostPower {
+    pub photons: u64,
+    pub power: [f32; 3],
+    /// Power of every photon routed (lost or not), for the fraction.
+    pub routed_power: [f32; 3],
+}
+
+impl LostPower {
+    /// The same with power scaled (raw power to the map's).
+    pub fn scaled(self, s: f32) -> Self {
+        Self {
+            power: self.power.map(|c| c * s),
+            routed_power: self.routed_power.map(|c| c * s),
+            ..self
+        }
+    }
+
+    /// Lost power over routed power, summed over the channels (0 if none routed).
+    pub fn fraction(&self) -> f64 {
+        let sum = |v: [f32; 3]| v.iter().map(|&c| c as f64).sum::<f64>();
+        let total = sum(self.routed_power);
+        if total > 0.0 {
+            sum(self.power) / total
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Blocks per row and the routing buffer's size for `cells` cells of m x m.
@@ -54,7 +100,7 @@ pub fn routing_layout(cells: u32, block: u32, max_size: u32) -> Result<(u32, u32
     let (w, h) = (per_row as u64 * block as u64, rows as u64 * block as u64);
     if w > max_size as u64 || h > max_size as u64 {
         return Err(Error::TooLarge(format!(
-            "stencil routing of {cells} cells of {block} x {block} slots needs a {w} x {h} buffer; this driver allows {max_size} a side: use a smaller m or fewer grid cells"
+            "stencil routing of {cells} cells of {block} x {block} slots needs a {w} x {h} buffer; this driver allows {max_size} a side: use a smaller m, fewer grid cells, or --grid hash (a block per bucket)"
         )));
     }
     Ok((per_row, w as u32, h as u32))
@@ -68,6 +114,9 @@ pub struct StencilRouting {
     count_fetch: Program,
     count_readback: Program,
     redistribute: Program,
+    count_cells_fetch: Program,
+    count_cells_readback: Program,
+    redistribute_hashed: Program,
 }
 
 impl StencilRouting {
@@ -81,6 +130,23 @@ impl StencilRouting {
             count_fetch: Program::new(gpu, "photon/route.vert", "photon/count.frag", &[])?,
             count_readback: Program::new(gpu, "photon/route.vert", "photon/count.frag", &readback)?,
             redistribute: Program::fullscreen(gpu, "photon/redistribute.frag")?,
+            count_cells_fetch: Program::new(
+                gpu,
+                "photon/route.vert",
+                "photon/count_cell.frag",
+                &[("CELL_COUNT", "1".into())],
+            )?,
+            count_cells_readback: Program::new(
+                gpu,
+                "photon/route.vert",
+                "photon/count_cell.frag",
+                &[("CELL_COUNT", "1".into()), ("READBACK", "1".into())],
+            )?,
+            redistribute_hashed: Program::fullscreen_with(
+                gpu,
+                "photon/redistribute.frag",
+                &[("HASHED", "1".into())],
+            )?,
         })
     }
 
@@ -128,7 +194,7 @@ impl StencilRouting {
         if !(1..=16).contains(&block) {
             return Err(Error::InvalidOption(format!("stencil routing block m = {block}: the allowed range is 1..=16 (m^2 slots must fit 8 stencil bits)")));
         }
-        let cells = grid.cell_count();
+        let cells = grid.slot_count();
         let (per_row, width, height) = routing_layout(cells, block, self.gpu.max_texture_size())?;
         let t = |w, h| Texture::new(&self.gpu, w, h, TexFormat::Rgba32F);
         let (position, raw_power, incoming) =
@@ -191,12 +257,21 @@ impl StencilRouting {
         draw.points(program, &count_target, &DrawState::ADDITIVE, count_width, 1)?;
         clock.stop(timings, "count", 1);
 
+        let (cell_counts, lost) = match grid.storage {
+            GridStorage::Uniform => (None, None),
+            GridStorage::Hashed { .. } => {
+                let clock = StageClock::start(&self.gpu, &query);
+                let (c, lost) = self.count_cells(&draw, &position, (per_row, block))?;
+                clock.stop(timings, "count cells", 2);
+                (Some(c), Some(lost))
+            }
+        };
+
         // Redistribute power: destined / stored per cell.
         let power = t(width, height)?;
         let power_target = Target::new(&self.gpu, &[&power])?;
         let clock = StageClock::start(&self.gpu, &query);
-        self.redistribute
-            .bind()
+        self.bind_redistribute(grid, cell_counts.as_ref())
             .texture("u_routed_position", &position)
             .texture("u_routed_power", &raw_power)
             .texture("u_counts", &counts)
@@ -212,12 +287,66 @@ impl StencilRouting {
             power,
             incoming,
             counts,
+            cell_counts,
+            lost: lost.map(|l: LostPower| l.scaled(frames.power_scale)),
             count_width,
             block,
             blocks_per_row: per_row,
             grid: *grid,
         };
         Ok((map, stencil))
+    }
+
+    /// The redistribution's program, bound with what only a hashed grid reads.
+    fn bind_redistribute<'a>(
+        &'a self,
+        grid: &Grid,
+        cell_counts: Option<&'a Texture>,
+    ) -> crate::gpu::Bindings<'a> {
+        match cell_counts {
+            Some(c) => {
+                let mut b = self.redistribute_hashed.bind();
+                grid.bind(&mut b);
+                b.texture("u_cell_counts", c);
+                b
+            }
+            None => self.redistribute.bind(),
+        }
+    }
+
+    /// Hashed grids: each cell's destined count and power at its first kept
+    /// photon's slot, and the split of lost and kept photons (raw power).
+    fn count_cells(
+        &self,
+        draw: &Draw<'_>,
+        routed: &Texture,
+        (per_row, block): (u32, u32),
+    ) -> Result<(Texture, LostPower)> {
+        let (w, h) = (routed.width, routed.height);
+        let counts = Texture::new(&self.gpu, w, h, TexFormat::Rgba32F)?;
+        let split = Texture::new(&self.gpu, 2, 1, TexFormat::Rgba32F)?;
+        let program = match draw.vertices {
+            Some(_) => &self.count_cells_readback,
+            None => &self.count_cells_fetch,
+        };
+        for (target_texture, split_flag) in [(&counts, 0), (&split, 1)] {
+            let target = Target::new(&self.gpu, &[target_texture])?;
+            target.clear([0.0; 4]);
+            draw.points_with(program, &target, &DrawState::ADDITIVE, 1, 1, &|b| {
+                b.texture("u_routed_position", routed)
+                    .int("u_route_block", block as i32)
+                    .int("u_route_per_row", per_row as i32)
+                    .int("u_split", split_flag);
+            })?;
+        }
+        let s = split.read_f32();
+        let rgb = |t: usize| [s[4 * t + 1], s[4 * t + 2], s[4 * t + 3]];
+        let lost = LostPower {
+            photons: s[0] as u64,
+            power: rgb(0),
+            routed_power: std::array::from_fn(|c| rgb(0)[c] + rgb(1)[c]),
+        };
+        Ok((counts, lost))
     }
 
     /// The paper's read-back: photon records to the CPU, back as vertices.
@@ -257,8 +386,22 @@ impl Draw<'_> {
         per_row: u32,
         m: u32,
     ) -> Result<()> {
+        self.points_with(program, target, state, per_row, m, &|_| {})
+    }
+
+    /// The same, with more uniforms bound by `extra`.
+    fn points_with(
+        &self,
+        program: &Program,
+        target: &Target,
+        state: &DrawState,
+        per_row: u32,
+        m: u32,
+        extra: &dyn Fn(&mut crate::gpu::Bindings<'_>),
+    ) -> Result<()> {
         let f = self.frames;
         let mut b = program.bind();
+        extra(&mut b);
         self.grid.bind(&mut b);
         b.int("u_record_width", f.width as i32)
             .int("u_frame_height", f.frame_height as i32)

@@ -67,8 +67,8 @@ pub fn knn_grid_filtered(
                     if xi < 0 || xi >= res[0] {
                         continue;
                     }
-                    let cell = (xi + res[0] * (y + res[1] * z)) as usize;
-                    for (p, power) in &map.cells[cell] {
+                    let cell = (xi + res[0] * (y + res[1] * z)) as u32;
+                    for (_, _, (p, power)) in map.cell_photons(cell) {
                         let o = *p - x;
                         let d2 = o.dot(o);
                         if d2 <= max_r2 && (accepted < k || d2 <= r2) && accept(*p) {

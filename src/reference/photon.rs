@@ -307,3 +307,56 @@ pub fn route(cells: &[Option<u32>], cell_count: u32, block: u32) -> (Vec<Vec<usi
     }
     (stored, destined)
 }
+
+/// Stencil routing into a hashed grid (section 4.4) in draw order, with the
+/// exact redistribution of glsl/photon/count_cell.frag and redistribute.frag.
+#[derive(Clone, Debug, Default)]
+pub struct HashedRoute {
+    /// Per bucket: the records kept, in slot order (slot m^2-1 first).
+    pub stored: Vec<Vec<usize>>,
+    /// Per bucket: how many records were destined to it.
+    pub destined: Vec<u32>,
+    /// Per record: destined / kept of its own cell (0 where not kept).
+    pub scale: Vec<f32>,
+    /// Records of cells that their bucket kept none of: their power is lost.
+    pub lost: Vec<usize>,
+}
+
+/// `cells[i]`: record i's cell (None: not drawn); buckets by `bucket_of`.
+pub fn route_hashed(
+    cells: &[Option<u32>],
+    buckets: u32,
+    block: u32,
+    bucket_of: &dyn Fn(u32) -> u32,
+) -> HashedRoute {
+    use std::collections::HashMap;
+    let slots = (block * block) as usize;
+    let mut r = HashedRoute {
+        stored: vec![Vec::new(); buckets as usize],
+        destined: vec![0; buckets as usize],
+        scale: vec![0.0; cells.len()],
+        lost: Vec::new(),
+    };
+    let (mut destined, mut kept) = (HashMap::new(), HashMap::new());
+    for (record, cell) in cells.iter().enumerate() {
+        if let Some(c) = *cell {
+            let b = bucket_of(c) as usize;
+            r.destined[b] += 1;
+            *destined.entry(c).or_insert(0u32) += 1;
+            if r.stored[b].len() < slots {
+                r.stored[b].push(record);
+                *kept.entry(c).or_insert(0u32) += 1;
+            }
+        }
+    }
+    for kept_records in &r.stored {
+        for &record in kept_records {
+            let c = cells[record].unwrap_or_default();
+            r.scale[record] = destined[&c] as f32 / kept[&c] as f32;
+        }
+    }
+    r.lost = (0..cells.len())
+        .filter(|&i| cells[i].is_some_and(|c| !kept.contains_key(&c)))
+        .collect();
+    r
+}

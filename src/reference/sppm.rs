@@ -56,17 +56,17 @@ pub fn gather(
     for cz in lo.z..=hi.z {
         for cy in lo.y..=hi.y {
             for cx in lo.x..=hi.x {
-                let cell = (cx + res.x * (cy + res.y * cz)) as usize;
-                for (k, (p, w)) in map.cells[cell].iter().enumerate() {
+                let cell = (cx + res.x * (cy + res.y * cz)) as u32;
+                for (slot, k, (p, w)) in map.cell_photons(cell) {
                     let offset = *p - x;
                     if offset.dot(offset) >= radius2 {
                         continue;
                     }
-                    if map.incoming[cell][k].dot(normal) >= 0.0 || !accept(*p) {
+                    if map.incoming[slot][k].dot(normal) >= 0.0 || !accept(*p) {
                         continue;
                     }
                     power += *w;
-                    m += map.weights[cell];
+                    m += map.weights[slot][k];
                 }
             }
         }

@@ -12,13 +12,14 @@ use super::{Image, RenderState};
 /// A photon map read back from the GPU: per cell, its photons in the GPU's order.
 pub struct CpuPhotonMap {
     pub grid: Grid,
-    /// Per cell: (position, power) of each photon.
+    /// Per slot (a cell, or a hash bucket: `Grid::slot_of_cell`):
+    /// (position, power) of each photon, in the GPU's order.
     pub cells: Vec<Vec<(Vec3, Vec3)>>,
-    /// Per cell: each photon's direction of arrival, in the same order.
+    /// Per slot: each photon's direction of arrival, in the same order.
     pub incoming: Vec<Vec<Vec3>>,
-    /// Per cell: how many photons each stored one stands for (1 in the sorted
-    /// map; destined / kept in stencil routing).
-    pub weights: Vec<f32>,
+    /// Per slot: how many photons each stored one stands for (1 in the sorted
+    /// map; destined / kept of its cell in stencil routing).
+    pub weights: Vec<Vec<f32>>,
 }
 
 impl CpuPhotonMap {
@@ -26,17 +27,17 @@ impl CpuPhotonMap {
         let (pos, pow, inc, texels, weights) = match map {
             PhotonMap::Sorted(m) => {
                 let first: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
-                let texels: Vec<Vec<usize>> = (0..m.grid.cell_count() as usize)
+                let texels: Vec<Vec<usize>> = (0..m.grid.slot_count() as usize)
                     .map(|c| (first[c]..first[c + 1]).map(|i| i as usize).collect())
                     .collect();
-                let weights = vec![1.0; texels.len()];
+                let weights = texels.iter().map(|t| vec![1.0; t.len()]).collect();
                 (&m.position, &m.power, &m.incoming, texels, weights)
             }
             PhotonMap::Routed(m) => {
                 let counts = m.counts.read_f32();
                 let (b, w) = (m.block as usize, m.position.width as usize);
-                let cells = m.grid.cell_count() as usize;
-                let texels = (0..cells)
+                let cells = m.grid.slot_count() as usize;
+                let texels: Vec<Vec<usize>> = (0..cells)
                     .map(|c| {
                         let n = (counts[4 * c] as usize).min(b * b);
                         let (bx, by) =
@@ -49,10 +50,14 @@ impl CpuPhotonMap {
                             .collect()
                     })
                     .collect();
+                // Hashed: each photon's own factor (power .w); else the cell's.
+                let power = m.grid.buckets().map(|_| m.power.read_f32());
                 let weights = (0..cells)
                     .map(|c| {
                         let destined = counts[4 * c];
-                        destined / destined.min((b * b) as f32).max(1.0)
+                        let cell = destined / destined.min((b * b) as f32).max(1.0);
+                        let w = |&i: &usize| power.as_ref().map_or(cell, |p| p[4 * i + 3]);
+                        texels[c].iter().map(w).collect()
                     })
                     .collect();
                 (&m.position, &m.power, &m.incoming, texels, weights)
@@ -76,6 +81,19 @@ impl CpuPhotonMap {
 
     pub fn photons(&self) -> impl Iterator<Item = &(Vec3, Vec3)> {
         self.cells.iter().flatten()
+    }
+
+    /// The photons of `cell` as (slot, index in the slot, photon): a hash
+    /// bucket's photons of other cells are skipped (their cell recomputed
+    /// from the position, as glsl/common/photon_map.glsl does).
+    pub fn cell_photons(&self, cell: u32) -> impl Iterator<Item = (usize, usize, &(Vec3, Vec3))> {
+        let slot = self.grid.slot_of_cell(cell) as usize;
+        let hashed = self.grid.buckets().is_some();
+        self.cells[slot]
+            .iter()
+            .enumerate()
+            .filter(move |(_, (p, _))| !hashed || self.grid.cell_of(*p) == Some(cell))
+            .map(move |(k, photon)| (slot, k, photon))
     }
 }
 

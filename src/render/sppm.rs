@@ -96,13 +96,15 @@ pub struct SppmState {
 }
 
 enum Builder {
-    Bitonic(BitonicBuild),
-    Stencil(StencilRouting, u32),
+    Bitonic(Box<BitonicBuild>),
+    Stencil(Box<StencilRouting>, u32),
 }
 
 /// A progressive render in progress: call `iterate` as often as wanted.
 pub struct Sppm {
     gpu: Gpu,
+    /// Each iteration's grid storage (`--grid`): uniform, or hashed (§4.4).
+    storage: crate::photon::GridStorage,
     /// The scene as SPPM traces it (bounces, shadow rays, first-hit storage).
     scene: Scene,
     options: SppmOptions,
@@ -158,11 +160,12 @@ impl Sppm {
         )?;
         let batch = photons.batch(&scene, sppm.photons_per_iteration)?;
         let builder = match config.build {
-            BuildMethod::Bitonic => {
-                Builder::Bitonic(BitonicBuild::with_addressing(gpu, config.faithful)?)
-            }
+            BuildMethod::Bitonic => Builder::Bitonic(Box::new(BitonicBuild::with_addressing(
+                gpu,
+                config.faithful,
+            )?)),
             BuildMethod::Stencil => {
-                Builder::Stencil(StencilRouting::new(gpu)?, config.stencil_block)
+                Builder::Stencil(Box::new(StencilRouting::new(gpu)?), config.stencil_block)
             }
         };
         let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
@@ -188,6 +191,7 @@ impl Sppm {
             photons,
             batch,
             builder,
+            storage: config.storage(sppm.photons_per_iteration),
             state: SppmState {
                 flux,
                 sums,
@@ -262,7 +266,8 @@ impl Sppm {
             frames.frames as usize,
         );
         let wall = std::time::Instant::now();
-        let grid = Grid::over_scene(&self.scene, self.cell, self.max_cells());
+        let grid =
+            Grid::over_scene(&self.scene, self.cell, self.max_cells()).with_storage(self.storage);
         let mut stages = Timings::default();
         let map = match &self.builder {
             Builder::Bitonic(b) => PhotonMap::Sorted(b.build(frames, &grid, &mut stages)?),

@@ -51,8 +51,14 @@ pub const MAX_SHADOW_RAYS: i64 = 1024;
 pub const MAX_SPECULAR_DEPTH: i64 = 64;
 /// 2^24: float-addressed photon textures stay exact below it.
 pub const MAX_PHOTONS_STORED: i64 = 1 << 24;
-/// Each of `photon_map.grid_resolution`: 1..=MAX_GRID_SIDE.
-pub const MAX_GRID_SIDE: i64 = 512;
+/// Each of `photon_map.grid_resolution`: 1..=MAX_GRID_SIDE. 1024^3 = 2^30
+/// cells keeps a cell's index an int; a grid of more than
+/// MAX_UNIFORM_GRID_CELLS needs `--grid hash` (section 4.4).
+pub const MAX_GRID_SIDE: i64 = 1024;
+/// The most cells a uniform grid stores (512^3 = 2^27: its first-index
+/// texture is then 2 GiB of RGBA32I texels); more are refused with a
+/// pointer to `--grid hash`, whose memory follows the photons instead.
+pub const MAX_UNIFORM_GRID_CELLS: u64 = 1 << 27;
 /// `photon_map.k`: 1..=MAX_K.
 pub const MAX_K: i64 = 4096;
 /// `photon_map.max_bounces`: 1..=MAX_BOUNCES.
