@@ -1355,11 +1355,12 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
         .as_u64()
         .unwrap();
     assert!(0 < computed && computed < all, "{computed} of {all}");
-    let refused: [(&[&str], &str); 4] = [
+    let refused: [(&[&str], &str); 5] = [
         (
             &["--final-gather", "2", "--scene-name-ring"],
             "caustics_only",
         ),
+        (&["--adaptive", "--method", "sppm"], "--adaptive"),
         (
             &["--final-gather", "2", "--method", "sppm"],
             "--final-gather",

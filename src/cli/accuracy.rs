@@ -13,7 +13,7 @@ use serde::Serialize;
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
-use photonmap::photon::BuildMethod;
+use photonmap::photon::{BuildMethod, GridKind};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
 use photonmap::render::{render, AdaptiveOptions, EstimateMode, FinalGatherOptions, Image};
@@ -70,6 +70,8 @@ pub struct AccuracyRun {
     pub gather_rays: u32,
     /// Adaptive sampling of the global light (its default threshold).
     pub adaptive: bool,
+    /// The photon map's grid storage: uniform, or hashed (section 4.4).
+    pub grid: GridKind,
     /// Wall seconds of one render (mean over the seeds).
     pub seconds: f64,
     /// RMSE of one render against the reference (mean over the seeds).
@@ -124,6 +126,7 @@ impl Config {
                 sppm_iterations: 0,
                 gather_rays: 0,
                 adaptive: false,
+                grid: GridKind::Uniform,
                 seconds: 0.0,
                 rmse: 0.0,
                 bias_rmse: 0.0,
@@ -202,6 +205,7 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
         }));
     }
     out.push(base.with("adaptive".into(), |r| r.adaptive = true));
+    out.push(base.with("hash grid".into(), |r| r.grid = GridKind::Hash));
     out.push(base.with("4 spp, adaptive".into(), |r| {
         r.spp = 4;
         r.adaptive = true;
@@ -320,6 +324,7 @@ fn render_config(
     o.spp = c.spp;
     let gi = o.global.as_mut().expect("global illumination");
     gi.photons.build = c.build;
+    gi.photons.grid = c.grid;
     gi.estimate.leak = c.leak;
     gi.estimate.mode = if c.tile == 0 {
         EstimateMode::FullScreen
@@ -491,10 +496,10 @@ fn mark_front(runs: &mut [AccuracyRun]) {
 }
 
 pub fn csv(r: &AccuracyReport) -> String {
-    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,tile,spp,sppm_iterations,gather_rays,adaptive,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
+    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,grid,tile,spp,sppm_iterations,gather_rays,adaptive,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
     for x in &r.runs {
         s += &format!(
-            "{},{},{},{},{},{:?},{},{:?},{},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
+            "{},{},{},{},{},{:?},{},{:?},{:?},{},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
             x.label,
             x.method,
             x.photons_stored,
@@ -503,6 +508,7 @@ pub fn csv(r: &AccuracyReport) -> String {
             x.leak,
             x.shadow_rays,
             x.build,
+            x.grid,
             x.tile,
             x.spp,
             x.sppm_iterations,

@@ -349,8 +349,9 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         || args.reference_software.is_some()
         || args.spp > 1
         || args.final_gather.is_some()
+        || args.adaptive
     {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp and --final-gather");
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather and --adaptive (adaptive sampling is built for the one-shot estimate and final gather only)");
     }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
