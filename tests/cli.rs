@@ -1355,10 +1355,15 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
         .as_u64()
         .unwrap();
     assert!(0 < computed && computed < all, "{computed} of {all}");
-    let refused: [(&[&str], &str); 5] = [
+    let refused: [(&[&str], &str); 7] = [
         (
             &["--final-gather", "2", "--scene-name-ring"],
             "caustics_only",
+        ),
+        (&["--adaptive", "--snapshots", "."], "--snapshots"),
+        (
+            &["--final-gather", "2", "--reference-software", "r.png"],
+            "--reference-software",
         ),
         (&["--adaptive", "--method", "sppm"], "--adaptive"),
         (

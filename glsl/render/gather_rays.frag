@@ -7,7 +7,10 @@
 // first diffuse hit, which becomes a query of the global photon map. A ray that
 // leaves the scene or meets an emitter gathers nothing: direct light is the
 // shadow rays', and light reaching the pixel by specular paths alone is the
-// caustic map's. src/reference/final_gather.rs is the twin.
+// caustic map's. Rays are cosine-distributed about the geometric normal, as
+// the estimate's albedo / pi at the first hit assumes: on a mesh with vertex
+// normals the gathered light follows the photon estimate's convention, not
+// the shadow rays' shading-normal cosine. src/reference/final_gather.rs is the twin.
 #include "common/scene.glsl"
 #include "common/random.glsl"
 #include "common/sampling.glsl"

@@ -271,6 +271,14 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     if args.method == Method::Sppm {
         return run_sppm(args, platform);
     }
+    if args.final_gather.is_some() || args.adaptive {
+        // Snapshots show one estimate's running image, and the software
+        // reference one map's: neither is the image final gather or the
+        // pyramid composes.
+        if args.snapshots.is_some() || args.reference_software.is_some() {
+            bail!("--snapshots and --reference-software show the one-map estimate: drop them with --final-gather or --adaptive");
+        }
+    }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
     let scene = &loaded.scene;
@@ -472,13 +480,13 @@ fn print_summary(
         );
     }
     if let Some(g) = out.gathers.first() {
+        // Totals over every eye sample (and, adaptive, every level).
         let passes: u32 = out.gathers.iter().map(|g| g.estimate_passes).sum();
+        let batches: u32 = out.gathers.iter().map(|g| g.batches).sum();
+        let hits: u64 = out.gathers.iter().map(|g| g.queries).sum();
         eprintln!(
-            "final gather: {} rays a pixel in {} batch{} per eye sample, {} of them reached a diffuse surface; {passes} estimate passes",
+            "final gather: {} rays a pixel; {batches} batches, {hits} gather rays reached a diffuse surface, {passes} estimate passes in all",
             g.rays_per_pixel,
-            g.batches,
-            if g.batches == 1 { "" } else { "es" },
-            g.queries
         );
     }
     if !out.adaptive.is_empty() {

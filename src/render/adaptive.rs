@@ -62,6 +62,7 @@ const PLAN_COMPUTE: f32 = 1.0;
 const PLAN_INTERPOLATE: f32 = 2.0;
 
 pub struct Adaptive {
+    gpu: Gpu,
     /// The first hits computed at the current level, packed (texel i: the
     /// i-th such pixel, row by row), shaped like the direct-light pass's.
     pub packed: DirectLight,
@@ -87,6 +88,7 @@ impl Adaptive {
         let (plan, value) = (t()?, t()?);
         let index = || Texture::new(gpu, width, height, TexFormat::R32I);
         Ok(Self {
+            gpu: gpu.clone(),
             packed: DirectLight::new(gpu, width, height)?,
             order: index()?,
             slot: index()?,
@@ -168,7 +170,10 @@ impl Adaptive {
             .texture("u_gathered", gathered.unwrap_or(&self.plan))
             .int("u_has_estimate", estimate.is_some() as i32)
             .int("u_has_gather", gathered.is_some() as i32)
-            .draw_fullscreen(&self.value_target, &DrawState::PLAIN)
+            .draw_fullscreen(&self.value_target, &DrawState::PLAIN)?;
+        // Finished here, so that the caller's clock measures the pass.
+        self.gpu.finish();
+        Ok(())
     }
 
     /// The global light of every pixel (after the last level).

@@ -3,7 +3,7 @@
 
 use crate::scene::Scene;
 
-use super::{EstimateMode, RenderOptions, RenderOutput};
+use super::{adaptive, EstimateMode, RenderOptions, RenderOutput};
 
 /// One line of `--explain`: a stage's passes, run or skipped, and why.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -118,10 +118,10 @@ impl RenderOutput {
             let all: u64 = self.adaptive.iter().map(|s| s.pixels_with_hits).sum();
             lines.push(line(
                 "adaptive sampling",
-                4 * self.adaptive.len(),
+                3 * adaptive::STRIDES.len() * self.adaptive.len(),
                 true,
                 format!(
-                    "global light computed at {computed} of {all} pixels with a diffuse hit, interpolated at the rest (strides 8, 4, 2, 1; threshold {})",
+                    "global light computed at {computed} of {all} pixels with a diffuse hit, interpolated at the rest (strides 8, 4, 2, 1, each a plan, pack and store pass; threshold {}); each level's estimate above runs on its packed pixels",
                     a.threshold
                 ),
             ));

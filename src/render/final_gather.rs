@@ -174,8 +174,8 @@ impl FinalGather {
 
     /// All gather rays of one eye sample from the first hits `first` (all of
     /// them, or the pixels adaptive sampling computes): the indirect light of
-    /// each, left in `indirect`. Adds the stages "gather rays" and "gather
-    /// estimate" to `timings`.
+    /// each, left in `indirect`. Adds the stages "gather rays", "gather
+    /// estimate" and "gather sum" to `timings`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
@@ -196,15 +196,24 @@ impl FinalGather {
             rays_per_pixel: options.rays,
             ..Default::default()
         };
+        let timer = crate::gpu::Query::timer(&self.gpu)?;
         let mut done = 0;
         while done < options.rays {
             crate::interrupt::check()?;
             let rays = self.batch.min(options.rays - done);
             self.gpu.finish();
             let t0 = std::time::Instant::now();
-            self.trace_batch(scene, first, done..done + rays, max_depth, seed)?;
+            timer.begin();
+            let traced = self.trace_batch(scene, first, done..done + rays, max_depth, seed);
+            timer.end();
+            traced?;
             self.gpu.finish();
-            timings.add_both("gather rays", 0.0, t0.elapsed().as_secs_f64(), 1);
+            timings.add_both(
+                "gather rays",
+                timer.seconds(),
+                t0.elapsed().as_secs_f64(),
+                1,
+            );
             let run = self.estimate.run(
                 scene,
                 global,
@@ -221,9 +230,13 @@ impl FinalGather {
                 run.passes as usize,
             );
             let t0 = std::time::Instant::now();
-            self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays)?;
+            timer.begin();
+            let added =
+                self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays);
+            timer.end();
+            added?;
             self.gpu.finish();
-            timings.add_both("gather rays", 0.0, t0.elapsed().as_secs_f64(), 1);
+            timings.add_both("gather sum", timer.seconds(), t0.elapsed().as_secs_f64(), 1);
             stats.batches += 1;
             stats.queries += run.query_pixels;
             stats.estimate_passes += run.passes;

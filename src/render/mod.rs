@@ -333,7 +333,9 @@ impl GlobalPart {
         pyramid.clear();
         let mut stats = AdaptiveStats::default();
         for level in 0..adaptive::STRIDES.len() {
+            let t0 = std::time::Instant::now();
             let (computed, interpolated) = pyramid.select(f.direct, level, &options)?;
+            timings.add_both("adaptive plan", 0.0, t0.elapsed().as_secs_f64(), 2);
             if computed > 0 {
                 // The estimate and gather run on the packed first hits.
                 let packed = SampleFrame {
@@ -343,6 +345,7 @@ impl GlobalPart {
                 let queries = pyramid.queries();
                 self.global_light(&packed, gi, queries, false, timings, observer)?;
             }
+            let t0 = std::time::Instant::now();
             pyramid.store(
                 self.estimate
                     .as_ref()
@@ -350,6 +353,7 @@ impl GlobalPart {
                     .map(|e| &e.image),
                 self.gather.as_ref().map(|g| &g.indirect),
             )?;
+            timings.add_both("adaptive plan", 0.0, t0.elapsed().as_secs_f64(), 1);
             stats.computed += computed;
             stats.interpolated += interpolated;
             stats
