@@ -327,7 +327,8 @@ impl GlobalPart {
         };
         // Taken for the levels and put back: global_light borrows self.
         let Some(pyramid) = self.pyramid.take() else {
-            return self.global_light(f, gi, f.direct.queries(), true, timings, observer);
+            let image = self.global_light(f, gi, f.direct.queries(), false, timings, observer)?;
+            return Ok(image.expect("an unpacked run composes its image"));
         };
         let options = gi.adaptive.clone().unwrap_or_default();
         pyramid.clear();
@@ -343,7 +344,7 @@ impl GlobalPart {
                     ..*f
                 };
                 let queries = pyramid.queries();
-                self.global_light(&packed, gi, queries, false, timings, observer)?;
+                self.global_light(&packed, gi, queries, true, timings, observer)?;
             }
             let t0 = std::time::Instant::now();
             pyramid.store(
@@ -368,18 +369,20 @@ impl GlobalPart {
         Ok(image)
     }
 
-    /// The estimate and the gather at `queries`: the composed image (with
-    /// direct light, or without it), and the gather's indirect light in its
-    /// texture, also added to the image.
+    /// The estimate and the gather at `queries`. Their light is left in
+    /// their textures (the estimate's composed `image` without direct light
+    /// when `packed`, the gather's `indirect`); unpacked, it is also read back
+    /// as the sample's image with its direct light. Packed (adaptive
+    /// sampling's levels), nothing is read back.
     fn global_light(
         &mut self,
         f: &SampleFrame<'_>,
         gi: &GlobalIllumination,
         queries: QueryPoints<'_>,
-        include_direct: bool,
+        packed: bool,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
-    ) -> Result<Image> {
+    ) -> Result<Option<Image>> {
         let mut image = match (&self.built, &self.estimate) {
             (Some(built), Some(estimate)) => {
                 let run = EstimateRun {
@@ -387,7 +390,7 @@ impl GlobalPart {
                     textures: f.textures,
                     direct: f.direct,
                     queries,
-                    include_direct,
+                    packed,
                     map: &built.map,
                     estimate,
                     options: gi,
@@ -397,8 +400,8 @@ impl GlobalPart {
                 self.estimates.push(stats);
                 img
             }
-            _ if include_direct => f.direct.read_radiance(),
-            _ => Image::new(f.options.width, f.options.height),
+            _ if packed => None,
+            _ => Some(f.direct.read_radiance()),
         };
         if let (Some(global), Some(gather)) = (&self.global_map, &self.gather) {
             let run = GatherRun {
@@ -412,7 +415,9 @@ impl GlobalPart {
                 at: f.at,
             };
             self.gathers.push(run.gather(f.seed, timings, observer)?);
-            image.add(&gather.read_indirect());
+            if let Some(image) = &mut image {
+                image.add(&gather.read_indirect());
+            }
         }
         Ok(image)
     }
@@ -644,7 +649,10 @@ struct EstimateRun<'a> {
     textures: &'a SceneTextures,
     direct: &'a DirectLight,
     queries: QueryPoints<'a>,
-    include_direct: bool,
+    /// Adaptive sampling's packed queries: the estimate is composed without
+    /// direct light and left on the GPU, and the observer sees only progress
+    /// (a packed level is no image).
+    packed: bool,
     map: &'a PhotonMap,
     estimate: &'a RadianceEstimate,
     options: &'a GlobalIllumination,
@@ -652,27 +660,22 @@ struct EstimateRun<'a> {
 }
 
 impl EstimateRun<'_> {
-    /// Runs the estimate to the end and composes the image. The observer sees
-    /// every pass and the final state; its own time is not counted.
+    /// Runs the estimate to the end and composes the image (read back unless
+    /// packed). The observer sees every pass and the final state; its own
+    /// time is not counted.
     fn estimate(
         &self,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
-    ) -> Result<(Image, EstimateStats)> {
+    ) -> Result<(Option<Image>, EstimateStats)> {
         let (k, max_radius) = (self.scene.photon_map.k, self.scene.photon_map.max_radius);
         let options = EstimateOptions {
             float_addressing: self.options.photons.faithful,
             ..self.options.estimate.clone()
         };
         let compose = || {
-            self.estimate.compose(
-                self.textures,
-                self.direct,
-                k,
-                max_radius,
-                self.include_direct,
-                true,
-            )
+            self.estimate
+                .compose(self.textures, self.direct, k, max_radius, true, true)
         };
         let mut observed = 0.0;
         let mut failure = None;
@@ -691,6 +694,9 @@ impl EstimateRun<'_> {
                     r.query_pixels,
                     self.at,
                 ));
+                if self.packed {
+                    return;
+                }
                 let pass = EstimatePass {
                     at: self.at,
                     pass: r.pass,
@@ -716,6 +722,11 @@ impl EstimateRun<'_> {
             seconds,
             stats.passes as usize,
         );
+        if self.packed {
+            self.estimate
+                .draw_composed(self.textures, self.direct, k, max_radius, false, true)?;
+            return Ok((None, stats));
+        }
         let image = compose()?;
         observer.estimate_pass(&EstimatePass {
             at: self.at,
@@ -726,7 +737,7 @@ impl EstimateRun<'_> {
             finished: true,
             image: &|| Ok(image.clone()),
         })?;
-        Ok((image, stats))
+        Ok((Some(image), stats))
     }
 }
 

@@ -356,6 +356,32 @@ impl RadianceEstimate {
         include_direct: bool,
         include_indirect: bool,
     ) -> Result<Image> {
+        self.draw_composed(
+            scene,
+            direct,
+            k,
+            max_radius,
+            include_direct,
+            include_indirect,
+        )?;
+        Ok(Image::from_gl_rgba(
+            self.width,
+            self.height,
+            &self.image.read_f32(),
+        ))
+    }
+
+    /// The same image left in `image`, not read back (adaptive sampling's
+    /// packed levels read it on the GPU).
+    pub fn draw_composed(
+        &self,
+        scene: &SceneTextures,
+        direct: &DirectLight,
+        k: u32,
+        max_radius: f32,
+        include_direct: bool,
+        include_indirect: bool,
+    ) -> Result<()> {
         let mut b = self.compose.bind();
         scene.bind(&mut b);
         b.texture("u_direct", &direct.radiance)
@@ -367,12 +393,7 @@ impl RadianceEstimate {
             .float("u_max_radius", max_radius)
             .int("u_include_direct", include_direct as i32)
             .int("u_include_indirect", include_indirect as i32)
-            .draw_fullscreen(&self.image_target, &DrawState::PLAIN)?;
-        Ok(Image::from_gl_rgba(
-            self.width,
-            self.height,
-            &self.image.read_f32(),
-        ))
+            .draw_fullscreen(&self.image_target, &DrawState::PLAIN)
     }
 }
 
