@@ -33,17 +33,6 @@ fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -
     o
 }
 
-fn texels(t: &photonmap::gpu::Texture) -> Vec<[f32; 4]> {
-    t.read_f32()
-        .chunks(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect()
-}
-
-fn v3(t: [f32; 4]) -> Vec3 {
-    Vec3::new(t[0], t[1], t[2])
-}
-
 /// One batch holds all 8 rays of each pixel, so the gather textures hold
 /// every ray after the render: each is compared with the CPU's ray from the
 /// same first hit and random numbers, and each pixel's indirect light with the
@@ -65,15 +54,15 @@ fn final_gather_equals_its_cpu_twin() {
     let fg = out.state.gather.as_ref().unwrap();
     assert_eq!(fg.batch, rays, "one batch holds every ray");
     let map = CpuPhotonMap::from_gpu(out.state.gather_map.as_ref().unwrap());
-    let first = texels(&out.state.direct.diffuse_position);
-    let first_normal = texels(&out.state.direct.diffuse_normal);
-    let first_throughput = texels(&out.state.direct.diffuse_throughput);
+    let first = common::texels(&out.state.direct.diffuse_position);
+    let first_normal = common::texels(&out.state.direct.diffuse_normal);
+    let first_throughput = common::texels(&out.state.direct.diffuse_throughput);
     let (gp, gn, gt) = (
-        texels(&fg.position),
-        texels(&fg.normal),
-        texels(&fg.throughput),
+        common::texels(&fg.position),
+        common::texels(&fg.normal),
+        common::texels(&fg.throughput),
     );
-    let indirect = texels(&fg.indirect);
+    let indirect = common::texels(&fg.indirect);
     let max_depth = scene.render.max_specular_depth;
     let max_radius = scene.photon_map.max_radius;
     let (mut rays_checked, mut rays_apart, mut through_specular) = (0, 0, 0);
@@ -87,13 +76,13 @@ fn final_gather_equals_its_cpu_twin() {
             let mut sum = Vec3::ZERO;
             for j in 0..rays {
                 let g = i + (j * w * h) as usize;
-                let n1 = v3(first_normal[i]);
-                let cpu = gather_ray(&scene, v3(first[i]), n1, seed, [x, y], j, max_depth);
+                let n1 = common::v3(first_normal[i]);
+                let cpu = gather_ray(&scene, common::v3(first[i]), n1, seed, [x, y], j, max_depth);
                 let gpu_hit = (gp[g][3] > 0.0).then(|| GatherHit {
-                    position: v3(gp[g]),
-                    normal: v3(gn[g]),
+                    position: common::v3(gp[g]),
+                    normal: common::v3(gn[g]),
                     material: gn[g][3] as usize - 1,
-                    throughput: v3(gt[g]),
+                    throughput: common::v3(gt[g]),
                 });
                 rays_checked += 1;
                 let same = match (&cpu, &gpu_hit) {
@@ -119,8 +108,8 @@ fn final_gather_equals_its_cpu_twin() {
             else {
                 panic!("a first diffuse hit on a diffuse material");
             };
-            let expected = v3(first_throughput[i]) * albedo * sum / rays as f32;
-            let got = v3(indirect[i]);
+            let expected = common::v3(first_throughput[i]) * albedo * sum / rays as f32;
+            let got = common::v3(indirect[i]);
             pixels += 1;
             if (got - expected).abs().max_element() > 1e-4 + 1e-3 * expected.max_element() {
                 pixels_apart += 1;

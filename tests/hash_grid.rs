@@ -7,8 +7,8 @@ mod common;
 use glam::Vec3;
 use photonmap::error::Error;
 use photonmap::photon::{
-    hash_bucket, BuildMethod, Grid, GridKind, GridStorage, PhotonConfig, PhotonFrames, PhotonMap,
-    StencilRouting, VertexFeed,
+    hash_bucket, BuildMethod, Grid, GridKind, GridStorage, PhotonConfig, PhotonMap, StencilRouting,
+    VertexFeed,
 };
 use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
 use photonmap::reference::photon::route_hashed;
@@ -167,32 +167,6 @@ fn a_1024_cubed_grid_renders_hashed_and_is_refused_uniform() {
     assert!(out.image.pixels.iter().flatten().any(|&v| v > 0.0));
 }
 
-fn frames_from_points(gpu: &photonmap::gpu::Gpu, points: &[[f32; 3]]) -> PhotonFrames {
-    let width = 64u32;
-    let frame_height = (points.len() as u32).div_ceil(width);
-    let texels = (width * frame_height) as usize;
-    let (mut pos, mut pow, inc) = (
-        vec![0f32; texels * 4],
-        vec![0f32; texels * 4],
-        vec![0f32; texels * 4],
-    );
-    for (i, p) in points.iter().enumerate() {
-        pos[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], 0.0]);
-        pow[4 * i..4 * i + 4].copy_from_slice(&[1.0 + (i % 7) as f32, 2.0, 0.5, 1.0]);
-    }
-    PhotonFrames::from_records(
-        gpu,
-        width,
-        frame_height,
-        1,
-        &pos,
-        &pow,
-        &inc,
-        width * frame_height,
-    )
-    .unwrap()
-}
-
 #[test]
 fn hashed_stencil_routing_equals_its_twin_with_the_lost_power() {
     let gpu = common::gpu();
@@ -208,7 +182,7 @@ fn hashed_stencil_routing_equals_its_twin_with_the_lost_power() {
         .map(|_| std::array::from_fn(|_| (rng.next_u64() % 100_000) as f32 / 100_000.0))
         .collect();
     let raw = |i: usize| [1.0 + (i % 7) as f32, 2.0, 0.5];
-    let frames = frames_from_points(&gpu, &points);
+    let frames = common::frames_from_points(&gpu, &points, |i| [1.0 + (i % 7) as f32, 2.0, 0.5]);
     let cells: Vec<Option<u32>> = points
         .iter()
         .map(|p| grid.cell_of(Vec3::from(*p)))

@@ -8,7 +8,7 @@ use common::Rng;
 
 use photonmap::gpu::{Gpu, TexFormat, Texture};
 use photonmap::photon::bitonic::{pass_count, sort_texture_size, BitonicBuild, INVALID_KEY};
-use photonmap::photon::{Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
+use photonmap::photon::{Grid, GridStorage, StencilRouting, VertexFeed};
 use photonmap::reference::photon::route;
 use photonmap::render::Timings;
 
@@ -148,40 +148,8 @@ fn binary_search_equals_a_cpu_lower_bound_with_empty_cells() {
     }
 }
 
-/// Photon frames with one frame of `records` photons at the given points.
-fn frames_from_points(
-    gpu: &Gpu,
-    points: &[[f32; 3]],
-    power: impl Fn(usize) -> [f32; 3],
-) -> PhotonFrames {
-    let n = points.len() as u32;
-    let width = 64u32;
-    let frame_height = n.div_ceil(width);
-    let texels = (width * frame_height) as usize;
-    let mut pos = vec![0f32; texels * 4];
-    let mut pow = vec![0f32; texels * 4];
-    let mut inc = vec![0f32; texels * 4];
-    for (i, p) in points.iter().enumerate() {
-        pos[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], 0.0]);
-        let q = power(i);
-        pow[4 * i..4 * i + 4].copy_from_slice(&[q[0], q[1], q[2], 1.0]);
-        inc[4 * i..4 * i + 4].copy_from_slice(&[0.0, -1.0, 0.0, 1.0]);
-    }
-    PhotonFrames::from_records(
-        gpu,
-        width,
-        frame_height,
-        1,
-        &pos,
-        &pow,
-        &inc,
-        width * frame_height,
-    )
-    .unwrap()
-}
-
 fn check_routing(gpu: &Gpu, points: &[[f32; 3]], grid: &Grid, block: u32, feed: VertexFeed) {
-    let frames = frames_from_points(gpu, points, |i| [1.0 + (i % 7) as f32, 2.0, 0.5]);
+    let frames = common::frames_from_points(gpu, points, |i| [1.0 + (i % 7) as f32, 2.0, 0.5]);
     let routing = StencilRouting::new(gpu).unwrap();
     let map = routing
         .build(&frames, grid, block, feed, &mut Timings::default())
@@ -348,7 +316,7 @@ fn routed_power_equals_destined_power_when_photons_are_alike() {
             ]
         })
         .collect();
-    let frames = frames_from_points(&gpu, &points, |_| [0.25, 0.5, 1.0]);
+    let frames = common::frames_from_points(&gpu, &points, |_| [0.25, 0.5, 1.0]);
     for block in [4u32, 16] {
         let map = StencilRouting::new(&gpu)
             .unwrap()
@@ -387,7 +355,7 @@ fn the_stencil_pattern_and_saturation_are_as_the_paper_describes() {
     };
     for n in [10usize, 300] {
         let points: Vec<[f32; 3]> = (0..n).map(|i| [0.001 * i as f32, 0.5, 0.5]).collect();
-        let frames = frames_from_points(&gpu, &points, |_| [1.0; 3]);
+        let frames = common::frames_from_points(&gpu, &points, |_| [1.0; 3]);
         let routing = StencilRouting::new(&gpu).unwrap();
         let (stencil, _) = routing.build_for_stencil_test(&frames, &grid, 16).unwrap();
         for (s, &v) in stencil.iter().enumerate() {

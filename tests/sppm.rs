@@ -26,17 +26,6 @@ fn options(scene: &Scene, w: u32, h: u32, seed: u32, build: BuildMethod) -> Rend
     o
 }
 
-fn texels(t: &photonmap::gpu::Texture) -> Vec<[f32; 4]> {
-    t.read_f32()
-        .chunks(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect()
-}
-
-fn v3(t: [f32; 4]) -> Vec3 {
-    Vec3::new(t[0], t[1], t[2])
-}
-
 /// After one iteration, the next one's GPU update against the twin run on the
 /// same photons, visible points and state: counts agree exactly but where a
 /// photon sits on the radius to rounding, flux and radius to float precision.
@@ -59,17 +48,23 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
         let mut run = Sppm::new(&gpu, &scene, &o, &sppm_options).unwrap();
         let mut timings = Timings::default();
         run.iterate(&mut timings, &mut ()).unwrap();
-        let (flux0, sums0) = (texels(&run.state.flux), texels(&run.state.sums));
+        let (flux0, sums0) = (
+            common::texels(&run.state.flux),
+            common::texels(&run.state.sums),
+        );
         let first_radius2 = run.cell * run.cell;
         run.iterate(&mut timings, &mut ()).unwrap();
-        let (flux1, sums1) = (texels(&run.state.flux), texels(&run.state.sums));
+        let (flux1, sums1) = (
+            common::texels(&run.state.flux),
+            common::texels(&run.state.sums),
+        );
         let map = CpuPhotonMap::from_gpu(run.map.as_ref().unwrap());
         let d = &run.direct;
         let (direct, pos, normal, through) = (
-            texels(&d.radiance),
-            texels(&d.diffuse_position),
-            texels(&d.diffuse_normal),
-            texels(&d.diffuse_throughput),
+            common::texels(&d.radiance),
+            common::texels(&d.diffuse_position),
+            common::texels(&d.diffuse_normal),
+            common::texels(&d.diffuse_throughput),
         );
         let (mut gathering, mut count_differs, mut worst) = (0, 0, 0f32);
         for i in 0..flux0.len() {
@@ -79,16 +74,16 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
                     panic!("a visible point on a non-diffuse surface")
                 };
                 VisiblePoint {
-                    position: v3(pos[i]),
-                    normal: v3(normal[i]),
+                    position: common::v3(pos[i]),
+                    normal: common::v3(normal[i]),
                     albedo,
-                    throughput: v3(through[i]),
+                    throughput: common::v3(through[i]),
                 }
             });
             let before = PixelState {
-                tau: v3(flux0[i]),
+                tau: common::v3(flux0[i]),
                 radius2: flux0[i][3],
-                direct: v3(sums0[i]),
+                direct: common::v3(sums0[i]),
                 count: sums0[i][3],
             };
             let accept = |vp: &VisiblePoint, p: Vec3| {
@@ -100,7 +95,15 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
                         p,
                     )
             };
-            let cpu = update(&map, before, v3(direct[i]), vp, 0.7, first_radius2, &accept);
+            let cpu = update(
+                &map,
+                before,
+                common::v3(direct[i]),
+                vp,
+                0.7,
+                first_radius2,
+                &accept,
+            );
             if sums1[i][3] > sums0[i][3] {
                 gathering += 1;
             }

@@ -269,3 +269,48 @@ edge1 = [0.2, 0.0, 0.0]
 edge2 = [0.0, 0.0, 0.2]
 radiance = [5.0, 5.0, 5.0]
 "#;
+
+/// Photon frames with one frame of `records` photons at the given points.
+pub fn frames_from_points(
+    gpu: &Gpu,
+    points: &[[f32; 3]],
+    power: impl Fn(usize) -> [f32; 3],
+) -> photonmap::photon::PhotonFrames {
+    let n = points.len() as u32;
+    let width = 64u32;
+    let frame_height = n.div_ceil(width);
+    let texels = (width * frame_height) as usize;
+    let mut pos = vec![0f32; texels * 4];
+    let mut pow = vec![0f32; texels * 4];
+    let mut inc = vec![0f32; texels * 4];
+    for (i, p) in points.iter().enumerate() {
+        pos[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], 0.0]);
+        let q = power(i);
+        pow[4 * i..4 * i + 4].copy_from_slice(&[q[0], q[1], q[2], 1.0]);
+        inc[4 * i..4 * i + 4].copy_from_slice(&[0.0, -1.0, 0.0, 1.0]);
+    }
+    photonmap::photon::PhotonFrames::from_records(
+        gpu,
+        width,
+        frame_height,
+        1,
+        &pos,
+        &pow,
+        &inc,
+        width * frame_height,
+    )
+    .unwrap()
+}
+
+/// A texture read back as RGBA texels, in GL order.
+pub fn texels(t: &photonmap::gpu::Texture) -> Vec<[f32; 4]> {
+    t.read_f32()
+        .chunks(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect()
+}
+
+/// A texel's rgb (xyz).
+pub fn v3(t: [f32; 4]) -> glam::Vec3 {
+    glam::Vec3::new(t[0], t[1], t[2])
+}
