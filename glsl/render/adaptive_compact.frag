@@ -5,6 +5,8 @@
 // block of queries instead of a sparse lattice (a SIMD block of fragments
 // costs as much for one live pixel as for all of them). Empty texels hold no
 // hit, and the estimate's computation mask skips them.
+#include "common/addressing.glsl"
+
 uniform isampler2D u_order;            // packed texel -> pixel index (y * width + x), -1: none
 uniform sampler2D u_first_position;
 uniform sampler2D u_first_normal;
@@ -23,8 +25,7 @@ void main() {
     o_diffuse_throughput = vec4(0.0);
     int i = texelFetch(u_order, t, 0).x;
     if (i < 0) return;
-    int width = textureSize(u_first_position, 0).x;
-    ivec2 p = ivec2(i % width, i / width);
+    ivec2 p = texel_of_index(i, textureSize(u_first_position, 0).x);
     o_diffuse_position = texelFetch(u_first_position, p, 0);
     o_diffuse_normal = texelFetch(u_first_normal, p, 0);
     o_diffuse_throughput = texelFetch(u_first_throughput, p, 0);

@@ -3,6 +3,7 @@
 // computed (the estimate's composed indirect light plus final gather's) or
 // interpolated; other pixels keep theirs.
 #include "render/adaptive_plan.glsl"
+#include "common/addressing.glsl"
 
 uniform sampler2D u_plan;          // rgb interpolated, w = plan (render/adaptive_plan.glsl)
 uniform isampler2D u_slot;         // pixel -> its packed texel index (adaptive_compact.frag)
@@ -20,9 +21,7 @@ void main() {
     if (kind == PLAN_NONE) discard;
     vec3 v = vec3(0.0);
     if (kind == PLAN_COMPUTE) {
-        int slot = texelFetch(u_slot, p, 0).x;
-        int width = textureSize(u_plan, 0).x;
-        ivec2 s = ivec2(slot % width, slot / width);
+        ivec2 s = texel_of_index(texelFetch(u_slot, p, 0).x, textureSize(u_plan, 0).x);
         if (u_has_estimate != 0) v += texelFetch(u_estimate, s, 0).rgb;
         if (u_has_gather != 0) v += texelFetch(u_gathered, s, 0).rgb;
     } else if (kind == PLAN_INTERPOLATE) {

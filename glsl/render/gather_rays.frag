@@ -15,6 +15,7 @@
 #include "common/random.glsl"
 #include "common/sampling.glsl"
 #include "common/specular.glsl"
+#include "common/addressing.glsl"
 
 uniform sampler2D u_diffuse_position;   // the pixel's first diffuse hit, w = 1 where one exists
 uniform sampler2D u_diffuse_normal;     // facing the viewer, w = material + 1
@@ -42,11 +43,8 @@ void main() {
     vec3 n1 = texelFetch(u_diffuse_normal, px, 0).xyz;
     // A packed hit draws its own pixel's random numbers.
     ivec2 own = px;
-    if (u_packed != 0) {
-        int i = texelFetch(u_pixel, px, 0).x;
-        int width = textureSize(u_diffuse_position, 0).x;
-        own = ivec2(i % width, i / width);
-    }
+    if (u_packed != 0)
+        own = texel_of_index(texelFetch(u_pixel, px, 0).x, textureSize(u_diffuse_position, 0).x);
     uint rng = rng_init(u_seed, uvec2(own), GATHER_STREAM | uint(u_first_ray + j));
     float u1 = rng_next(rng), u2 = rng_next(rng);
     vec3 d = sample_cosine(n1, u1, u2);
