@@ -66,6 +66,16 @@ pub const GATHER_STREAM: u32 = 0x5000_0000;
 /// material is the same (glsl/render/adaptive_plan.glsl).
 pub const ADAPTIVE_NORMAL_COS: f32 = 0.95;
 
+/// Adaptive sampling's plan of a pixel at one level (glsl/render/adaptive_plan.glsl):
+/// not this level's, computed, interpolated, or empty (no diffuse hit).
+pub const PLAN_NONE: u32 = 0;
+pub const PLAN_COMPUTE: u32 = 1;
+pub const PLAN_INTERPOLATE: u32 = 2;
+pub const PLAN_EMPTY: u32 = 3;
+
+/// Rec. 709 luminance weights of linear RGB.
+pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
 /// pi as every shader writes it (the same f32 as `std::f32::consts::PI`).
 const PI_GLSL: &str = "3.14159265358979";
 
@@ -103,6 +113,17 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
+        ("PLAN_NONE", u(PLAN_NONE)),
+        ("PLAN_COMPUTE", u(PLAN_COMPUTE)),
+        ("PLAN_INTERPOLATE", u(PLAN_INTERPOLATE)),
+        ("PLAN_EMPTY", u(PLAN_EMPTY)),
+        (
+            "LUMINANCE",
+            format!(
+                "vec3({:?}, {:?}, {:?})",
+                LUMINANCE[0], LUMINANCE[1], LUMINANCE[2]
+            ),
+        ),
     ]
 }
 

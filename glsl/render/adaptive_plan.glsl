@@ -14,12 +14,10 @@ uniform int u_stride;
 uniform int u_coarsest;              // 1: the first level computes its whole lattice
 uniform float u_threshold;
 
-const int PLAN_NONE = 0;             // not this level's pixel
-const int PLAN_COMPUTE = 1;
-const int PLAN_INTERPOLATE = 2;
-const int PLAN_EMPTY = 3;            // no diffuse hit: no global light
+// Plans: PLAN_NONE (not this level's pixel), PLAN_COMPUTE, PLAN_INTERPOLATE,
+// PLAN_EMPTY (no diffuse hit: no global light), from src/layout.rs.
 
-float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+float luminance(vec3 c) { return dot(c, LUMINANCE); }
 
 bool on_lattice(ivec2 p, int s) { return p.x % s == 0 && p.y % s == 0; }
 

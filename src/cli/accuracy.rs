@@ -436,7 +436,8 @@ pub fn bench_accuracy(
 /// at a luminance difference of the returned scale (half the reference's
 /// mean luminance).
 fn bias_map(mean: &Image, reference: &Image) -> (Image, f64) {
-    let luminance = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let [wr, wg, wb] = photonmap::layout::LUMINANCE;
+    let luminance = |p: &[f32; 3]| wr * p[0] + wg * p[1] + wb * p[2];
     let mean_luminance =
         reference.pixels.iter().map(luminance).sum::<f32>() / reference.pixels.len().max(1) as f32;
     let scale = if mean_luminance > 0.0 {

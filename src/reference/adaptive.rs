@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::layout::ADAPTIVE_NORMAL_COS;
+use crate::layout::{ADAPTIVE_NORMAL_COS, LUMINANCE};
 use crate::render::adaptive::STRIDES;
 
 /// Each pixel's first diffuse hit: its viewer-facing normal and material + 1
@@ -18,7 +18,7 @@ pub struct FirstHits {
 }
 
 fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    c.dot(Vec3::from(LUMINANCE))
 }
 
 /// The pyramid's result: every pixel's global light, and per level (stride,

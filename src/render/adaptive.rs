@@ -24,6 +24,7 @@
 //! stencil in masked mode) drops the empty rest after its first pass.
 
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
+use crate::layout::{PLAN_COMPUTE, PLAN_INTERPOLATE};
 
 use super::radiance_estimate::QueryPoints;
 use super::{DirectLight, Image};
@@ -56,10 +57,6 @@ pub struct AdaptiveStats {
     /// (stride, computed, interpolated) per level.
     pub levels: Vec<(u32, u64, u64)>,
 }
-
-/// Plan codes of glsl/render/adaptive_plan.glsl.
-const PLAN_COMPUTE: f32 = 1.0;
-const PLAN_INTERPOLATE: f32 = 2.0;
 
 pub struct Adaptive {
     gpu: Gpu,
@@ -131,11 +128,11 @@ impl Adaptive {
         let (mut order, mut slot) = (vec![-1i32; n], vec![-1i32; n]);
         let (mut computed, mut interpolated) = (0usize, 0u64);
         for (pixel, texel) in plan.chunks(4).enumerate() {
-            if texel[3] == PLAN_COMPUTE {
+            if texel[3] == PLAN_COMPUTE as f32 {
                 order[computed] = pixel as i32;
                 slot[pixel] = computed as i32;
                 computed += 1;
-            } else if texel[3] == PLAN_INTERPOLATE {
+            } else if texel[3] == PLAN_INTERPOLATE as f32 {
                 interpolated += 1;
             }
         }
