@@ -73,6 +73,20 @@ pub const PLAN_COMPUTE: u32 = 1;
 pub const PLAN_INTERPOLATE: u32 = 2;
 pub const PLAN_EMPTY: u32 = 3;
 
+/// Texels in one row of IGI's primitive-box texture (2 texels a primitive:
+/// min, max) for imperfect visibility.
+pub const PRIMITIVE_BOX_ROW: u32 = 4096;
+/// VPLs gathered per IGI pass at most, per pixel (bounds work per pass).
+pub const VPL_BATCH: u32 = 64;
+/// IGI's discontinuity buffer: a neighbour's incident light is averaged in
+/// where its first-hit normal is within this cosine of the pixel's (about 25
+/// degrees) and its hit lies within VPL_DEPTH_TOLERANCE of the pixel's
+/// distance from the eye off the pixel's tangent plane (a priori values).
+pub const VPL_NORMAL_COS: f32 = 0.9;
+pub const VPL_DEPTH_TOLERANCE: f32 = 0.05;
+/// The random stream of IGI's VPL paths (seeded apart from the caustic map's).
+pub const VPL_STREAM: u32 = 0x6000_0000;
+
 /// Rec. 709 luminance weights of linear RGB.
 pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
@@ -113,6 +127,9 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
+        ("PRIMITIVE_BOX_ROW", u(PRIMITIVE_BOX_ROW)),
+        ("VPL_NORMAL_COS", format!("{VPL_NORMAL_COS:?}")),
+        ("VPL_DEPTH_TOLERANCE", format!("{VPL_DEPTH_TOLERANCE:?}")),
         ("PLAN_NONE", u(PLAN_NONE)),
         ("PLAN_COMPUTE", u(PLAN_COMPUTE)),
         ("PLAN_INTERPOLATE", u(PLAN_INTERPOLATE)),

@@ -27,7 +27,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    Render(cli::render::RenderArgs),
+    Render(Box<cli::render::RenderArgs>),
     Photons(cli::photons::PhotonsArgs),
     Compare(cli::compare::CompareArgs),
     Convert(cli::convert::ConvertArgs),

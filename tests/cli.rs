@@ -1319,9 +1319,10 @@ fn bench_meshes_reports_every_size_with_rates_renders_and_a_plot() {
 }
 
 /// Final gather and adaptive sampling as a user runs them: the JSON reports
-/// the gather and the pyramid's levels; a caustics-only scene, SPPM, and
-/// --gather-k or a threshold without their switch are refused with a reason,
-/// and write nothing.
+/// the gather and the pyramid's levels (adaptive SPPM: its pilot and plan); a
+/// caustics-only scene, final gather with SPPM, a pilot that leaves no
+/// iterations, and --gather-k, a threshold or a pilot without their switch
+/// are refused with a reason, and write nothing.
 #[test]
 fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
     let d = tmp("final-gather");
@@ -1355,7 +1356,33 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
         .as_u64()
         .unwrap();
     assert!(0 < computed && computed < all, "{computed} of {all}");
-    let refused: [(&[&str], &str); 7] = [
+    let out = photonmap()
+        .args([
+            "render", "--quiet", "--json", "--width", "40", "--height", "36",
+        ])
+        .args([
+            "--method",
+            "sppm",
+            "--adaptive",
+            "--iterations",
+            "4",
+            "--photons-per-iteration",
+            "4096",
+        ])
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        json["adaptive_pilot"], 1,
+        "an eighth of 4 iterations, at least 1"
+    );
+    let interpolated = json["adaptive_samples"]["interpolated"].as_u64().unwrap();
+    assert!(0 < interpolated && interpolated < 40 * 36, "{interpolated}");
+    let refused: [(&[&str], &str); 9] = [
         (
             &["--final-gather", "2", "--scene-name-ring"],
             "caustics_only",
@@ -1365,7 +1392,20 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
             &["--final-gather", "2", "--reference-software", "r.png"],
             "--reference-software",
         ),
-        (&["--adaptive", "--method", "sppm"], "--adaptive"),
+        (
+            &[
+                "--adaptive",
+                "--method",
+                "sppm",
+                "--iterations",
+                "4",
+                "--adaptive-pilot",
+                "4",
+            ],
+            "pilot",
+        ),
+        (&["--adaptive", "--adaptive-pilot", "2"], "--adaptive-pilot"),
+        (&["--method", "sppm", "--adaptive-pilot", "2"], "--adaptive"),
         (
             &["--final-gather", "2", "--method", "sppm"],
             "--final-gather",
@@ -1380,6 +1420,72 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
             .args(["render", "--quiet", "--width", "16", "--height", "16"])
             .args(args.iter().filter(|a| !a.starts_with("--scene-name")))
             .arg(scene(if ring { "ring" } else { "cornell_box" }))
+            .arg("-o")
+            .arg(&bad)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} ran");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(!bad.exists(), "{args:?} wrote an image");
+    }
+}
+
+/// IGI as a user runs it: the JSON reports the VPLs and the gather; IGI's
+/// switches without `--method igi`, the one-shot estimate's accelerations
+/// with it, and impossible values are refused with a reason, writing nothing.
+#[test]
+fn igi_runs_and_refuses_what_it_cannot_do() {
+    let d = tmp("igi");
+    let png = d.join("igi.png");
+    let out = photonmap()
+        .args([
+            "render", "--quiet", "--json", "--width", "40", "--height", "36",
+        ])
+        .args([
+            "--method",
+            "igi",
+            "--vpl-paths",
+            "32",
+            "--interleave",
+            "2",
+            "--downsample",
+            "2",
+            "--imperfect-visibility",
+            "--set",
+            "photon_map.photons_stored=4000",
+        ])
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    assert!(png.exists());
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["method"], "igi");
+    assert_eq!(json["vpls"]["paths"], 32);
+    let vpls = json["vpls"]["vpls"].as_u64().unwrap();
+    assert!(vpls >= 32, "{vpls}");
+    assert_eq!(json["igi"]["interleave"], 2);
+    let per_point = json["igi_samples"][0]["vpls_per_point"].as_f64().unwrap();
+    assert_eq!(per_point, vpls as f64 / 4.0);
+    let refused: [(&[&str], &str); 5] = [
+        (&["--interleave", "3"], "--method igi"),
+        (&["--method", "igi", "--adaptive"], "--adaptive"),
+        (
+            &["--method", "igi", "--final-gather", "2"],
+            "--final-gather",
+        ),
+        (&["--method", "igi", "--interleave", "0"], "1..=8"),
+        (&["--method", "igi", "--vpl-min-distance=-1"], "0 or more"),
+    ];
+    for (args, says) in refused {
+        let bad = d.join("bad.png");
+        let out = photonmap()
+            .args(["render", "--quiet", "--width", "16", "--height", "16"])
+            .args(args)
+            .arg(scene("cornell_box"))
             .arg("-o")
             .arg(&bad)
             .output()

@@ -29,6 +29,7 @@ fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -
             leak: LeakTest::None,
         }),
         adaptive: None,
+        igi: None,
     });
     o
 }

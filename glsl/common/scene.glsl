@@ -157,8 +157,29 @@ float box_entry(ivec4 lo, ivec4 hi, SceneRay r, float t_max) {
     return t_in <= min(t_out, t_max) ? t_in : BOX_MISS;
 }
 
+#ifdef PRIMITIVE_BOXES
+// Imperfect visibility (IGI's VPL shadow rays, after Marques and Santos 4.1):
+// every primitive stands for its bounding box. A box blocks the segment only
+// where the segment passes through it with both ends outside, so the boxes
+// of the primitives at the ends never block it.
+uniform sampler2D u_primitive_boxes; // 2 texels a primitive: min, max
+vec4 leaf_hit(int prim, SceneRay r) {
+    ivec2 t = ivec2((2 * prim) % PRIMITIVE_BOX_ROW, (2 * prim) / PRIMITIVE_BOX_ROW);
+    vec3 lo = texelFetch(u_primitive_boxes, t, 0).xyz;
+    vec3 hi = texelFetch(u_primitive_boxes, t + ivec2(1, 0), 0).xyz;
+    vec3 t0 = (lo - r.o) * r.inv, t1 = (hi - r.o) * r.inv;
+    vec3 near = min(t0, t1), far = max(t0, t1);
+    float t_in = max(max(near.x, near.y), near.z);
+    float t_out = min(min(far.x, far.y), far.z);
+    return t_in > 0.0 && t_in <= t_out ? vec4(t_out, 0.0, 0.0, 1.0) : NO_HIT;
+}
+#else
+vec4 leaf_hit(int prim, SceneRay r) { return intersect_primitive_ray(prim, r); }
+#endif
+
 // The closest primitive hit before best.x (set by the caller), or -1; with
-// any_hit, the first found. best becomes its record.
+// any_hit, the first found. best becomes its record. (With PRIMITIVE_BOXES a
+// "hit" is a box passed through, at its exit distance: for occlusion only.)
 int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
     if (u_primitive_count == 0) return -1;
     ivec4 lo = bvh_node_texel(0, 0), hi = bvh_node_texel(0, 1);
@@ -172,7 +193,7 @@ int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
         if (b < 0) {
             for (int i = a; i < a - b; ++i) {
                 int prim = bvh_leaf_primitive(i);
-                vec4 h = intersect_primitive_ray(prim, r);
+                vec4 h = leaf_hit(prim, r);
                 if (h.w > 0.0 && h.x < best.x) {
                     best = h;
                     hit = prim;

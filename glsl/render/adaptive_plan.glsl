@@ -7,6 +7,8 @@
 // pixel's (the full-resolution first hits are the discontinuity buffer) and
 // the corners' global light differs by at most u_threshold of its mean.
 // src/render/adaptive.rs documents the levels.
+#include "render/adaptive_lattice.glsl"
+
 uniform sampler2D u_first_position;  // the pixel's first diffuse hit, w = 1 where one exists
 uniform sampler2D u_first_normal;    // facing the viewer, w = material + 1
 uniform sampler2D u_value;           // global light known so far, w = 1 where known
@@ -27,19 +29,15 @@ int adaptive_plan(ivec2 p, out vec3 interpolated) {
     if (u_coarsest == 0 && on_lattice(p, 2 * u_stride)) return PLAN_NONE;
     if (texelFetch(u_first_position, p, 0).w <= 0.0) return PLAN_EMPTY;
     if (u_coarsest != 0) return PLAN_COMPUTE;
-    ivec2 size = textureSize(u_first_position, 0);
-    int s2 = 2 * u_stride;
-    ivec2 c0 = (p / s2) * s2;
-    ivec2 c1 = c0 + s2;
-    // Past the image's last lattice row or column the near corners carry it all.
-    float fx = c1.x < size.x ? float(p.x - c0.x) / float(s2) : 0.0;
-    float fy = c1.y < size.y ? float(p.y - c0.y) / float(s2) : 0.0;
+    ivec2 corners[4];
+    float weights[4];
+    lattice_corners(p, u_stride, textureSize(u_first_position, 0), corners, weights);
     vec4 n = texelFetch(u_first_normal, p, 0);
     float lo = 1e30, hi = -1e30;
     for (int i = 0; i < 4; ++i) {
-        float w = ((i & 1) != 0 ? fx : 1.0 - fx) * ((i & 2) != 0 ? fy : 1.0 - fy);
+        float w = weights[i];
         if (w == 0.0) continue;
-        ivec2 c = ivec2((i & 1) != 0 ? c1.x : c0.x, (i & 2) != 0 ? c1.y : c0.y);
+        ivec2 c = corners[i];
         vec4 cn = texelFetch(u_first_normal, c, 0);
         if (cn.w != n.w || dot(cn.xyz, n.xyz) < ADAPTIVE_NORMAL_COS) return PLAN_COMPUTE;
         vec3 v = texelFetch(u_value, c, 0).rgb;

@@ -11,6 +11,7 @@ uniform sampler2D u_estimate;      // packed: composed estimate without direct l
 uniform sampler2D u_gathered;      // packed: final gather's indirect light
 uniform int u_has_estimate;
 uniform int u_has_gather;
+uniform int u_packed;              // 0: u_estimate is a full-resolution image (adaptive SPPM's pilot)
 
 layout(location = 0) out vec4 o_value;
 
@@ -21,7 +22,7 @@ void main() {
     if (kind == PLAN_NONE) discard;
     vec3 v = vec3(0.0);
     if (kind == PLAN_COMPUTE) {
-        ivec2 s = texel_of_index(texelFetch(u_slot, p, 0).x, textureSize(u_plan, 0).x);
+        ivec2 s = u_packed != 0 ? texel_of_index(texelFetch(u_slot, p, 0).x, textureSize(u_plan, 0).x) : p;
         if (u_has_estimate != 0) v += texelFetch(u_estimate, s, 0).rgb;
         if (u_has_gather != 0) v += texelFetch(u_gathered, s, 0).rgb;
     } else if (kind == PLAN_INTERPOLATE) {

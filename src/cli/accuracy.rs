@@ -16,7 +16,9 @@ use photonmap::metrics::compare;
 use photonmap::photon::{BuildMethod, GridKind};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
-use photonmap::render::{render, AdaptiveOptions, EstimateMode, FinalGatherOptions, Image};
+use photonmap::render::{
+    render, AdaptiveOptions, EstimateMode, FinalGatherOptions, IgiOptions, Image,
+};
 use photonmap::scene::{embedded, Light, Scene};
 
 use super::reference::{read_reference, reference_options, ReferenceInfo};
@@ -55,7 +57,7 @@ pub struct AccuracyArgs {
 #[derive(Serialize, Clone, Debug)]
 pub struct AccuracyRun {
     pub label: String,
-    /// "paper" (the one-shot kNN estimate), "final-gather" or "sppm".
+    /// "paper" (the one-shot kNN estimate), "final-gather", "sppm" or "igi".
     pub method: String,
     pub photons_stored: u32,
     pub k: u32,
@@ -72,6 +74,8 @@ pub struct AccuracyRun {
     pub adaptive: bool,
     /// The photon map's grid storage: uniform, or hashed (section 4.4).
     pub grid: GridKind,
+    /// IGI's options (method "igi").
+    pub igi: Option<IgiOptions>,
     /// Wall seconds of one render (mean over the seeds).
     pub seconds: f64,
     /// RMSE of one render against the reference (mean over the seeds).
@@ -127,6 +131,7 @@ impl Config {
                 gather_rays: 0,
                 adaptive: false,
                 grid: GridKind::Uniform,
+                igi: None,
                 seconds: 0.0,
                 rmse: 0.0,
                 bias_rmse: 0.0,
@@ -221,6 +226,49 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
             r.sppm_iterations = it;
         }));
     }
+    // Instant global illumination: the canonical version, more VPLs, each of
+    // Marques and Santos's accelerations alone, all three together, and the
+    // remedy they suggest for the combination's artefacts (a 2 x 2 interleave).
+    let igi = |label: &str, f: &dyn Fn(&mut IgiOptions)| {
+        base.with(label.into(), |r| {
+            r.method = "igi".into();
+            let mut o = IgiOptions::default();
+            f(&mut o);
+            r.igi = Some(o);
+        })
+    };
+    let all_three = |o: &mut IgiOptions| {
+        o.imperfect_visibility = true;
+        o.interleave = 3;
+        o.downsample = 4;
+    };
+    out.push(igi("IGI", &|_| {}));
+    out.push(igi("IGI, all three accelerations", &all_three));
+    if !quick {
+        out.push(igi("IGI 256 paths", &|o| o.vpl_paths = 256));
+        out.push(igi("IGI, imperfect visibility", &|o| {
+            o.imperfect_visibility = true
+        }));
+        out.push(igi("IGI, downsample 4", &|o| o.downsample = 4));
+        out.push(igi("IGI, interleave 3", &|o| o.interleave = 3));
+        out.push(igi("IGI, all three, interleave 2", &|o| {
+            all_three(o);
+            o.interleave = 2;
+        }));
+        out.push(igi("IGI 256 paths, all three", &|o| {
+            all_three(o);
+            o.vpl_paths = 256;
+        }));
+    }
+    // Adaptive SPPM (a pilot of an eighth of the iterations, then the
+    // gather only where the plan computes), beside the full runs above.
+    for it in if quick { vec![16] } else { vec![16, 64] } {
+        out.push(base.with(format!("SPPM {it} iterations, adaptive"), |r| {
+            r.method = "sppm".into();
+            r.sppm_iterations = it;
+            r.adaptive = true;
+        }));
+    }
     out
 }
 
@@ -289,7 +337,7 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
     Ok(())
 }
 
-fn stem(scene: &Path) -> String {
+pub fn stem(scene: &Path) -> String {
     scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -337,10 +385,12 @@ fn render_config(
         ..FinalGatherOptions::default()
     });
     gi.adaptive = c.adaptive.then(AdaptiveOptions::default);
+    gi.igi = c.igi.clone();
     let wall = std::time::Instant::now();
     let image = if c.method == "sppm" {
         let sppm = SppmOptions {
             iterations: c.sppm_iterations,
+            adaptive: c.adaptive.then(AdaptiveOptions::default),
             ..SppmOptions::default()
         };
         render_sppm(gpu, &s, &o, &sppm, &mut ())?.image
@@ -498,10 +548,14 @@ fn mark_front(runs: &mut [AccuracyRun]) {
 }
 
 pub fn csv(r: &AccuracyReport) -> String {
-    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,grid,tile,spp,sppm_iterations,gather_rays,adaptive,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
+    let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,grid,tile,spp,sppm_iterations,gather_rays,adaptive,vpl_paths,imperfect_visibility,interleave,downsample,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
     for x in &r.runs {
+        let igi = x.igi.clone().unwrap_or(IgiOptions {
+            vpl_paths: 0,
+            ..IgiOptions::default()
+        });
         s += &format!(
-            "{},{},{},{},{},{:?},{},{:?},{:?},{},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
+            "{},{},{},{},{},{:?},{},{:?},{:?},{},{},{},{},{},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
             x.label,
             x.method,
             x.photons_stored,
@@ -516,6 +570,10 @@ pub fn csv(r: &AccuracyReport) -> String {
             x.sppm_iterations,
             x.gather_rays,
             x.adaptive,
+            igi.vpl_paths,
+            igi.imperfect_visibility,
+            igi.interleave,
+            igi.downsample,
             x.seconds,
             x.rmse,
             x.bias_rmse,
@@ -554,11 +612,19 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
         .map(point)
         .collect();
     plot.points("#d62728", front, true);
-    for (method, colour) in [("sppm", "#2ca02c"), ("photon map", "#1f77b4")] {
+    for (method, colour) in [
+        ("sppm", "#2ca02c"),
+        ("igi", "#9467bd"),
+        ("photon map", "#1f77b4"),
+    ] {
+        let kind = |m: &str| match m {
+            "sppm" | "igi" => m.to_string(),
+            _ => "photon map".into(),
+        };
         let others = r
             .runs
             .iter()
-            .filter(|x| !x.on_pareto_front && (x.method == "sppm") == (method == "sppm"))
+            .filter(|x| !x.on_pareto_front && kind(&x.method) == method)
             .map(point)
             .collect();
         plot.points(colour, others, false);
@@ -616,6 +682,7 @@ pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
         let c = match (run.on_pareto_front, run.method.as_str()) {
             (true, _) => [214, 39, 40],
             (false, "sppm") => [44, 160, 44],
+            (false, "igi") => [148, 103, 189],
             _ => [31, 119, 180],
         };
         for dy in -3..=3i64 {

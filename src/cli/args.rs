@@ -7,7 +7,7 @@ use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{DirectLighting, SppmOptions};
-use photonmap::render::{EstimateMode, EstimateOptions};
+use photonmap::render::{EstimateMode, EstimateOptions, IgiOptions};
 
 /// A parser for a whole number in lo..=hi whose error names the range.
 pub fn in_range(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone + Send + Sync {
@@ -118,6 +118,9 @@ pub enum Method {
     Paper,
     /// Stochastic progressive photon mapping: converges to the exact image.
     Sppm,
+    /// Instant global illumination: virtual point lights for diffuse
+    /// interreflection, a caustic photon map for caustics.
+    Igi,
 }
 
 /// A positive finite number.
@@ -163,6 +166,10 @@ pub struct SppmArgs {
     /// SPPM: shadow rays per area light per iteration (1..=1024).
     #[arg(long, default_value_t = 1, value_parser = in_range(1, 1024))]
     pub sppm_shadow_rays: u32,
+    /// SPPM with --adaptive: iterations at every pixel before the plan
+    /// (1..iterations; default an eighth of --iterations, at least 1).
+    #[arg(long, value_name = "N", value_parser = in_range(1, 1_000_000), requires = "adaptive")]
+    pub adaptive_pilot: Option<u32>,
 }
 
 impl From<&SppmArgs> for SppmOptions {
@@ -176,7 +183,63 @@ impl From<&SppmArgs> for SppmOptions {
             max_bounces: a.photon_bounces,
             direct: a.sppm_direct,
             shadow_rays: a.sppm_shadow_rays,
+            adaptive: None,
+            adaptive_pilot: a.adaptive_pilot,
         }
+    }
+}
+
+/// Instant global illumination (`--method igi`).
+#[derive(Args, Clone, Debug)]
+pub struct IgiArgs {
+    /// IGI: light paths traced for VPLs, one VPL at each diffuse hit (1..=1048576).
+    #[arg(long, default_value_t = 64, value_parser = in_range(1, 1 << 20))]
+    pub vpl_paths: u32,
+    /// IGI: the geometry term's bounding distance m (VPLs nearer than 0.8 m
+    /// light nothing; 0: unbounded). Default: the scene's photon_map.max_radius.
+    #[arg(long, value_name = "M", value_parser = non_negative)]
+    pub vpl_min_distance: Option<f64>,
+    /// IGI: VPL shadow rays against primitive bounding boxes.
+    #[arg(long)]
+    pub imperfect_visibility: bool,
+    /// IGI: interleaved sampling over N x N VPL subsets, merged by the
+    /// discontinuity buffer (1..=8; 1: off; the paper's 3).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = in_range(1, 8))]
+    pub interleave: u32,
+    /// IGI: the VPL gather at one pixel per F x F block, joint-bilateral
+    /// upsampled (1..=16; 1: off; the paper's 4).
+    #[arg(long, value_name = "F", default_value_t = 1, value_parser = in_range(1, 16))]
+    pub downsample: u32,
+}
+
+impl IgiArgs {
+    /// Whether any IGI switch differs from its default.
+    pub fn any_given(&self) -> bool {
+        self.vpl_paths != 64
+            || self.vpl_min_distance.is_some()
+            || self.imperfect_visibility
+            || self.interleave != 1
+            || self.downsample != 1
+    }
+}
+
+impl From<&IgiArgs> for IgiOptions {
+    fn from(a: &IgiArgs) -> Self {
+        IgiOptions {
+            vpl_paths: a.vpl_paths,
+            min_distance: a.vpl_min_distance.map(|m| m as f32),
+            imperfect_visibility: a.imperfect_visibility,
+            interleave: a.interleave,
+            downsample: a.downsample,
+        }
+    }
+}
+
+/// A finite number of 0 or more.
+fn non_negative(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("{s}: give a number of 0 or more")),
     }
 }
 

@@ -22,6 +22,10 @@ pub enum BenchCommand {
     /// The BVH at scale: a ball on a floor, analytic and as meshes of growing
     /// size; BVH build, eye/shadow/photon rays per second, render times.
     Meshes(super::meshes::MeshesArgs),
+    /// Instant global illumination with Marques and Santos's accelerations
+    /// one at a time, and their remedies: time by component (their figures 4
+    /// and 5) and error against the SPPM reference.
+    Igi(super::igi_bench::IgiBenchArgs),
     /// Whether the stencil test skips fragment work on this driver (the
     /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
     Mask(MaskArgs),
@@ -83,6 +87,7 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
         BenchCommand::Accuracy(a) => super::accuracy::run_bench(&a, platform),
         BenchCommand::Mask(a) => run_mask(&a, platform),
         BenchCommand::Meshes(a) => super::meshes::run(&a, platform),
+        BenchCommand::Igi(a) => super::igi_bench::run(&a, platform),
         BenchCommand::Build(a) => {
             if a.min_log2 > a.max_log2 {
                 bail!(

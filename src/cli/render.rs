@@ -10,13 +10,14 @@ use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::gpu::Platform;
 use photonmap::image::{check_writable, write_all_atomically, write_atomically};
 use photonmap::provenance::Provenance;
+use photonmap::render::sppm::SppmOptions;
 use photonmap::render::{
     self, AdaptiveOptions, EstimatePass, FinalGatherOptions, GlobalIllumination, Image, PassPlan,
     Progress, RenderObserver, RenderOptions,
 };
 use photonmap::scene::Scene;
 
-use super::args::{in_range, EstimateArgs, Method, PhotonMapArgs, SceneArgs, SppmArgs};
+use super::args::{in_range, EstimateArgs, IgiArgs, Method, PhotonMapArgs, SceneArgs, SppmArgs};
 use super::progress::{ProgressReport, Work};
 
 /// Render a scene to images: PNG (sRGB), EXR (linear float RGB, with the
@@ -87,6 +88,8 @@ pub struct RenderArgs {
     pub adaptive_threshold: f32,
     #[command(flatten)]
     pub sppm: SppmArgs,
+    #[command(flatten)]
+    pub igi: IgiArgs,
     #[command(flatten)]
     pub photons: PhotonMapArgs,
     #[command(flatten)]
@@ -253,6 +256,7 @@ impl RenderArgs {
             adaptive: self.adaptive.then_some(AdaptiveOptions {
                 threshold: self.adaptive_threshold,
             }),
+            igi: (self.method == Method::Igi).then(|| (&self.igi).into()),
         });
         options
     }
@@ -270,6 +274,17 @@ struct Report<'a> {
 pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     if args.method == Method::Sppm {
         return run_sppm(args, platform);
+    }
+    if args.method != Method::Igi && args.igi.any_given() {
+        bail!("--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi");
+    }
+    if args.method == Method::Igi
+        && (args.final_gather.is_some() || args.adaptive || args.reference_software.is_some())
+    {
+        bail!("--method igi has its own accelerations (--interleave, --downsample) and no one-map estimate to compare: drop --final-gather, --adaptive and --reference-software");
+    }
+    if args.sppm.adaptive_pilot.is_some() {
+        bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
     }
     if args.final_gather.is_some() || args.adaptive {
         // Snapshots show one estimate's running image, and the software
@@ -312,13 +327,20 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
             provenance: &provenance,
             outputs: written.clone(),
             figures: serde_json::json!({
-                "method": if args.final_gather.is_some() { "final-gather" } else { "paper" },
+                "method": match (args.method, args.final_gather.is_some()) {
+                    (Method::Igi, _) => "igi",
+                    (_, true) => "final-gather",
+                    _ => "paper",
+                },
                 "timings": out.timings,
                 "estimates": out.estimates,
                 "final_gather": options.global.as_ref().and_then(|g| g.final_gather.clone()),
                 "gathers": out.gathers,
                 "adaptive": options.global.as_ref().and_then(|g| g.adaptive.clone()),
                 "adaptive_samples": out.adaptive,
+                "igi": options.global.as_ref().and_then(|g| g.igi.clone()),
+                "vpls": out.vpls,
+                "igi_samples": out.igi,
             }),
         })?;
     }
@@ -357,9 +379,8 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         || args.reference_software.is_some()
         || args.spp > 1
         || args.final_gather.is_some()
-        || args.adaptive
     {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather and --adaptive (adaptive sampling is built for the one-shot estimate and final gather only)");
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp and --final-gather");
     }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
@@ -370,7 +391,12 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
     let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
     let work = Work::Iterations(args.sppm.iterations);
     let mut observer = CliObserver::new(args, scene, &outputs, work);
-    let sppm = (&args.sppm).into();
+    let sppm = SppmOptions {
+        adaptive: args.adaptive.then_some(AdaptiveOptions {
+            threshold: args.adaptive_threshold,
+        }),
+        ..(&args.sppm).into()
+    };
     let out = render::sppm::render_sppm(&gpu, scene, &options, &sppm, &mut observer)?;
     observer.finish()?;
     let written = write_images(&out.image, outputs.images(), &provenance)?;
@@ -385,6 +411,8 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "photons_emitted": out.photons_emitted,
                 "initial_radius": out.initial_radius,
                 "final_largest_radius": out.final_largest_radius,
+                "adaptive_pilot": out.adaptive.as_ref().map(|a| a.0),
+                "adaptive_samples": out.adaptive.as_ref().map(|a| &a.1),
                 "timings": out.timings,
             }),
         })?;
@@ -398,6 +426,15 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
             "SPPM: {} iterations, {} photons emitted, radius {} -> {:.5} (largest)",
             out.iterations, out.photons_emitted, out.initial_radius, out.final_largest_radius
         );
+        if let Some((pilot, s)) = &out.adaptive {
+            let pixels = (options.width * options.height) as u64;
+            eprintln!(
+                "adaptive sampling: after a pilot of {pilot} iterations, the photon half is interpolated at {} of {pixels} pixels and gathered at the other {} ({:.1}%)",
+                s.interpolated,
+                pixels - s.interpolated,
+                100.0 * (pixels - s.interpolated) as f64 / pixels as f64
+            );
+        }
         for (p, _) in &written {
             eprintln!("wrote {p}");
         }
@@ -487,6 +524,21 @@ fn print_summary(
         eprintln!(
             "final gather: {} rays a pixel; {batches} batches, {hits} gather rays reached a diffuse surface, {passes} estimate passes in all",
             g.rays_per_pixel,
+        );
+    }
+    if let (Some(v), Some(s)) = (&out.vpls, out.igi.first()) {
+        eprintln!(
+            "IGI: {} VPLs from {} light paths (bounding distance {}); {:.1} VPL shadow rays at each of {} shading points; caustics {}",
+            v.vpls,
+            v.paths,
+            v.min_distance,
+            s.vpls_per_point,
+            s.shading_points,
+            if out.photons.is_some() {
+                "from the caustic photon map"
+            } else {
+                "none (nothing specular in the scene)"
+            }
         );
     }
     if !out.adaptive.is_empty() {

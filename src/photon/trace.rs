@@ -165,6 +165,33 @@ pub enum RandomSource {
     /// filled on the CPU from the seed (with the hash's own sequence, so both
     /// sources trace the same photons).
     Texture,
+    /// Quasi-random numbers through the same texture (instant radiosity's
+    /// light paths, as Keller and Marques and Santos draw them): photon i's
+    /// number in dimension d is the Halton sequence's point i + 1 in base
+    /// prime(d), rotated by a random offset of the seed (Cranley-Patterson),
+    /// for the first `HALTON_DIMENSIONS` dimensions (the emission and the
+    /// first bounces); later ones take the hash's numbers.
+    Halton,
+}
+
+/// Dimensions drawn from the Halton sequence: every prime base below 256
+/// (the `halton` crate's bases are bytes), 8 numbers a frame.
+pub const HALTON_DIMENSIONS: usize = 48;
+
+/// Photon `photon`'s number in Halton dimension `dim`: the sequence's point
+/// photon + 1 in the dim-th prime base, rotated by the seed's offset for that
+/// dimension (so each seed draws another, equally even, point set).
+pub fn halton_number(seed: u32, dim: usize, photon: usize) -> f32 {
+    const PRIMES: [u8; 54] = [
+        2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89,
+        97, 101, 103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181,
+        191, 193, 197, 199, 211, 223, 227, 229, 233, 239, 241, 251,
+    ];
+    let mut state = crate::random::rng_init(seed, [dim as u32, 0], 0x7000_0000);
+    let offset = crate::random::rng_next(&mut state) as f64;
+    let v = (halton::number(PRIMES[dim], photon + 1) + offset).fract() as f32;
+    // Rounding to f32 may reach 1.0; the shaders expect [0, 1).
+    v.min(1.0 - f32::EPSILON / 2.0)
 }
 
 /// How a `PhotonTracer` traces (fixed when it is made).
@@ -228,7 +255,9 @@ impl PhotonTracer {
     pub fn with_config(gpu: &Gpu, config: TraceConfig) -> Result<Self> {
         let defines: Vec<(&'static str, String)> = match config.random {
             RandomSource::Hash => vec![],
-            RandomSource::Texture => vec![("RANDOM_TEXTURE", "1".into())],
+            RandomSource::Texture | RandomSource::Halton => {
+                vec![("RANDOM_TEXTURE", "1".into())]
+            }
         };
         Ok(Self {
             gpu: gpu.clone(),
@@ -266,6 +295,11 @@ impl PhotonTracer {
                     let base = (row * (width as usize * 2) + x as usize * 2) * 4;
                     for k in 0..RANDOM_PER_PHOTON_FRAME {
                         data[base + k] = rng_next(&mut state);
+                        let dim = f as usize * RANDOM_PER_PHOTON_FRAME + k;
+                        if self.config.random == RandomSource::Halton && dim < HALTON_DIMENSIONS {
+                            let photon = (y * width + x) as usize;
+                            data[base + k] = halton_number(seed, dim, photon);
+                        }
                     }
                 }
             }
@@ -335,7 +369,7 @@ impl PhotonTracer {
         seed: u32,
     ) -> Result<()> {
         let frames = scene.photon_map.max_bounces + 1;
-        if self.config.random == RandomSource::Texture
+        if self.config.random != RandomSource::Hash
             && batch.random.as_ref().map(|r| r.0) != Some(seed)
         {
             let f = &batch.frames;

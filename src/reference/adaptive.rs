@@ -1,6 +1,7 @@
 //! Adaptive sampling on the CPU, the twin of glsl/render/adaptive_plan.glsl,
-//! adaptive_select.frag and adaptive_store.frag: the same levels, plans and
-//! interpolation, with each computed pixel's light taken from a full render.
+//! adaptive_select.frag and adaptive_store.frag (and of adaptive SPPM's fill,
+//! sppm_adaptive_fill.frag): the same levels, plans and interpolation, with
+//! each computed pixel's light taken from a full render.
 //! Pixels are in GL order (row 0 at the bottom), as the lattices are.
 
 use glam::Vec3;
@@ -28,8 +29,28 @@ pub fn adaptive_light(
     computed: &dyn Fn(usize) -> Vec3,
     threshold: f32,
 ) -> (Vec<Vec3>, Vec<(u32, u64, u64)>) {
+    let p = adaptive_pyramid(first, computed, threshold);
+    (p.value, p.levels)
+}
+
+/// The pyramid in full.
+pub struct Pyramid {
+    /// Every pixel's global light.
+    pub value: Vec<Vec3>,
+    /// (stride, computed, interpolated) per level.
+    pub levels: Vec<(u32, u64, u64)>,
+    /// Per pixel: the level (index into `STRIDES`) that interpolates it, or -1.
+    pub interpolated_at: Vec<i32>,
+}
+
+pub fn adaptive_pyramid(
+    first: &FirstHits,
+    computed: &dyn Fn(usize) -> Vec3,
+    threshold: f32,
+) -> Pyramid {
     let (w, h) = (first.width as i32, first.height as i32);
     let mut value = vec![Vec3::ZERO; (w * h) as usize];
+    let mut interpolated_at = vec![-1; (w * h) as usize];
     let mut levels = Vec::new();
     for (level, &stride) in STRIDES.iter().enumerate() {
         let s = stride as i32;
@@ -51,6 +72,7 @@ pub fn adaptive_light(
                 {
                     Some(v) => {
                         next[i] = v;
+                        interpolated_at[i] = level as i32;
                         n_interpolated += 1;
                     }
                     None => {
@@ -63,20 +85,53 @@ pub fn adaptive_light(
         value = next;
         levels.push((stride, n_computed, n_interpolated));
     }
-    (value, levels)
+    Pyramid {
+        value,
+        levels,
+        interpolated_at,
+    }
 }
 
-/// The bilinear light at (x, y) from the coarser lattice (stride 2s) around
-/// it, or None where the corners' geometry or light says compute.
-fn interpolate(
-    first: &FirstHits,
-    value: &[Vec3],
-    x: i32,
-    y: i32,
-    s: i32,
-    threshold: f32,
-) -> Option<Vec3> {
-    let (w, h) = (first.width as i32, first.height as i32);
+/// Adaptive SPPM's image half on a fixed plan: `computed(i)` at every pixel
+/// that no level interpolates, then each level's interpolated pixels from
+/// the corners as they stand (the twin of glsl/render/sppm_adaptive_fill.frag).
+pub fn fill_planned(
+    width: u32,
+    height: u32,
+    interpolated_at: &[i32],
+    computed: &dyn Fn(usize) -> Vec3,
+) -> Vec<Vec3> {
+    let (w, h) = (width as i32, height as i32);
+    let mut value: Vec<Vec3> = (0..(w * h) as usize)
+        .map(|i| {
+            if interpolated_at[i] < 0 {
+                computed(i)
+            } else {
+                Vec3::ZERO
+            }
+        })
+        .collect();
+    for (level, &stride) in STRIDES.iter().enumerate().skip(1) {
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                if interpolated_at[i] == level as i32 {
+                    value[i] = corners(w, h, x, y, stride as i32)
+                        .iter()
+                        .filter(|(_, weight)| *weight != 0.0)
+                        .map(|&(c, weight)| weight * value[c])
+                        .sum();
+                }
+            }
+        }
+    }
+    value
+}
+
+/// The coarser lattice's (stride 2s) corners around (x, y), as pixel
+/// indices, with their bilinear weights; past the image's last lattice row or
+/// column the near corners carry it all.
+fn corners(w: i32, h: i32, x: i32, y: i32, s: i32) -> [(usize, f32); 4] {
     let s2 = 2 * s;
     let (x0, y0) = ((x / s2) * s2, (y / s2) * s2);
     let (x1, y1) = (x0 + s2, y0 + s2);
@@ -90,18 +145,33 @@ fn interpolate(
     } else {
         0.0
     };
-    let i = (y * w + x) as usize;
-    let (mut lo, mut hi, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, Vec3::ZERO);
-    for corner in 0..4 {
+    std::array::from_fn(|corner| {
         let wx = if corner & 1 != 0 { fx } else { 1.0 - fx };
         let wy = if corner & 2 != 0 { fy } else { 1.0 - fy };
-        let weight = wx * wy;
+        let cx = if corner & 1 != 0 { x1 } else { x0 };
+        let cy = if corner & 2 != 0 { y1 } else { y0 };
+        // A zero-weight corner may lie outside the image; it is never read.
+        (((cy * w + cx).max(0)) as usize, wx * wy)
+    })
+}
+
+/// The bilinear light at (x, y) from the coarser lattice (stride 2s) around
+/// it, or None where the corners' geometry or light says compute.
+fn interpolate(
+    first: &FirstHits,
+    value: &[Vec3],
+    x: i32,
+    y: i32,
+    s: i32,
+    threshold: f32,
+) -> Option<Vec3> {
+    let (w, h) = (first.width as i32, first.height as i32);
+    let i = (y * w + x) as usize;
+    let (mut lo, mut hi, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, Vec3::ZERO);
+    for (c, weight) in corners(w, h, x, y, s) {
         if weight == 0.0 {
             continue;
         }
-        let cx = if corner & 1 != 0 { x1 } else { x0 };
-        let cy = if corner & 2 != 0 { y1 } else { y0 };
-        let c = (cy * w + cx) as usize;
         if first.material[c] != first.material[i]
             || first.normal[c].dot(first.normal[i]) < ADAPTIVE_NORMAL_COS
         {

@@ -3,6 +3,7 @@
 pub mod adaptive;
 pub mod bvh;
 pub mod final_gather;
+pub mod igi;
 pub mod intersect;
 pub mod knn;
 pub mod path_trace;

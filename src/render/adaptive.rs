@@ -58,6 +58,13 @@ pub struct AdaptiveStats {
     pub levels: Vec<(u32, u64, u64)>,
 }
 
+/// One level's plan: the pixels (y * width + x) it computes and interpolates.
+#[derive(Clone, Debug, Default)]
+pub struct LevelPlan {
+    pub computed: Vec<u32>,
+    pub interpolated: Vec<u32>,
+}
+
 pub struct Adaptive {
     gpu: Gpu,
     /// The first hits computed at the current level, packed (texel i: the
@@ -107,13 +114,13 @@ impl Adaptive {
     }
 
     /// Plans level `level` (of `STRIDES`) and packs the first hits to compute
-    /// into `packed`. Returns (computed, interpolated).
+    /// into `packed`. Returns the level's pixels, computed and interpolated.
     pub fn select(
         &self,
         direct: &DirectLight,
         level: usize,
         options: &AdaptiveOptions,
-    ) -> Result<(u64, u64)> {
+    ) -> Result<LevelPlan> {
         self.select
             .bind()
             .texture("u_first_position", &direct.diffuse_position)
@@ -123,29 +130,50 @@ impl Adaptive {
             .int("u_coarsest", (level == 0) as i32)
             .float("u_threshold", options.threshold)
             .draw_fullscreen(&self.plan_target, &DrawState::PLAIN)?;
-        let plan = self.plan.read_f32();
-        let n = (self.width * self.height) as usize;
-        let (mut order, mut slot) = (vec![-1i32; n], vec![-1i32; n]);
-        let (mut computed, mut interpolated) = (0usize, 0u64);
-        for (pixel, texel) in plan.chunks(4).enumerate() {
+        let mut plan = LevelPlan::default();
+        for (pixel, texel) in self.plan.read_f32().chunks(4).enumerate() {
             if texel[3] == PLAN_COMPUTE as f32 {
-                order[computed] = pixel as i32;
-                slot[pixel] = computed as i32;
-                computed += 1;
+                plan.computed.push(pixel as u32);
             } else if texel[3] == PLAN_INTERPOLATE as f32 {
-                interpolated += 1;
+                plan.interpolated.push(pixel as u32);
             }
         }
+        self.pack_order(&plan.computed)?;
+        self.pack_hits(direct)?;
+        Ok(plan)
+    }
+
+    /// Sets the packed order: texel i of the packed textures is `pixels[i]`
+    /// (pixel indices, y * width + x), and every other pixel has no slot.
+    pub fn pack_order(&self, pixels: &[u32]) -> Result<()> {
+        let n = (self.width * self.height) as usize;
+        let (mut order, mut slot) = (vec![-1i32; n], vec![-1i32; n]);
+        for (i, &pixel) in pixels.iter().enumerate() {
+            order[i] = pixel as i32;
+            slot[pixel as usize] = i as i32;
+        }
         self.order.upload(&order)?;
-        self.slot.upload(&slot)?;
+        self.slot.upload(&slot)
+    }
+
+    /// Packs `direct`'s first hits of the pixels in the packed order into `packed`.
+    pub fn pack_hits(&self, direct: &DirectLight) -> Result<()> {
         self.pack
             .bind()
             .texture("u_order", &self.order)
             .texture("u_first_position", &direct.diffuse_position)
             .texture("u_first_normal", &direct.diffuse_normal)
             .texture("u_first_throughput", &direct.diffuse_throughput)
-            .draw_fullscreen(&self.packed.target, &DrawState::PLAIN)?;
-        Ok((computed as u64, interpolated))
+            .draw_fullscreen(&self.packed.target, &DrawState::PLAIN)
+    }
+
+    /// Packed texel -> pixel index (-1: none), and pixel -> packed texel.
+    pub fn order(&self) -> &Texture {
+        &self.order
+    }
+
+    pub fn slot(&self) -> &Texture {
+        &self.slot
     }
 
     /// This level's packed first hits, as queries.
@@ -159,6 +187,21 @@ impl Adaptive {
     /// Stores this level's light: computed (the packed `estimate` without
     /// direct light plus the packed `gathered`) or interpolated.
     pub fn store(&self, estimate: Option<&Texture>, gathered: Option<&Texture>) -> Result<()> {
+        self.store_from(estimate, gathered, true)
+    }
+
+    /// Stores this level's light with the computed pixels' light read from
+    /// `light`, a full-resolution image (adaptive SPPM plans on its pilot).
+    pub fn store_unpacked(&self, light: &Texture) -> Result<()> {
+        self.store_from(Some(light), None, false)
+    }
+
+    fn store_from(
+        &self,
+        estimate: Option<&Texture>,
+        gathered: Option<&Texture>,
+        packed: bool,
+    ) -> Result<()> {
         // An absent source is never read; the plan stands in for its sampler.
         let mut b = self.store.bind();
         b.texture("u_plan", &self.plan)
@@ -167,6 +210,7 @@ impl Adaptive {
             .texture("u_gathered", gathered.unwrap_or(&self.plan))
             .int("u_has_estimate", estimate.is_some() as i32)
             .int("u_has_gather", gathered.is_some() as i32)
+            .int("u_packed", packed as i32)
             .draw_fullscreen(&self.value_target, &DrawState::PLAIN)?;
         // Finished here, so that the caller's clock measures the pass.
         self.gpu.finish();

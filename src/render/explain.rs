@@ -75,6 +75,12 @@ impl RenderOutput {
                     ));
                 }
             }
+            (Some(gi), None) if gi.igi.is_some() => lines.push(line(
+                "caustic map, estimate",
+                0,
+                false,
+                "skipped: IGI takes caustics from a caustic photon map, and the scene has no mirror or glass to make them".into(),
+            )),
             (Some(gi), None) if gi.final_gather.is_some() => lines.push(line(
                 "caustic map, estimate",
                 0,
@@ -110,6 +116,39 @@ impl RenderOutput {
                 format!(
                     "the photon map above the gather is the caustic map (specular paths only), visualised at the first hits; the one here is the global map (every diffuse hit), estimated only where {} gather rays a pixel land (k = {}, leak test {:?}): {queries} gather hits in all",
                     fg.rays, fg.k, fg.leak
+                ),
+            ));
+        }
+        if let (Some(o), Some(v)) = (&gi.igi, &self.vpls) {
+            let passes: u32 = self.igi.iter().map(|s| s.passes).sum();
+            lines.push(line(
+                "IGI VPLs",
+                0,
+                true,
+                format!(
+                    "{} VPLs at the diffuse hits of {} Halton light paths (traced by the photon passes, compacted by the HistoPyramid); the photon map above, if any, is a caustic map: VPLs reach the first hit only straight from a diffuse surface, so IGI alone has no caustics",
+                    v.vpls, v.paths
+                ),
+            ));
+            lines.push(line(
+                "IGI gather",
+                passes as usize,
+                true,
+                format!(
+                    "every shading point sums {} with the geometry term bounded at {} and a shadow ray each ({}), {} VPLs a pass; {}",
+                    if o.interleave > 1 {
+                        format!("1 of {} VPL subsets (interleaved sampling, merged by the discontinuity buffer)", o.interleave * o.interleave)
+                    } else {
+                        "every VPL".to_string()
+                    },
+                    v.min_distance,
+                    if o.imperfect_visibility { "against primitive bounding boxes: imperfect visibility" } else { "exact visibility" },
+                    crate::layout::VPL_BATCH,
+                    if o.downsample > 1 {
+                        format!("shading points at one pixel per {0} x {0} block, joint-bilateral upsampled", o.downsample)
+                    } else {
+                        "at every pixel".to_string()
+                    }
                 ),
             ));
         }

@@ -7,6 +7,7 @@ pub mod adaptive;
 pub mod direct;
 pub mod explain;
 pub mod final_gather;
+pub mod igi;
 pub mod observer;
 pub mod plan;
 pub mod radiance_estimate;
@@ -14,6 +15,7 @@ pub mod ray_rates;
 pub mod ray_trace;
 pub mod software;
 pub mod sppm;
+pub mod sppm_adaptive;
 
 use crate::error::Error;
 use crate::gpu::{Gpu, Result};
@@ -27,6 +29,7 @@ pub use adaptive::{Adaptive, AdaptiveOptions, AdaptiveStats};
 pub use direct::DirectLight;
 pub use explain::ExplainLine;
 pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
+pub use igi::{Igi, IgiOptions, IgiStats, VplReport, Vpls};
 pub use observer::{EstimatePass, Progress, RenderObserver};
 pub use plan::PassPlan;
 pub use radiance_estimate::{
@@ -60,6 +63,9 @@ pub struct GlobalIllumination {
     /// Adaptive sampling (section 4.5): global light computed on a pyramid of
     /// pixel lattices and interpolated where it is smooth.
     pub adaptive: Option<AdaptiveOptions>,
+    /// Instant global illumination (`--method igi`): VPLs for the diffuse
+    /// interreflection, and the photon map for caustics only.
+    pub igi: Option<IgiOptions>,
 }
 
 impl RenderOptions {
@@ -97,6 +103,9 @@ pub struct RenderOutput {
     pub gathers: Vec<GatherStats>,
     /// Each eye sample's adaptive sampling.
     pub adaptive: Vec<AdaptiveStats>,
+    /// IGI's VPLs, and each eye sample's gather.
+    pub vpls: Option<VplReport>,
+    pub igi: Vec<IgiStats>,
     /// The last radiance estimate, and every one (view by view, sample by sample).
     pub estimate: Option<EstimateStats>,
     pub estimates: Vec<EstimateStats>,
@@ -123,6 +132,9 @@ pub struct RenderState {
     /// Final gather's global map, and its textures (the last batch's gather hits).
     pub gather_map: Option<PhotonMap>,
     pub gather: Option<FinalGather>,
+    /// IGI's VPLs and gather textures (the last eye sample's).
+    pub vpls: Option<Vpls>,
+    pub igi: Option<Igi>,
 }
 
 /// Renders a scene: the paper's ray tracer (direct light, specular paths) and,
@@ -195,6 +207,7 @@ pub fn render_views(
             )?;
             let frame = SampleFrame {
                 scene,
+                camera_position: camera.position,
                 textures: &textures,
                 direct: &direct,
                 options,
@@ -216,6 +229,9 @@ pub fn render_views(
         estimates,
         gathers,
         adaptive,
+        vpls,
+        igi,
+        igi_stats,
         ..
     } = global;
     let mut output = finish(
@@ -232,6 +248,8 @@ pub fn render_views(
             estimate,
             gather_map: None,
             gather,
+            vpls: None,
+            igi: None,
         },
     );
     if let Some(g) = global_map {
@@ -240,6 +258,19 @@ pub fn render_views(
     }
     output.gathers = gathers;
     output.adaptive = adaptive;
+    output.vpls = vpls.as_ref().map(|v| VplReport {
+        paths: v.paths,
+        vpls: v.count,
+        frames_traced: v.frames_traced,
+        min_distance: options
+            .global
+            .as_ref()
+            .and_then(|g| g.igi.as_ref())
+            .map_or(0.0, |o| o.min_distance_for(scene)),
+    });
+    output.igi = igi_stats;
+    output.state.vpls = vpls;
+    output.state.igi = igi;
     Ok(output)
 }
 
@@ -247,6 +278,8 @@ pub fn render_views(
 #[derive(Clone, Copy)]
 struct SampleFrame<'a> {
     scene: &'a Scene,
+    /// The eye (IGI's discontinuity buffer measures depth from it).
+    camera_position: glam::Vec3,
     textures: &'a SceneTextures,
     direct: &'a DirectLight,
     options: &'a RenderOptions,
@@ -265,6 +298,10 @@ struct GlobalPart {
     gathers: Vec<GatherStats>,
     pyramid: Option<Adaptive>,
     adaptive: Vec<AdaptiveStats>,
+    /// IGI's VPLs and gather, and each eye sample's report.
+    vpls: Option<Vpls>,
+    igi: Option<Igi>,
+    igi_stats: Vec<IgiStats>,
 }
 
 impl GlobalPart {
@@ -301,6 +338,26 @@ impl GlobalPart {
             .global
             .as_ref()
             .is_some_and(|g| g.adaptive.is_some());
+        let (vpls, igi) = match options.global.as_ref().and_then(|g| g.igi.as_ref()) {
+            None => (None, None),
+            Some(o) => {
+                if adaptive
+                    || options
+                        .global
+                        .as_ref()
+                        .is_some_and(|g| g.final_gather.is_some())
+                {
+                    return Err(Error::InvalidOption(
+                        "IGI has its own accelerations (--interleave, --downsample): drop --adaptive and --final-gather".into(),
+                    ));
+                }
+                let igi = Igi::new(gpu, scene, w, h, o)?;
+                observer.progress(&Progress::stage("VPLs", 0, 1));
+                let seed = crate::random::pcg_hash(options.seed ^ crate::layout::VPL_STREAM);
+                let vpls = Vpls::trace(gpu, scene, textures, o.vpl_paths, seed, timings)?;
+                (Some(vpls), Some(igi))
+            }
+        };
         Ok(Self {
             built,
             global_map,
@@ -310,6 +367,9 @@ impl GlobalPart {
             gathers: Vec::new(),
             pyramid: adaptive.then(|| Adaptive::new(gpu, w, h)).transpose()?,
             adaptive: Vec::new(),
+            vpls,
+            igi,
+            igi_stats: Vec::new(),
         })
     }
 
@@ -335,7 +395,9 @@ impl GlobalPart {
         let mut stats = AdaptiveStats::default();
         for level in 0..adaptive::STRIDES.len() {
             let t0 = std::time::Instant::now();
-            let (computed, interpolated) = pyramid.select(f.direct, level, &options)?;
+            let plan = pyramid.select(f.direct, level, &options)?;
+            let (computed, interpolated) =
+                (plan.computed.len() as u64, plan.interpolated.len() as u64);
             timings.add_both("adaptive plan", 0.0, t0.elapsed().as_secs_f64(), 2);
             if computed > 0 {
                 // The estimate and gather run on the packed first hits.
@@ -419,6 +481,24 @@ impl GlobalPart {
                 image.add(&gather.read_indirect());
             }
         }
+        if let (Some(vpls), Some(igi)) = (&self.vpls, &self.igi) {
+            let at = f.at;
+            let eye = f.camera_position;
+            let stats = igi.run(
+                f.textures,
+                f.direct,
+                vpls,
+                eye,
+                timings,
+                &mut |done, total| {
+                    observer.progress(&Progress::at("VPL gather", done as u64, total as u64, at))
+                },
+            )?;
+            self.igi_stats.push(stats);
+            if let Some(image) = &mut image {
+                image.add(&igi.read_indirect());
+            }
+        }
         Ok(image)
     }
 }
@@ -463,6 +543,8 @@ fn finish(
         gather_photons: None,
         gathers: Vec::new(),
         adaptive: Vec::new(),
+        vpls: None,
+        igi: Vec::new(),
         estimate: estimates.last().cloned(),
         estimates,
     }
@@ -495,6 +577,19 @@ fn build_maps(
     seed: u32,
     timings: &mut Timings,
 ) -> Result<(Option<BuiltMap>, Option<BuiltMap>)> {
+    if gi.igi.is_some() {
+        // IGI's VPLs carry the diffuse interreflection; the photon map only
+        // the caustics, which VPLs cannot (light through glass or off a mirror
+        // onto the first hit), and none in a scene with nothing specular.
+        if !scene.has_specular() {
+            return Ok((None, None));
+        }
+        let mut caustic = scene.clone();
+        caustic.photon_map.caustics_only = true;
+        caustic.photon_map.store_direct = false;
+        let map = photon::build_map(gpu, &caustic, textures, &gi.photons, seed, timings)?;
+        return Ok((Some(map), None));
+    }
     if gi.final_gather.is_none() {
         let map = photon::build_map(gpu, scene, textures, &gi.photons, seed, timings)?;
         return Ok((Some(map), None));

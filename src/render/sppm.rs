@@ -25,7 +25,10 @@ use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 use crate::timing::Timings;
 
+use super::adaptive::{AdaptiveOptions, AdaptiveStats};
 use super::radiance_estimate::LeakTest;
+pub use super::sppm_adaptive::SppmState;
+use super::sppm_adaptive::{default_pilot, SppmAdaptive};
 use super::{
     trace_eye_paths, At, DirectLight, EstimatePass, ExplainLine, EyeSample, Image, PassPlan,
     Progress, RayTracer, RenderObserver, RenderOptions,
@@ -57,6 +60,11 @@ pub struct SppmOptions {
     pub direct: DirectLighting,
     /// Shadow rays per area light per iteration.
     pub shadow_rays: u32,
+    /// Adaptive sampling (`sppm_adaptive.rs`): after the pilot, the gather
+    /// runs only where the pyramid's plan computes.
+    pub adaptive: Option<AdaptiveOptions>,
+    /// Iterations at every pixel before the plan (default: an eighth).
+    pub adaptive_pilot: Option<u32>,
 }
 
 impl Default for SppmOptions {
@@ -70,6 +78,8 @@ impl Default for SppmOptions {
             max_bounces: 32,
             direct: DirectLighting::ShadowRays,
             shadow_rays: 1,
+            adaptive: None,
+            adaptive_pilot: None,
         }
     }
 }
@@ -84,15 +94,6 @@ const MAX_CELLS_ROUTED: u64 = 1 << 18;
 /// stale maximum is still an upper bound).
 fn reads_radius(iteration: u32) -> bool {
     iteration.is_power_of_two() || iteration.is_multiple_of(64)
-}
-
-/// Per-pixel SPPM state, updated in place.
-pub struct SppmState {
-    /// tau.rgb (flux already weighted by BRDF and path), w = R^2.
-    pub flux: Texture,
-    /// Sum of direct light .rgb, w = N (photons gathered, alpha-weighted).
-    pub sums: Texture,
-    target: Target,
 }
 
 enum Builder {
@@ -133,6 +134,8 @@ pub struct Sppm {
     pub grid: Option<Grid>,
     /// The leak tests the gather applies.
     pub leak: LeakTest,
+    /// Adaptive sampling's plan and packed state (`--adaptive`).
+    pub adaptive: Option<SppmAdaptive>,
 }
 
 impl Sppm {
@@ -169,16 +172,33 @@ impl Sppm {
             }
         };
         let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
-        let (flux, sums) = (t()?, t()?);
+        let adaptive = match &sppm.adaptive {
+            None => None,
+            Some(a) => {
+                let pilot = sppm
+                    .adaptive_pilot
+                    .unwrap_or(default_pilot(sppm.iterations));
+                if pilot == 0 || pilot >= sppm.iterations {
+                    return Err(Error::InvalidOption(format!(
+                        "adaptive SPPM plans after a pilot of {pilot} iteration(s) and needs iterations after it: the pilot's allowed range is 1..={} for --iterations {}",
+                        sppm.iterations.saturating_sub(1),
+                        sppm.iterations
+                    )));
+                }
+                Some(SppmAdaptive::new(gpu, w, h, a.clone(), pilot)?)
+            }
+        };
         let initial_radius = sppm.initial_radius.unwrap_or(scene.photon_map.max_radius);
         if !(initial_radius > 0.0 && initial_radius.is_finite()) {
             return Err(Error::InvalidOption(format!(
                 "--radius {initial_radius}: the first radius must be a positive number"
             )));
         }
-        let state_target = Target::new(gpu, &[&flux, &sums])?;
-        flux.upload(&[0.0, 0.0, 0.0, initial_radius * initial_radius].repeat((w * h) as usize))?;
-        sums.upload(&vec![0f32; (w * h * 4) as usize])?;
+        let state = SppmState::new(gpu, w, h)?;
+        state
+            .flux
+            .upload(&[0.0, 0.0, 0.0, initial_radius * initial_radius].repeat((w * h) as usize))?;
+        state.sums.upload(&vec![0f32; (w * h * 4) as usize])?;
         let image = t()?;
         let image_target = Target::new(gpu, &[&image])?;
         Ok(Self {
@@ -192,11 +212,7 @@ impl Sppm {
             batch,
             builder,
             storage: config.storage(sppm.photons_per_iteration),
-            state: SppmState {
-                flux,
-                sums,
-                target: state_target,
-            },
+            state,
             update: Program::fullscreen_with(gpu, "render/sppm_update.frag", &{
                 let mut d = leak.defines();
                 if config.build == BuildMethod::Stencil {
@@ -217,6 +233,7 @@ impl Sppm {
             leak,
             textures,
             scene,
+            adaptive,
         })
     }
 
@@ -233,6 +250,19 @@ impl Sppm {
     ) -> Result<()> {
         let i = self.iteration + 1;
         let seed = crate::random::sample_seed(self.seed, i);
+        if self
+            .adaptive
+            .as_ref()
+            .is_some_and(|a| a.planned.is_none() && self.iteration == a.pilot)
+        {
+            // Before this iteration's eye paths replace the pilot's first hits.
+            let wall = std::time::Instant::now();
+            self.compose(false, true)?;
+            let a = self.adaptive.as_mut().expect("adaptive");
+            a.plan(&self.direct, &self.image, &self.state)?;
+            self.gpu.finish();
+            timings.add_both("adaptive plan", 0.0, wall.elapsed().as_secs_f64(), 12);
+        }
         let at = At {
             view: 0,
             views: 1,
@@ -310,8 +340,41 @@ impl Sppm {
         }
     }
 
-    /// The gather at each visible point and the in-place update.
+    /// The gather at each visible point and the in-place update; adaptive
+    /// after the pilot, direct light at every pixel and the gather at the
+    /// packed computed pixels.
     fn gather_and_update(&self, map: &PhotonMap, grid: &Grid) -> Result<()> {
+        let planned = self
+            .adaptive
+            .as_ref()
+            .and_then(|a| Some((a, a.planned.as_ref()?)));
+        let Some((adaptive, planned)) = planned else {
+            return self.update(map, grid, &self.state, &self.direct, true, None);
+        };
+        self.update(map, grid, &self.state, &self.direct, false, None)?;
+        adaptive.pyramid.pack_hits(&self.direct)?;
+        let rows = Some(planned.rows as i32);
+        self.update(
+            map,
+            grid,
+            &planned.state,
+            &adaptive.pyramid.packed,
+            true,
+            rows,
+        )
+    }
+
+    /// One update pass over `state` at the visible points `hits`, on its
+    /// first `rows` rows (all when None); `gather` false adds direct light only.
+    fn update(
+        &self,
+        map: &PhotonMap,
+        grid: &Grid,
+        state: &SppmState,
+        hits: &DirectLight,
+        gather: bool,
+        rows: Option<i32>,
+    ) -> Result<()> {
         let mut b = self.update.bind();
         self.textures.bind(&mut b);
         match map {
@@ -334,34 +397,47 @@ impl Sppm {
             }
         }
         grid.bind(&mut b);
-        let d = &self.direct;
-        b.texture("u_state_flux", &self.state.flux)
-            .texture("u_state_direct", &self.state.sums)
+        let d = hits;
+        b.texture("u_state_flux", &state.flux)
+            .texture("u_state_direct", &state.sums)
             .texture("u_direct", &d.radiance)
             .texture("u_diffuse_position", &d.diffuse_position)
             .texture("u_diffuse_normal", &d.diffuse_normal)
             .texture("u_diffuse_throughput", &d.diffuse_throughput)
             .float("u_alpha", self.options.alpha)
             .float("u_first_radius2", self.cell * self.cell)
-            .int("u_gather", 1);
+            .int("u_gather", gather as i32);
         if matches!(self.leak, LeakTest::Disc | LeakTest::DiscAndVisibility) {
             b.float("u_disc_radius", self.initial_radius);
         }
-        b.draw_fullscreen(&self.state.target, &DrawState::PLAIN)?;
+        match rows {
+            None => b.draw_fullscreen(&state.target, &DrawState::PLAIN)?,
+            Some(rows) => b.draw_region(
+                &state.target,
+                &DrawState::PLAIN,
+                [0, 0, state.flux.width as i32, rows],
+            )?,
+        }
         // The next iteration reads what this one wrote.
         self.gpu.texture_barrier();
         Ok(())
     }
 
     /// The largest radius among pixels that have gathered photons (a max
-    /// reduction on the GPU, one float read back); 0 if none has.
+    /// reduction on the GPU, one float read back); 0 if none has. Adaptive,
+    /// after the pilot: among the computed pixels (the others' radii no
+    /// longer shrink, and no longer gather).
     pub fn largest_radius(&self) -> Result<f32> {
-        let (mut w, mut h) = (self.state.flux.width, self.state.flux.height);
+        let state = match self.adaptive.as_ref().and_then(|a| a.planned.as_ref()) {
+            Some(p) => &p.state,
+            None => &self.state,
+        };
+        let (mut w, mut h) = (state.flux.width, state.flux.height);
         let mut level = Texture::new(&self.gpu, w, h, TexFormat::R32F)?;
         self.radius
             .bind()
-            .texture("u_state_flux", &self.state.flux)
-            .texture("u_state_direct", &self.state.sums)
+            .texture("u_state_flux", &state.flux)
+            .texture("u_state_direct", &state.sums)
             .draw_fullscreen(&Target::new(&self.gpu, &[&level])?, &DrawState::PLAIN)?;
         while w > 1 || h > 1 {
             (w, h) = (w.div_ceil(2), h.div_ceil(2));
@@ -377,19 +453,35 @@ impl Sppm {
 
     /// The image after the iterations so far (direct and photon halves as chosen).
     pub fn image_parts(&self, include_direct: bool, include_indirect: bool) -> Result<Image> {
-        self.compose
-            .bind()
-            .texture("u_state_flux", &self.state.flux)
-            .texture("u_state_direct", &self.state.sums)
-            .float("u_iterations", self.iteration.max(1) as f32)
-            .int("u_include_direct", include_direct as i32)
-            .int("u_include_indirect", include_indirect as i32)
-            .draw_fullscreen(&self.image_target, &DrawState::PLAIN)?;
+        self.compose(include_direct, include_indirect)?;
         Ok(Image::from_gl_rgba(
             self.image.width,
             self.image.height,
             &self.image.read_f32(),
         ))
+    }
+
+    /// Composes the image into `self.image` (on the GPU only).
+    fn compose(&self, include_direct: bool, include_indirect: bool) -> Result<()> {
+        let filled = match self.adaptive.as_ref() {
+            Some(a) if a.planned.is_some() && include_indirect => Some(a.fill(self.iteration)?),
+            _ => None,
+        };
+        self.compose
+            .bind()
+            .texture("u_state_flux", &self.state.flux)
+            .texture("u_state_direct", &self.state.sums)
+            .texture("u_indirect", filled.unwrap_or(&self.state.flux))
+            .int("u_adaptive", filled.is_some() as i32)
+            .float("u_iterations", self.iteration.max(1) as f32)
+            .int("u_include_direct", include_direct as i32)
+            .int("u_include_indirect", include_indirect as i32)
+            .draw_fullscreen(&self.image_target, &DrawState::PLAIN)
+    }
+
+    /// Adaptive sampling's plan counts, once planned.
+    pub fn adaptive_stats(&self) -> Option<&AdaptiveStats> {
+        Some(&self.adaptive.as_ref()?.planned.as_ref()?.stats)
     }
 
     pub fn image(&self) -> Result<Image> {
@@ -429,6 +521,9 @@ pub struct SppmOutput {
     /// The largest radius among pixels that gathered photons, at the end.
     pub final_largest_radius: f32,
     pub explain: Vec<ExplainLine>,
+    /// Adaptive sampling: the pilot's length and the plan's counts (None
+    /// when not adaptive, or stopped before the plan).
+    pub adaptive: Option<(u32, AdaptiveStats)>,
 }
 
 /// Renders `scene` by SPPM: iterations until `sppm.iterations` or
@@ -495,7 +590,11 @@ pub fn render_sppm(
     observer.frame(0, &image)?;
     let final_largest_radius = run.largest_radius()?;
     let explain = explain(&run, sppm);
+    let adaptive = run
+        .adaptive_stats()
+        .map(|s| (run.adaptive.as_ref().expect("adaptive").pilot, s.clone()));
     Ok(SppmOutput {
+        adaptive,
         image,
         timings,
         iterations: run.iteration,
@@ -558,6 +657,29 @@ fn explain(run: &Sppm, o: &SppmOptions) -> Vec<ExplainLine> {
                 g.resolution[0], g.resolution[1], g.resolution[2], run.cell
             ),
         ));
+    }
+    if let Some(a) = &run.adaptive {
+        lines.push(match (&a.planned, run.adaptive_stats()) {
+            (Some(p), Some(s)) => line(
+                "adaptive plan",
+                12,
+                format!(
+                    "after a pilot of {} iterations at every pixel, the pyramid (strides 8, 4, 2, 1, threshold {}) on the pilot's photon half: {} pixels interpolated, {} go on gathering ({:.1}% of the image), packed into {} rows",
+                    a.pilot,
+                    a.options.threshold,
+                    s.interpolated,
+                    p.computed.len(),
+                    100.0 * p.computed.len() as f64 / (run.image.width * run.image.height) as f64,
+                    p.rows
+                ),
+            ),
+            _ => ExplainLine {
+                stage: "adaptive plan".into(),
+                passes: 0,
+                ran: false,
+                why: format!("the render stopped within its pilot of {} iterations", a.pilot),
+            },
+        });
     }
     lines.push(line(
         "gather + update",

@@ -1,0 +1,436 @@
+//! Instant global illumination (Keller's instant radiosity as Wald et al.
+//! made it interactive; Marques and Santos's OptiX version with its three
+//! accelerations), as a second method beside photon mapping on the same
+//! passes:
+//!
+//! 1. **VPLs.** Light paths are traced by the photon passes with quasi-random
+//!    (Halton) numbers; every diffuse hit, the first included, is a virtual
+//!    point light with the power that arrived there. The bitonic build's
+//!    HistoPyramid compacts the stored records and `igi_vpls` turns each into
+//!    a VPL texel (position, normal, intensity).
+//! 2. **Gather.** At each pixel's first diffuse hit, `igi_gather` sums the
+//!    VPLs with the bounded geometry term and a shadow ray each, in batches
+//!    of `VPL_BATCH` VPLs a pass (additive), as incident light.
+//! 3. **Accelerations** (each a switch): imperfect visibility (shadow rays
+//!    against primitive bounding boxes, `PRIMITIVE_BOXES` in
+//!    glsl/common/scene.glsl); interleaved sampling over n x n VPL subsets
+//!    with the discontinuity buffer (`igi_interleave`); downsampling by a
+//!    factor with joint bilateral upsampling (`igi_upsample`).
+//! 4. **The image**: direct light and specular paths from the ray tracer,
+//!    caustics from a caustic photon map (IGI has none of its own: VPL light
+//!    reaches x only straight from a diffuse surface), and
+//!    throughput x albedo / pi x the incident light.
+
+use crate::error::Error;
+use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
+use crate::layout::{PRIMITIVE_BOX_ROW, VPL_BATCH};
+use crate::photon::{BitonicBuild, Grid, PhotonTracer, RandomSource, TraceConfig};
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+
+use super::{DirectLight, Image, Timings};
+
+/// How IGI runs.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct IgiOptions {
+    /// Light paths traced; each leaves a VPL at every diffuse hit.
+    pub vpl_paths: u32,
+    /// Marques and Santos's bounding distance m of the geometry term (VPLs
+    /// nearer than 0.8 m give nothing, beyond 1.2 m all); 0: unbounded.
+    /// None: the scene's photon_map.max_radius.
+    pub min_distance: Option<f32>,
+    /// VPL shadow rays against primitive bounding boxes.
+    pub imperfect_visibility: bool,
+    /// n: n x n VPL subsets over pixel blocks (1: every pixel sees every VPL).
+    pub interleave: u32,
+    /// The gather at one pixel per f x f block, upsampled (1: full resolution).
+    pub downsample: u32,
+}
+
+impl Default for IgiOptions {
+    /// 64 paths (about the paper's 180 VPLs in the Cornell box); no
+    /// acceleration: the paper's canonical version.
+    fn default() -> Self {
+        Self {
+            vpl_paths: 64,
+            min_distance: None,
+            imperfect_visibility: false,
+            interleave: 1,
+            downsample: 1,
+        }
+    }
+}
+
+impl IgiOptions {
+    /// The bounding distance in use for `scene`.
+    pub fn min_distance_for(&self, scene: &Scene) -> f32 {
+        self.min_distance.unwrap_or(scene.photon_map.max_radius)
+    }
+
+    pub fn check(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::InvalidOption(what));
+        if !(1..=1 << 20).contains(&self.vpl_paths) {
+            return bad(format!(
+                "--vpl-paths {}: the allowed range is 1..=1048576",
+                self.vpl_paths
+            ));
+        }
+        if !(1..=8).contains(&self.interleave) {
+            return bad(format!(
+                "--interleave {}: the allowed range is 1..=8 (n x n subsets)",
+                self.interleave
+            ));
+        }
+        if !(1..=16).contains(&self.downsample) {
+            return bad(format!(
+                "--downsample {}: the allowed range is 1..=16",
+                self.downsample
+            ));
+        }
+        if let Some(m) = self.min_distance {
+            if !(m >= 0.0 && m.is_finite()) {
+                return bad(format!(
+                    "--vpl-min-distance {m}: give a distance of 0 (unbounded) or more"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The VPLs of a render.
+pub struct Vpls {
+    /// xyz, w = 1 where a VPL; normal; intensity (power x albedo / pi).
+    pub position: Texture,
+    pub normal: Texture,
+    pub intensity: Texture,
+    pub count: u32,
+    pub paths: u32,
+    /// Bounce passes the paths took before every one had ended.
+    pub frames_traced: u32,
+}
+
+/// What the VPL stage did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct VplReport {
+    pub paths: u32,
+    pub vpls: u32,
+    pub frames_traced: u32,
+    pub min_distance: f32,
+}
+
+impl Vpls {
+    /// Traces `paths` light paths through `scene` (every diffuse hit stored)
+    /// and makes their VPLs.
+    pub fn trace(
+        gpu: &Gpu,
+        scene: &Scene,
+        textures: &SceneTextures,
+        paths: u32,
+        seed: u32,
+        timings: &mut Timings,
+    ) -> Result<Self> {
+        let mut s = scene.clone();
+        s.photon_map.caustics_only = false;
+        s.photon_map.store_direct = true;
+        let wall = std::time::Instant::now();
+        let tracer = PhotonTracer::with_config(
+            gpu,
+            TraceConfig {
+                random: RandomSource::Halton,
+                stop_when_dead: true,
+                projection_maps: false,
+            },
+        )?;
+        let frames = tracer.trace(&s, textures, seed, paths)?;
+        gpu.finish();
+        timings.add_both(
+            "VPL paths",
+            frames.gpu_seconds,
+            wall.elapsed().as_secs_f64(),
+            frames.frames as usize,
+        );
+        let wall = std::time::Instant::now();
+        // One cell: the compaction only needs the stored records' indices.
+        let grid = Grid::over_scene(&s, f32::INFINITY, 1);
+        let (pairs, count) = BitonicBuild::new(gpu)?.compacted_pairs(&frames, &grid)?;
+        if count == 0 {
+            return Err(Error::InvalidOption(format!(
+                "{paths} VPL paths left no VPL in {} (no light reached a diffuse surface): trace more with --vpl-paths",
+                scene.name
+            )));
+        }
+        let t = || Texture::new(gpu, pairs.width, pairs.height, TexFormat::Rgba32F);
+        let (position, normal, intensity) = (t()?, t()?, t()?);
+        let target = Target::new(gpu, &[&position, &normal, &intensity])?;
+        let program = Program::fullscreen(gpu, "render/igi_vpls.frag")?;
+        let mut b = program.bind();
+        textures.bind(&mut b);
+        b.texture("u_pairs", &pairs)
+            .int("u_count", count as i32)
+            .texture("u_position", &frames.position)
+            .texture("u_power", &frames.power)
+            .texture("u_incoming", &frames.incoming)
+            .texture("u_outgoing", &frames.outgoing)
+            .int("u_record_width", frames.width as i32)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
+        drop(b);
+        gpu.finish();
+        timings.add_both("VPLs", 0.0, wall.elapsed().as_secs_f64(), 1);
+        gpu.check("VPLs")?;
+        Ok(Self {
+            position,
+            normal,
+            intensity,
+            count,
+            paths,
+            frames_traced: frames.frames,
+        })
+    }
+
+    /// Every VPL read back: (position, normal, intensity) (for tests).
+    pub fn read(&self) -> Vec<([f32; 3], [f32; 3], [f32; 3])> {
+        let (p, n, i) = (
+            self.position.read_f32(),
+            self.normal.read_f32(),
+            self.intensity.read_f32(),
+        );
+        (0..self.count as usize)
+            .map(|k| {
+                let v = |a: &[f32]| [a[4 * k], a[4 * k + 1], a[4 * k + 2]];
+                (v(&p), v(&n), v(&i))
+            })
+            .collect()
+    }
+}
+
+/// What one eye sample's gather did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct IgiStats {
+    pub vpls: u32,
+    pub passes: u32,
+    /// Shading points (pixels, or downsampled blocks) with a diffuse hit.
+    pub shading_points: u64,
+    /// VPL shadow rays per shading point: VPLs / subsets.
+    pub vpls_per_point: f64,
+}
+
+/// IGI's textures and programs at one image size.
+pub struct Igi {
+    gpu: Gpu,
+    options: IgiOptions,
+    min_distance: f32,
+    /// The gather's incident light, and after the discontinuity buffer.
+    pub incident: Texture,
+    incident_target: Target,
+    filtered: Texture,
+    filtered_target: Target,
+    /// Reflected indirect light at full resolution.
+    pub indirect: Texture,
+    indirect_target: Target,
+    gather: Program,
+    interleave: Program,
+    upsample: Program,
+    boxes: Option<Texture>,
+    width: u32,
+    height: u32,
+}
+
+impl Igi {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &IgiOptions,
+    ) -> Result<Self> {
+        options.check()?;
+        let f = options.downsample;
+        let (lw, lh) = (width.div_ceil(f), height.div_ceil(f));
+        let low = || Texture::new(gpu, lw, lh, TexFormat::Rgba32F);
+        let (incident, filtered) = (low()?, low()?);
+        let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let defines: Vec<(&str, String)> = if options.imperfect_visibility {
+            vec![("PRIMITIVE_BOXES", "1".into())]
+        } else {
+            vec![]
+        };
+        let boxes = options
+            .imperfect_visibility
+            .then(|| primitive_boxes(gpu, scene))
+            .transpose()?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            options: options.clone(),
+            min_distance: options.min_distance_for(scene),
+            incident_target: Target::new(gpu, &[&incident])?,
+            filtered_target: Target::new(gpu, &[&filtered])?,
+            indirect_target: Target::new(gpu, &[&indirect])?,
+            incident,
+            filtered,
+            indirect,
+            gather: Program::fullscreen_with(gpu, "render/igi_gather.frag", &defines)?,
+            interleave: Program::fullscreen(gpu, "render/igi_interleave.frag")?,
+            upsample: Program::fullscreen(gpu, "render/igi_upsample.frag")?,
+            boxes,
+            width,
+            height,
+        })
+    }
+
+    /// The indirect light of one eye sample at `direct`'s first hits, left in
+    /// `indirect`. Adds "VPL gather", "discontinuity buffer" and "upsample"
+    /// to `timings`.
+    pub fn run(
+        &self,
+        textures: &SceneTextures,
+        direct: &DirectLight,
+        vpls: &Vpls,
+        eye: glam::Vec3,
+        timings: &mut Timings,
+        on_batch: &mut dyn FnMut(u32, u32),
+    ) -> Result<IgiStats> {
+        let o = &self.options;
+        self.incident_target.clear([0.0; 4]);
+        let mut stats = IgiStats {
+            vpls: vpls.count,
+            vpls_per_point: vpls.count as f64 / (o.interleave * o.interleave) as f64,
+            ..Default::default()
+        };
+        // Each batch holds VPL_BATCH VPLs of every subset: a pixel's share
+        // per pass stays VPL_BATCH whatever the interleave.
+        let per_pass = VPL_BATCH * o.interleave * o.interleave;
+        let mut first = 0;
+        self.gpu.finish();
+        let t0 = std::time::Instant::now();
+        while first < vpls.count {
+            crate::interrupt::check()?;
+            let end = (first + per_pass).min(vpls.count);
+            let mut b = self.gather.bind();
+            textures.bind(&mut b);
+            if let Some(boxes) = &self.boxes {
+                b.texture("u_primitive_boxes", boxes);
+            }
+            b.texture("u_diffuse_position", &direct.diffuse_position)
+                .texture("u_diffuse_normal", &direct.diffuse_normal)
+                .texture("u_vpl_position", &vpls.position)
+                .texture("u_vpl_normal", &vpls.normal)
+                .texture("u_vpl_intensity", &vpls.intensity)
+                .int("u_vpl_width", vpls.position.width as i32)
+                .int("u_first", first as i32)
+                .int("u_end", end as i32)
+                .int("u_scale", o.downsample as i32)
+                .int("u_interleave", o.interleave as i32)
+                .float("u_min_distance", self.min_distance)
+                .draw_fullscreen(&self.incident_target, &DrawState::ADDITIVE)?;
+            drop(b);
+            // Bounded work per submission (llvmpipe runs a pass at once).
+            self.gpu.finish();
+            stats.passes += 1;
+            first = end;
+            on_batch(first, vpls.count);
+        }
+        timings.add_both(
+            "VPL gather",
+            0.0,
+            t0.elapsed().as_secs_f64(),
+            stats.passes as usize,
+        );
+        let mut incident = &self.incident;
+        if o.interleave > 1 {
+            let t0 = std::time::Instant::now();
+            self.interleave
+                .bind()
+                .texture("u_incident", &self.incident)
+                .texture("u_diffuse_position", &direct.diffuse_position)
+                .texture("u_diffuse_normal", &direct.diffuse_normal)
+                .vec3("u_eye", eye.to_array())
+                .int("u_scale", o.downsample as i32)
+                .int("u_interleave", o.interleave as i32)
+                .draw_fullscreen(&self.filtered_target, &DrawState::PLAIN)?;
+            self.gpu.finish();
+            timings.add_both("discontinuity buffer", 0.0, t0.elapsed().as_secs_f64(), 1);
+            incident = &self.filtered;
+        }
+        let t0 = std::time::Instant::now();
+        let mut b = self.upsample.bind();
+        textures.bind(&mut b);
+        b.texture("u_incident", incident)
+            .texture("u_diffuse_position", &direct.diffuse_position)
+            .texture("u_diffuse_normal", &direct.diffuse_normal)
+            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
+            .int("u_scale", o.downsample as i32)
+            .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
+        drop(b);
+        self.gpu.finish();
+        timings.add_both(
+            if o.downsample > 1 {
+                "upsample"
+            } else {
+                "VPL compose"
+            },
+            0.0,
+            t0.elapsed().as_secs_f64(),
+            1,
+        );
+        stats.shading_points = self.shading_points(direct);
+        self.gpu.check("IGI")?;
+        Ok(stats)
+    }
+
+    /// Shading points with a hit (counted on the CPU from the first hits).
+    fn shading_points(&self, direct: &DirectLight) -> u64 {
+        let f = self.options.downsample as usize;
+        let (w, h) = (self.width as usize, self.height as usize);
+        let pos = direct.diffuse_position.read_f32();
+        let mut n = 0;
+        for qy in 0..h.div_ceil(f) {
+            for qx in 0..w.div_ceil(f) {
+                let (x, y) = ((qx * f + f / 2).min(w - 1), (qy * f + f / 2).min(h - 1));
+                n += (pos[(y * w + x) * 4 + 3] > 0.0) as u64;
+            }
+        }
+        n
+    }
+
+    pub fn read_indirect(&self) -> Image {
+        Image::from_gl_rgba(self.width, self.height, &self.indirect.read_f32())
+    }
+
+    /// The incident light at the gather's resolution, after the
+    /// discontinuity buffer when interleaving (GL order, for tests).
+    pub fn read_incident(&self) -> Vec<[f32; 4]> {
+        let t = if self.options.interleave > 1 {
+            &self.filtered
+        } else {
+            &self.incident
+        };
+        t.read_f32()
+            .chunks(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect()
+    }
+
+    /// The gather's unfiltered incident light (GL order, for tests).
+    pub fn read_gathered(&self) -> Vec<[f32; 4]> {
+        self.incident
+            .read_f32()
+            .chunks(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect()
+    }
+}
+
+/// Each primitive's bounding box, two texels (min, max) a primitive, in rows
+/// of `PRIMITIVE_BOX_ROW` texels.
+fn primitive_boxes(gpu: &Gpu, scene: &Scene) -> Result<Texture> {
+    let n = scene.shapes.len().max(1);
+    let height = (2 * n).div_ceil(PRIMITIVE_BOX_ROW as usize) as u32;
+    let mut data = vec![0f32; PRIMITIVE_BOX_ROW as usize * height as usize * 4];
+    for (i, s) in scene.shapes.iter().enumerate() {
+        let (lo, hi) = crate::scene::bvh::bounds(&s.geometry);
+        data[8 * i..8 * i + 3].copy_from_slice(&lo.to_array());
+        data[8 * i + 4..8 * i + 7].copy_from_slice(&hi.to_array());
+    }
+    Texture::from_f32(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
+}
