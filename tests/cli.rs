@@ -1382,7 +1382,11 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
     );
     let interpolated = json["adaptive_samples"]["interpolated"].as_u64().unwrap();
     assert!(0 < interpolated && interpolated < 40 * 36, "{interpolated}");
-    let refused: [(&[&str], &str); 9] = [
+    let refused: [(&[&str], &str); 10] = [
+        (
+            &["--adaptive", "--method", "sppm", "--sppm-direct", "photons"],
+            "shadow-rays",
+        ),
         (
             &["--final-gather", "2", "--scene-name-ring"],
             "caustics_only",
@@ -1470,8 +1474,10 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
     assert_eq!(json["igi"]["interleave"], 2);
     let per_point = json["igi_samples"][0]["vpls_per_point"].as_f64().unwrap();
     assert_eq!(per_point, vpls as f64 / 4.0);
-    let refused: [(&[&str], &str); 5] = [
+    let refused: [(&[&str], &str); 7] = [
         (&["--interleave", "3"], "--method igi"),
+        (&["--method", "sppm", "--interleave", "3"], "IGI's switches"),
+        (&["--method", "igi", "--direct-only"], "--direct-only"),
         (&["--method", "igi", "--adaptive"], "--adaptive"),
         (
             &["--method", "igi", "--final-gather", "2"],

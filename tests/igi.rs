@@ -252,7 +252,13 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
                     k += wgt;
                 }
             }
-            let e = if k > 0.0 { sum / k } else { Vec3::ZERO };
+            let e = if k > 0.0 {
+                sum / k
+            } else {
+                let qx = ((ux + 0.5).floor() as i32).clamp(0, lw - 1);
+                let qy = ((uy + 0.5).floor() as i32).clamp(0, lh - 1);
+                filtered[(qy * lw + qx) as usize]
+            };
             common::v3(thr[pi]) * albedo(nor[pi][3]) / std::f32::consts::PI * e
         })
         .collect();

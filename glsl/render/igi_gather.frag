@@ -5,7 +5,8 @@
 // so that the filters after it do not blur albedo):
 //   E(x) += sum_k I_k V(x, y_k) cos(theta_x) cos(theta_y) / d^2 f(d),
 // with Marques and Santos's bound f(0.8 m, 1.2 m, d): 0 below 0.8 m, 1 above
-// 1.2 m and a smooth quadratic step between (m = u_min_distance; 0: unbounded).
+// 1.2 m and quadratic between, ((d - 0.8 m) / 0.4 m)^2 (m = u_min_distance;
+// 0: unbounded).
 // Shading points are the first diffuse hits of the full-resolution pixels, or
 // (downsampling) of one pixel per u_scale x u_scale block. Interleaved
 // sampling: pixel p samples only the VPLs of its subset, (p.x mod n) +
@@ -26,11 +27,11 @@ uniform float u_min_distance;
 
 layout(location = 0) out vec4 o_incident;
 
-// Marques and Santos's f(a, b, d): 0 below a, 1 above b, a quadratic step between.
+// Marques and Santos's f(a, b, d): 0 below a, 1 above b, quadratic between.
 float bound(float d) {
     if (u_min_distance <= 0.0) return 1.0;
     float s = clamp((d - 0.8 * u_min_distance) / (0.4 * u_min_distance), 0.0, 1.0);
-    return s * s * (3.0 - 2.0 * s);
+    return s * s;
 }
 
 void main() {

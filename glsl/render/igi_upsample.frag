@@ -4,7 +4,8 @@
 // to full resolution by a joint bilateral filter (Kopf et al. 2007), the
 // paper's equation 2: a spatial Gaussian over the 4 x 4 low-resolution
 // neighbours around the pixel, times the cosine between the pixel's
-// full-resolution first-hit normal and the neighbour's (no weight below 0).
+// full-resolution first-hit normal and the neighbour's (no weight below 0);
+// where no neighbour has weight, the nearest one's light.
 // Then, at every pixel, the incident light becomes reflected radiance:
 // throughput x albedo / pi x E (with u_scale = 1 this is all the pass does).
 #include "common/scene.glsl"
@@ -48,7 +49,14 @@ void main() {
                 sum += w * texelFetch(u_incident, q, 0).rgb;
                 k += w;
             }
-        e = k > 0.0 ? sum / k : vec3(0.0);
+        // No neighbour agrees (a thin object against the background, or
+        // normals all turned away): the nearest shading point's light.
+        if (k > 0.0) {
+            e = sum / k;
+        } else {
+            ivec2 q = clamp(ivec2(floor(u + 0.5)), ivec2(0), low - 1);
+            e = texelFetch(u_incident, q, 0).rgb;
+        }
     }
     vec3 albedo = material_texel(mat, 1).rgb;
     o_radiance = vec4(texelFetch(u_diffuse_throughput, px, 0).rgb * albedo / PI * e, 0.0);

@@ -2,7 +2,9 @@
 // Instant global illumination: the virtual point lights, one texel each. The
 // VPL paths were traced by the photon passes (quasi-random, Halton), and the
 // records stored at their diffuse hits compacted to the first slots (the
-// bitonic build's HistoPyramid); slot i becomes VPL i: its position, its
+// bitonic build's HistoPyramid); VPL i takes the pair a random permutation
+// gives it (so that interleaving's subsets, k mod n^2, are random samples of
+// the paths, not one Halton stratum each): its position, its
 // normal facing the side the light arrived from, and its intensity
 // I = power x albedo / pi, so that it lights x with
 // I cos(theta_y) cos(theta_x) / d^2 (times the albedo at x over pi).
@@ -10,6 +12,7 @@
 #include "common/addressing.glsl"
 
 uniform isampler2D u_pairs;       // (cell, record) of each stored record, compacted
+uniform isampler2D u_order;       // VPL slot -> its pair (a random permutation)
 uniform int u_count;              // stored records
 uniform sampler2D u_position;     // the VPL paths' frames: xyz, w = material
 uniform sampler2D u_power;        // rgb arriving
@@ -28,7 +31,9 @@ void main() {
     o_intensity = vec4(0.0);
     int slot = index_of_texel(t, textureSize(u_pairs, 0).x);
     if (slot >= u_count) return;
-    ivec2 r = texel_of_index(texelFetch(u_pairs, t, 0).y, u_record_width);
+    int pair = texelFetch(u_order, t, 0).x;
+    ivec2 pt = texel_of_index(pair, textureSize(u_pairs, 0).x);
+    ivec2 r = texel_of_index(texelFetch(u_pairs, pt, 0).y, u_record_width);
     vec4 p = texelFetch(u_position, r, 0);
     int prim = int(texelFetch(u_outgoing, r, 0).w);
     // The geometric normal: cos(theta_y) measures the VPL's projected area

@@ -279,9 +279,13 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         bail!("--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi");
     }
     if args.method == Method::Igi
-        && (args.final_gather.is_some() || args.adaptive || args.reference_software.is_some())
+        && (args.final_gather.is_some()
+            || args.adaptive
+            || args.reference_software.is_some()
+            || args.snapshots.is_some()
+            || args.direct_only)
     {
-        bail!("--method igi has its own accelerations (--interleave, --downsample) and no one-map estimate to compare: drop --final-gather, --adaptive and --reference-software");
+        bail!("--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
     }
     if args.sppm.adaptive_pilot.is_some() {
         bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
@@ -304,7 +308,12 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         None => vec![scene.camera.clone()],
     };
     let gpu = super::gpu(platform)?;
-    let provenance = provenance(loaded.provenance, &gpu, "paper", &options);
+    let method = match (args.method, args.final_gather.is_some()) {
+        (Method::Igi, _) => "igi",
+        (_, true) => "final-gather",
+        _ => "paper",
+    };
+    let provenance = provenance(loaded.provenance, &gpu, method, &options);
     let work = Work::Paper {
         passes: PassPlan::new(scene, &options).passes_per_sample(),
         samples: options.spp,
@@ -327,11 +336,7 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
             provenance: &provenance,
             outputs: written.clone(),
             figures: serde_json::json!({
-                "method": match (args.method, args.final_gather.is_some()) {
-                    (Method::Igi, _) => "igi",
-                    (_, true) => "final-gather",
-                    _ => "paper",
-                },
+                "method": method,
                 "timings": out.timings,
                 "estimates": out.estimates,
                 "final_gather": options.global.as_ref().and_then(|g| g.final_gather.clone()),
@@ -379,8 +384,9 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         || args.reference_software.is_some()
         || args.spp > 1
         || args.final_gather.is_some()
+        || args.igi.any_given()
     {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp and --final-gather");
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather and IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample)");
     }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;

@@ -167,31 +167,84 @@ pub enum RandomSource {
     Texture,
     /// Quasi-random numbers through the same texture (instant radiosity's
     /// light paths, as Keller and Marques and Santos draw them): photon i's
-    /// number in dimension d is the Halton sequence's point i + 1 in base
-    /// prime(d), rotated by a random offset of the seed (Cranley-Patterson),
-    /// for the first `HALTON_DIMENSIONS` dimensions (the emission and the
-    /// first bounces); later ones take the hash's numbers.
+    /// numbers are the scrambled Halton sequence's point i (`ScrambledHalton`,
+    /// digits permuted by the seed) in the first `HALTON_DIMENSIONS`
+    /// dimensions (the emission and the first bounces); later ones take the
+    /// hash's numbers.
     Halton,
 }
 
-/// Dimensions drawn from the Halton sequence: every prime base below 256
-/// (the `halton` crate's bases are bytes), 8 numbers a frame.
-pub const HALTON_DIMENSIONS: usize = 48;
+/// Dimensions drawn from the Halton sequence (the first 54 primes): the
+/// emission's numbers and those of the first 16 bounces.
+pub const HALTON_DIMENSIONS: usize = 54;
 
-/// Photon `photon`'s number in Halton dimension `dim`: the sequence's point
-/// photon + 1 in the dim-th prime base, rotated by the seed's offset for that
-/// dimension (so each seed draws another, equally even, point set).
-pub fn halton_number(seed: u32, dim: usize, photon: usize) -> f32 {
-    const PRIMES: [u8; 54] = [
-        2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89,
-        97, 101, 103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181,
-        191, 193, 197, 199, 211, 223, 227, 229, 233, 239, 241, 251,
-    ];
-    let mut state = crate::random::rng_init(seed, [dim as u32, 0], 0x7000_0000);
-    let offset = crate::random::rng_next(&mut state) as f64;
-    let v = (halton::number(PRIMES[dim], photon + 1) + offset).fract() as f32;
-    // Rounding to f32 may reach 1.0; the shaders expect [0, 1).
-    v.min(1.0 - f32::EPSILON / 2.0)
+/// The prime bases of the Halton dimensions.
+const PRIMES: [u32; HALTON_DIMENSIONS] = [
+    2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97,
+    101, 103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181, 191, 193,
+    197, 199, 211, 223, 227, 229, 233, 239, 241, 251,
+];
+
+/// Random numbers a photon draws at emission (light, two for the point, two
+/// for the direction; projection maps draw one more, which is never a Halton
+/// one) and at each bounce (glsl/photon/emit.frag, trace.frag).
+const EMISSION_NUMBERS: usize = 5;
+const BOUNCE_NUMBERS: usize = 3;
+
+/// The Halton dimension of number `k` of frame `frame`, if it has one: the
+/// numbers actually drawn take consecutive dimensions, so the first bounces
+/// get the small bases, whose points are evenly spread even for few paths.
+fn halton_dimension(frame: usize, k: usize) -> Option<usize> {
+    let dim = match frame {
+        0 => (k < EMISSION_NUMBERS).then_some(k)?,
+        f => (k < BOUNCE_NUMBERS).then_some(EMISSION_NUMBERS + BOUNCE_NUMBERS * (f - 1) + k)?,
+    };
+    (dim < HALTON_DIMENSIONS).then_some(dim)
+}
+
+/// The scrambled Halton sequence of one seed: a random permutation of the
+/// digits of each dimension's base (random-digit scrambling, as pbrt-v4's
+/// Halton sampler does), applied to every digit down to below f32 precision.
+/// Unscrambled, the large bases give the first points i / b in every
+/// dimension, nearly on a line; scrambled, each dimension's points stay
+/// stratified and the dimensions are decorrelated.
+pub struct ScrambledHalton {
+    permutations: Vec<Vec<u32>>,
+}
+
+impl ScrambledHalton {
+    pub fn new(seed: u32) -> Self {
+        let permutations = PRIMES
+            .iter()
+            .enumerate()
+            .map(|(dim, &base)| {
+                let mut state = crate::random::rng_init(seed, [dim as u32, 0], 0x7000_0000);
+                let mut p: Vec<u32> = (0..base).collect();
+                for i in (1..base as usize).rev() {
+                    let j =
+                        ((crate::random::rng_next(&mut state) * (i + 1) as f32) as usize).min(i);
+                    p.swap(i, j);
+                }
+                p
+            })
+            .collect();
+        Self { permutations }
+    }
+
+    /// Point `index`'s number in dimension `dim` (< HALTON_DIMENSIONS), in [0, 1).
+    pub fn number(&self, dim: usize, mut index: u64) -> f32 {
+        let base = PRIMES[dim] as u64;
+        let perm = &self.permutations[dim];
+        let inv = 1.0 / base as f64;
+        let (mut factor, mut v) = (inv, 0.0f64);
+        while factor > 1e-9 {
+            v += perm[(index % base) as usize] as f64 * factor;
+            index /= base;
+            factor *= inv;
+        }
+        // Rounding to f32 may reach 1.0; the shaders expect [0, 1).
+        (v as f32).min(1.0 - f32::EPSILON / 2.0)
+    }
 }
 
 /// How a `PhotonTracer` traces (fixed when it is made).
@@ -287,6 +340,8 @@ impl PhotonTracer {
         use crate::layout::RANDOM_PER_PHOTON_FRAME;
         use crate::random::{rng_init, rng_next};
         let mut data = vec![0f32; (width * 2 * frame_height * frames * 4) as usize];
+        let halton =
+            (self.config.random == RandomSource::Halton).then(|| ScrambledHalton::new(seed));
         for f in 0..frames {
             for y in 0..frame_height {
                 for x in 0..width {
@@ -295,10 +350,9 @@ impl PhotonTracer {
                     let base = (row * (width as usize * 2) + x as usize * 2) * 4;
                     for k in 0..RANDOM_PER_PHOTON_FRAME {
                         data[base + k] = rng_next(&mut state);
-                        let dim = f as usize * RANDOM_PER_PHOTON_FRAME + k;
-                        if self.config.random == RandomSource::Halton && dim < HALTON_DIMENSIONS {
-                            let photon = (y * width + x) as usize;
-                            data[base + k] = halton_number(seed, dim, photon);
+                        let dim = halton.as_ref().zip(halton_dimension(f as usize, k));
+                        if let Some((h, dim)) = dim {
+                            data[base + k] = h.number(dim, (y * width + x) as u64);
                         }
                     }
                 }

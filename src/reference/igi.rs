@@ -19,13 +19,13 @@ pub struct Vpl {
     pub intensity: Vec3,
 }
 
-/// Marques and Santos's f(0.8 m, 1.2 m, d), smooth-stepped; 1 when m = 0.
+/// Marques and Santos's f(0.8 m, 1.2 m, d), quadratic between; 1 when m = 0.
 pub fn bound(d: f32, m: f32) -> f32 {
     if m <= 0.0 {
         return 1.0;
     }
     let s = ((d - 0.8 * m) / (0.4 * m)).clamp(0.0, 1.0);
-    s * s * (3.0 - 2.0 * s)
+    s * s
 }
 
 /// Whether a primitive's bounding box blocks the segment from o along unit

@@ -7,7 +7,7 @@
 //!    (Halton) numbers; every diffuse hit, the first included, is a virtual
 //!    point light with the power that arrived there. The bitonic build's
 //!    HistoPyramid compacts the stored records and `igi_vpls` turns each into
-//!    a VPL texel (position, normal, intensity).
+//!    a VPL texel (position, normal, intensity), in a random order.
 //! 2. **Gather.** At each pixel's first diffuse hit, `igi_gather` sums the
 //!    VPLs with the bounded geometry term and a shadow ray each, in batches
 //!    of `VPL_BATCH` VPLs a pass (additive), as incident light.
@@ -17,9 +17,12 @@
 //!    with the discontinuity buffer (`igi_interleave`); downsampling by a
 //!    factor with joint bilateral upsampling (`igi_upsample`).
 //! 4. **The image**: direct light and specular paths from the ray tracer,
-//!    caustics from a caustic photon map (IGI has none of its own: VPL light
-//!    reaches x only straight from a diffuse surface), and
-//!    throughput x albedo / pi x the incident light.
+//!    caustics (light from an emitter through mirrors or glass onto x) from a
+//!    caustic photon map, and throughput x albedo / pi x the incident light.
+//!    Light from a diffuse surface through a mirror or glass onto x (L D S+ D
+//!    paths) is in none of them: VPL shadow rays stop at mirrors and glass as
+//!    every shadow ray does, and the caustic map holds only paths straight
+//!    from an emitter. IGI as Marques and Santos build it has the same gap.
 
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
@@ -160,6 +163,18 @@ impl Vpls {
                 scene.name
             )));
         }
+        // VPLs in a random order: interleaving's subsets (k mod n^2) must
+        // not follow the paths' Halton index, whose leading digits fix a
+        // subset's directions or lights.
+        let mut order: Vec<i32> = (0..count as i32).collect();
+        let mut state = crate::random::rng_init(seed, [count, 0], crate::layout::VPL_STREAM);
+        for i in (1..order.len()).rev() {
+            let j = ((crate::random::rng_next(&mut state) * (i + 1) as f32) as usize).min(i);
+            order.swap(i, j);
+        }
+        order.resize((pairs.width * pairs.height) as usize, -1);
+        let order =
+            Texture::from_i32_format(gpu, pairs.width, pairs.height, TexFormat::R32I, &order)?;
         let t = || Texture::new(gpu, pairs.width, pairs.height, TexFormat::Rgba32F);
         let (position, normal, intensity) = (t()?, t()?, t()?);
         let target = Target::new(gpu, &[&position, &normal, &intensity])?;
@@ -167,6 +182,7 @@ impl Vpls {
         let mut b = program.bind();
         textures.bind(&mut b);
         b.texture("u_pairs", &pairs)
+            .texture("u_order", &order)
             .int("u_count", count as i32)
             .texture("u_position", &frames.position)
             .texture("u_power", &frames.power)

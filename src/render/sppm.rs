@@ -175,6 +175,11 @@ impl Sppm {
         let adaptive = match &sppm.adaptive {
             None => None,
             Some(a) => {
+                if sppm.direct == DirectLighting::Photons {
+                    return Err(Error::InvalidOption(
+                        "adaptive SPPM interpolates the photon half on a plan fixed after its pilot; with --sppm-direct photons that half holds direct light and its hard shadows too: use --sppm-direct shadow-rays".into(),
+                    ));
+                }
                 let pilot = sppm
                     .adaptive_pilot
                     .unwrap_or(default_pilot(sppm.iterations));

@@ -16,10 +16,13 @@
 //! first rows). Direct light still accumulates at every pixel, from every
 //! iteration's eye paths, with the gather off. The image interpolates the
 //! photon half of the other pixels level by level from the finished corners
-//! (`glsl/render/sppm_adaptive_fill.frag`). A computed pixel follows the same
-//! sequence of states as in a full SPPM render; an interpolated pixel carries
-//! the interpolation's error, which does not shrink with iterations, and the
-//! error of the plan made on the pilot.
+//! (`glsl/render/sppm_adaptive_fill.frag`). A computed pixel that gathered
+//! photons in the pilot follows the same sequence of states as in a full SPPM
+//! render (one that had not takes its first radius from the grid's cell,
+//! which now follows the computed pixels' radii only); an interpolated pixel
+//! carries the interpolation's error, which does not shrink with iterations,
+//! and the error of a plan made on the pilot's still-wide radii: it is fixed
+//! for the rest of the render.
 
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 
@@ -128,12 +131,14 @@ impl SppmAdaptive {
             stats.interpolated += i;
             stats.levels.push((stride, c, i));
         }
-        stats.pixels_with_hits = stats.computed + stats.interpolated;
         // Every pixel not interpolated computes, hit or not in the pilot's
-        // last iteration: row-major order keeps neighbours together.
+        // last iteration: row-major order keeps neighbours together. The
+        // stats count them all (a full SPPM render gathers at every pixel).
         let computed: Vec<u32> = (0..n as u32)
             .filter(|&p| interpolated_at[p as usize] < 0)
             .collect();
+        stats.computed = computed.len() as u64;
+        stats.pixels_with_hits = n as u64;
         self.pyramid.pack_order(&computed)?;
         let packed = SppmState::new(&self.gpu, self.width, self.height)?;
         self.pack_state
