@@ -1502,3 +1502,40 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
         assert!(!bad.exists(), "{args:?} wrote an image");
     }
 }
+
+/// `bench igi` on the mesh stage: the paper's four versions and two remedies,
+/// each with its time split into components that add up to it (the stages
+/// outside them are few and small), its image, and no reference to compare.
+#[test]
+fn bench_igi_splits_each_version_by_component() {
+    let d = tmp("bench-igi");
+    let out = photonmap()
+        .args([
+            "bench",
+            "igi",
+            "--triangles",
+            "1024",
+            "--vpl-paths",
+            "16",
+            "--json",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&d)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 6);
+    assert!(v["reference"].is_null());
+    assert_eq!(rows[0]["rmse_to_canonical"], 0.0);
+    for r in rows {
+        let f = |k: &str| r[k].as_f64().unwrap();
+        let parts = f("direct") + f("specular") + f("indirect") + f("caustics") + f("other");
+        assert!(parts <= f("seconds") && parts > 0.5 * f("seconds"), "{r}");
+        assert!(r["rmse"].is_null());
+    }
+    assert!(rows[3]["options"]["interleave"] == 3 && rows[3]["options"]["downsample"] == 4);
+    assert!(d.join("igi.json").is_file() && d.join("00_igi.png").is_file());
+}

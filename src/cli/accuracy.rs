@@ -226,9 +226,26 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
             r.sppm_iterations = it;
         }));
     }
-    // Instant global illumination: the canonical version, more VPLs, each of
-    // Marques and Santos's accelerations alone, all three together, and the
-    // remedy they suggest for the combination's artefacts (a 2 x 2 interleave).
+    out.extend(igi_rows(&base, quick));
+    // Adaptive SPPM (a pilot of an eighth of the iterations, then the
+    // gather only where the plan computes), beside the full runs above.
+    for it in if quick { vec![16] } else { vec![16, 64] } {
+        out.push(base.with(format!("SPPM {it} iterations, adaptive"), |r| {
+            r.method = "sppm".into();
+            r.sppm_iterations = it;
+            r.adaptive = true;
+        }));
+    }
+    out
+}
+
+/// Instant global illumination: the canonical version, more VPLs, each of
+/// Marques and Santos's accelerations alone, all three together, the remedy
+/// they suggest for the combination's artefacts (a 2 x 2 interleave), and 4
+/// spp (at 1 spp every method's error is mostly aliasing against the
+/// antialiased reference).
+fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
+    let mut out = Vec::new();
     let igi = |label: &str, f: &dyn Fn(&mut IgiOptions)| {
         base.with(label.into(), |r| {
             r.method = "igi".into();
@@ -259,15 +276,22 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
             all_three(o);
             o.vpl_paths = 256;
         }));
-    }
-    // Adaptive SPPM (a pilot of an eighth of the iterations, then the
-    // gather only where the plan computes), beside the full runs above.
-    for it in if quick { vec![16] } else { vec![16, 64] } {
-        out.push(base.with(format!("SPPM {it} iterations, adaptive"), |r| {
-            r.method = "sppm".into();
-            r.sppm_iterations = it;
-            r.adaptive = true;
-        }));
+        // At 1 spp every method's error is mostly aliasing against the
+        // antialiased reference; 4 spp compares the estimators.
+        for (label, f) in [
+            (
+                "IGI, 4 spp",
+                &(|_: &mut IgiOptions| {}) as &dyn Fn(&mut IgiOptions),
+            ),
+            ("IGI 256 paths, all three, 4 spp", &|o: &mut IgiOptions| {
+                all_three(o);
+                o.vpl_paths = 256;
+            }),
+        ] {
+            let mut c = igi(label, f);
+            c.run.spp = 4;
+            out.push(c);
+        }
     }
     out
 }
