@@ -274,70 +274,13 @@ radiance = [1.0, 1.0, 1.0]
 /// A closed diffuse box (coloured walls) lit by a point light and a ceiling
 /// area light: SPPM and the independent CPU path tracer (next-event
 /// estimation) must agree block by block within their combined noise.
-const TWO_LIGHT_BOX: &str = r#"
-[camera]
-position = [0.5, 0.5, 1.45]
-look_at = [0.5, 0.45, 0.0]
-vfov = 60.0
-width = 32
-height = 32
-[photon_map]
-max_radius = 0.08
-[materials]
-white = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
-red = { type = "diffuse", albedo = [0.7, 0.2, 0.2] }
-green = { type = "diffuse", albedo = [0.2, 0.6, 0.3] }
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 1.5]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 1.0, 0.0]
-edge1 = [0.0, 0.0, 1.5]
-edge2 = [1.0, 0.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [0.0, 1.0, 0.0]
-edge2 = [1.0, 0.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 1.5]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 1.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [0.0, 0.0, 1.5]
-edge2 = [0.0, 1.0, 0.0]
-material = "red"
-[[shape]]
-type = "parallelogram"
-corner = [1.0, 0.0, 0.0]
-edge1 = [0.0, 1.0, 0.0]
-edge2 = [0.0, 0.0, 1.5]
-material = "green"
-[[light]]
-type = "point"
-position = [0.3, 0.7, 0.5]
-intensity = [0.3, 0.3, 0.3]
-[[light]]
-type = "area"
-corner = [0.6, 0.999, 0.4]
-edge1 = [0.2, 0.0, 0.0]
-edge2 = [0.0, 0.0, 0.2]
-radiance = [6.0, 6.0, 6.0]
-"#;
-
 #[test]
 fn sppm_agrees_with_an_independent_path_tracer() {
-    let scene = load_scene_str(TWO_LIGHT_BOX, std::path::Path::new("two_light_box.toml")).unwrap();
+    let scene = load_scene_str(
+        common::TWO_LIGHT_BOX,
+        std::path::Path::new("two_light_box.toml"),
+    )
+    .unwrap();
     let t0 = std::time::Instant::now();
     let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
     let pt_seconds = t0.elapsed().as_secs_f64();

@@ -195,6 +195,9 @@ pub struct IgiArgs {
     /// IGI: light paths traced for VPLs, one VPL at each diffuse hit (1..=1048576).
     #[arg(long, default_value_t = 64, value_parser = in_range(1, 1 << 20))]
     pub vpl_paths: u32,
+    /// IGI: bounces of a VPL path at most (1..=64; Russian roulette ends most far sooner).
+    #[arg(long, default_value_t = 32, value_parser = in_range(1, 64))]
+    pub vpl_bounces: u32,
     /// IGI: the geometry term's bounding distance m (VPLs nearer than 0.8 m
     /// light nothing; 0: unbounded). Default: the scene's photon_map.max_radius.
     #[arg(long, value_name = "M", value_parser = non_negative)]
@@ -216,6 +219,7 @@ impl IgiArgs {
     /// Whether any IGI switch differs from its default.
     pub fn any_given(&self) -> bool {
         self.vpl_paths != 64
+            || self.vpl_bounces != 32
             || self.vpl_min_distance.is_some()
             || self.imperfect_visibility
             || self.interleave != 1
@@ -227,6 +231,7 @@ impl From<&IgiArgs> for IgiOptions {
     fn from(a: &IgiArgs) -> Self {
         IgiOptions {
             vpl_paths: a.vpl_paths,
+            vpl_bounces: a.vpl_bounces,
             min_distance: a.vpl_min_distance.map(|m| m as f32),
             imperfect_visibility: a.imperfect_visibility,
             interleave: a.interleave,

@@ -38,6 +38,9 @@ use super::{DirectLight, Image, Timings};
 pub struct IgiOptions {
     /// Light paths traced; each leaves a VPL at every diffuse hit.
     pub vpl_paths: u32,
+    /// Bounces of a light path at most (Russian roulette ends most far
+    /// sooner); SPPM's default, so that the truncated tail is negligible.
+    pub vpl_bounces: u32,
     /// Marques and Santos's bounding distance m of the geometry term (VPLs
     /// nearer than 0.8 m give nothing, beyond 1.2 m all); 0: unbounded.
     /// None: the scene's photon_map.max_radius.
@@ -56,6 +59,7 @@ impl Default for IgiOptions {
     fn default() -> Self {
         Self {
             vpl_paths: 64,
+            vpl_bounces: 32,
             min_distance: None,
             imperfect_visibility: false,
             interleave: 1,
@@ -76,6 +80,12 @@ impl IgiOptions {
             return bad(format!(
                 "--vpl-paths {}: the allowed range is 1..=1048576",
                 self.vpl_paths
+            ));
+        }
+        if !(1..=64).contains(&self.vpl_bounces) {
+            return bad(format!(
+                "--vpl-bounces {}: the allowed range is 1..=64",
+                self.vpl_bounces
             ));
         }
         if !(1..=8).contains(&self.interleave) {
@@ -123,17 +133,18 @@ pub struct VplReport {
 }
 
 impl Vpls {
-    /// Traces `paths` light paths through `scene` (every diffuse hit stored)
-    /// and makes their VPLs.
+    /// Traces `paths` light paths of up to `bounces` bounces through `scene`
+    /// (every diffuse hit stored) and makes their VPLs.
     pub fn trace(
         gpu: &Gpu,
         scene: &Scene,
         textures: &SceneTextures,
-        paths: u32,
+        (paths, bounces): (u32, u32),
         seed: u32,
         timings: &mut Timings,
     ) -> Result<Self> {
         let mut s = scene.clone();
+        s.photon_map.max_bounces = bounces;
         s.photon_map.caustics_only = false;
         s.photon_map.store_direct = true;
         let wall = std::time::Instant::now();

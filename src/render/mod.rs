@@ -354,7 +354,14 @@ impl GlobalPart {
                 let igi = Igi::new(gpu, scene, w, h, o)?;
                 observer.progress(&Progress::stage("VPLs", 0, 1));
                 let seed = crate::random::pcg_hash(options.seed ^ crate::layout::VPL_STREAM);
-                let vpls = Vpls::trace(gpu, scene, textures, o.vpl_paths, seed, timings)?;
+                let vpls = Vpls::trace(
+                    gpu,
+                    scene,
+                    textures,
+                    (o.vpl_paths, o.vpl_bounces),
+                    seed,
+                    timings,
+                )?;
                 (Some(vpls), Some(igi))
             }
         };

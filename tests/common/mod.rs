@@ -314,3 +314,66 @@ pub fn texels(t: &photonmap::gpu::Texture) -> Vec<[f32; 4]> {
 pub fn v3(t: [f32; 4]) -> glam::Vec3 {
     glam::Vec3::new(t[0], t[1], t[2])
 }
+
+/// A diffuse box with a point light and a small area light (the SPPM and IGI
+/// tests against the CPU path tracer).
+pub const TWO_LIGHT_BOX: &str = r#"
+[camera]
+position = [0.5, 0.5, 1.45]
+look_at = [0.5, 0.45, 0.0]
+vfov = 60.0
+width = 32
+height = 32
+[photon_map]
+max_radius = 0.08
+[materials]
+white = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
+red = { type = "diffuse", albedo = [0.7, 0.2, 0.2] }
+green = { type = "diffuse", albedo = [0.2, 0.6, 0.3] }
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, 1.5]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 1.0, 0.0]
+edge1 = [0.0, 0.0, 1.5]
+edge2 = [1.0, 0.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [0.0, 1.0, 0.0]
+edge2 = [1.0, 0.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 1.5]
+edge1 = [1.0, 0.0, 0.0]
+edge2 = [0.0, 1.0, 0.0]
+material = "white"
+[[shape]]
+type = "parallelogram"
+corner = [0.0, 0.0, 0.0]
+edge1 = [0.0, 0.0, 1.5]
+edge2 = [0.0, 1.0, 0.0]
+material = "red"
+[[shape]]
+type = "parallelogram"
+corner = [1.0, 0.0, 0.0]
+edge1 = [0.0, 1.0, 0.0]
+edge2 = [0.0, 0.0, 1.5]
+material = "green"
+[[light]]
+type = "point"
+position = [0.3, 0.7, 0.5]
+intensity = [0.3, 0.3, 0.3]
+[[light]]
+type = "area"
+corner = [0.6, 0.999, 0.4]
+edge1 = [0.2, 0.0, 0.0]
+edge2 = [0.0, 0.0, 0.2]
+radiance = [6.0, 6.0, 6.0]
+"#;
