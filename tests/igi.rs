@@ -242,6 +242,10 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
                     if pos[qp][3] <= 0.0 {
                         continue;
                     }
+                    let x = common::v3(pos[pi]);
+                    if (common::v3(pos[qp]) - x).dot(np).abs() > depth * eye.distance(x) {
+                        continue;
+                    }
                     let range = np.dot(common::v3(nor[qp]));
                     if range <= 0.0 {
                         continue;

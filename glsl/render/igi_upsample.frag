@@ -4,8 +4,10 @@
 // to full resolution by a joint bilateral filter (Kopf et al. 2007), the
 // paper's equation 2: a spatial Gaussian over the 4 x 4 low-resolution
 // neighbours around the pixel, times the cosine between the pixel's
-// full-resolution first-hit normal and the neighbour's (no weight below 0);
-// where no neighbour has weight, the nearest one's light.
+// full-resolution first-hit normal and the neighbour's (no weight below 0),
+// and, as the discontinuity buffer does, only neighbours whose hit lies
+// within VPL_DEPTH_TOLERANCE of the pixel's eye distance off its tangent
+// plane (depth guidance); where no neighbour has weight, the nearest one's light.
 // Then, at every pixel, the incident light becomes reflected radiance:
 // throughput x albedo / pi x E (with u_scale = 1 this is all the pass does).
 #include "common/scene.glsl"
@@ -15,6 +17,7 @@ uniform sampler2D u_diffuse_position;    // full resolution, w = 1 where a hit
 uniform sampler2D u_diffuse_normal;      // w = material + 1
 uniform sampler2D u_diffuse_throughput;
 uniform int u_scale;
+uniform vec3 u_eye;
 
 layout(location = 0) out vec4 o_radiance;
 
@@ -34,6 +37,8 @@ void main() {
         // block q sits at pixel q * scale + scale / 2).
         vec2 u = (vec2(px) - float(u_scale / 2)) / float(u_scale);
         ivec2 base = ivec2(floor(u)) - 1;
+        vec3 x = texelFetch(u_diffuse_position, px, 0).xyz;
+        float tolerance = VPL_DEPTH_TOLERANCE * distance(u_eye, x);
         vec3 sum = vec3(0.0);
         float k = 0.0;
         for (int j = 0; j < 4; ++j)
@@ -41,7 +46,9 @@ void main() {
                 ivec2 q = base + ivec2(i, j);
                 if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, low))) continue;
                 ivec2 qp = min(q * u_scale + u_scale / 2, full - 1);
-                if (texelFetch(u_diffuse_position, qp, 0).w <= 0.0) continue;
+                vec4 qx = texelFetch(u_diffuse_position, qp, 0);
+                if (qx.w <= 0.0) continue;
+                if (abs(dot(qx.xyz - x, xn.xyz)) > tolerance) continue;
                 float range = dot(xn.xyz, texelFetch(u_diffuse_normal, qp, 0).xyz);
                 if (range <= 0.0) continue;
                 vec2 off = u - vec2(q);

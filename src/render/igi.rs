@@ -386,6 +386,7 @@ impl Igi {
             .texture("u_diffuse_position", &direct.diffuse_position)
             .texture("u_diffuse_normal", &direct.diffuse_normal)
             .texture("u_diffuse_throughput", &direct.diffuse_throughput)
+            .vec3("u_eye", eye.to_array())
             .int("u_scale", o.downsample as i32)
             .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
         drop(b);
