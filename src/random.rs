@@ -25,3 +25,12 @@ pub fn sample_seed(seed: u32, sample: u32) -> u32 {
         pcg_hash(seed ^ pcg_hash(sample.wrapping_add(0x5bd1e995)))
     }
 }
+
+/// Shuffles `values` in place (Fisher-Yates) with the stream `state`: the
+/// Halton digit permutations and IGI's VPL order draw from it.
+pub fn shuffle<T>(values: &mut [T], state: &mut u32) {
+    for i in (1..values.len()).rev() {
+        let j = ((rng_next(state) * (i + 1) as f32) as usize).min(i);
+        values.swap(i, j);
+    }
+}

@@ -71,12 +71,7 @@ fn the_vpl_gather_equals_its_cpu_twin() {
         let v = vpls(&out);
         let pos = common::texels(&out.state.direct.diffuse_position);
         let nor = common::texels(&out.state.direct.diffuse_normal);
-        let got: Vec<Vec3> = out
-            .state
-            .igi
-            .as_ref()
-            .unwrap()
-            .read_gathered()
+        let got: Vec<Vec3> = common::texels(&out.state.igi.as_ref().unwrap().incident)
             .into_iter()
             .map(common::v3)
             .collect();
@@ -145,7 +140,10 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
         (y * w as i32 + x) as usize
     };
     // The gather, subset by subset.
-    let gathered: Vec<Vec3> = state.read_gathered().into_iter().map(common::v3).collect();
+    let gathered: Vec<Vec3> = common::texels(&state.incident)
+        .into_iter()
+        .map(common::v3)
+        .collect();
     let subsets = (n * n) as usize;
     let twin: Vec<Vec3> = (0..lw * lh)
         .map(|q| {
@@ -169,7 +167,10 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
     let (gather_apart, gather_worst) = apart(&gathered, &twin);
     // The discontinuity buffer on the GPU's gather.
     let eye = scene.camera.position;
-    let filtered: Vec<Vec3> = state.read_incident().into_iter().map(common::v3).collect();
+    let filtered: Vec<Vec3> = common::texels(state.filtered_incident())
+        .into_iter()
+        .map(common::v3)
+        .collect();
     let ncos = photonmap::layout::VPL_NORMAL_COS;
     let depth = photonmap::layout::VPL_DEPTH_TOLERANCE;
     let filter_twin: Vec<Vec3> = (0..lw * lh)
@@ -207,6 +208,11 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
         })
         .collect();
     let (filter_apart, filter_worst) = apart(&filtered, &filter_twin);
+    // The gather's occlusion query counts the shading points with a hit.
+    let points = (0..lw * lh)
+        .filter(|&q| pos[shading(q % lw, q / lw)][3] > 0.0)
+        .count() as u64;
+    assert_eq!(out.igi[0].shading_points, points);
     // The joint bilateral upsampling on the GPU's filtered light.
     let albedo = |mat: f32| -> Vec3 {
         match scene.materials[mat as usize - 1] {

@@ -12,6 +12,7 @@
 // sampling: pixel p samples only the VPLs of its subset, (p.x mod n) +
 // n (p.y mod n), scaled by the n^2 subsets.
 #include "common/scene.glsl"
+#include "render/igi_shading.glsl"
 
 uniform sampler2D u_diffuse_position;  // full resolution, w = 1 where a hit
 uniform sampler2D u_diffuse_normal;    // facing the viewer, w = material + 1
@@ -36,12 +37,11 @@ float bound(float d) {
 
 void main() {
     ivec2 q = ivec2(gl_FragCoord.xy);
-    ivec2 px = q * u_scale + u_scale / 2;
-    o_incident = vec4(0.0);
-    ivec2 size = textureSize(u_diffuse_position, 0);
-    px = min(px, size - 1);
+    ivec2 px = shading_pixel(q, u_scale, textureSize(u_diffuse_position, 0));
     vec4 xp = texelFetch(u_diffuse_position, px, 0);
-    if (xp.w <= 0.0) return;
+    // No hit, no light; discarded so that the first batch's occlusion query
+    // counts the shading points.
+    if (xp.w <= 0.0) discard;
     vec3 x = xp.xyz;
     vec3 nx = texelFetch(u_diffuse_normal, px, 0).xyz;
     int subsets = u_interleave * u_interleave;

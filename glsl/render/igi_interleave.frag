@@ -6,6 +6,8 @@
 // of its own, and a hit within VPL_DEPTH_TOLERANCE of its distance from the
 // eye off its tangent plane. The centre always counts. Works at the
 // gather's resolution (downsampled: one pixel per u_scale x u_scale block).
+#include "render/igi_shading.glsl"
+
 uniform sampler2D u_incident;          // the gather's interleaved light
 uniform sampler2D u_diffuse_position;  // full resolution, w = 1 where a hit
 uniform sampler2D u_diffuse_normal;
@@ -15,14 +17,11 @@ uniform int u_interleave;
 
 layout(location = 0) out vec4 o_incident;
 
-ivec2 shading_pixel(ivec2 q) {
-    return min(q * u_scale + u_scale / 2, textureSize(u_diffuse_position, 0) - 1);
-}
-
 void main() {
     ivec2 q = ivec2(gl_FragCoord.xy);
     ivec2 size = textureSize(u_incident, 0);
-    ivec2 px = shading_pixel(q);
+    ivec2 full = textureSize(u_diffuse_position, 0);
+    ivec2 px = shading_pixel(q, u_scale, full);
     vec4 xp = texelFetch(u_diffuse_position, px, 0);
     vec3 centre = texelFetch(u_incident, q, 0).rgb;
     if (xp.w <= 0.0) {
@@ -30,7 +29,7 @@ void main() {
         return;
     }
     vec4 nx = texelFetch(u_diffuse_normal, px, 0);
-    float tolerance = VPL_DEPTH_TOLERANCE * distance(u_eye, xp.xyz);
+    float d = distance(u_eye, xp.xyz);
     int lo = -(u_interleave - 1) / 2;
     vec3 sum = vec3(0.0);
     float n = 0.0;
@@ -38,14 +37,14 @@ void main() {
         for (int i = lo; i < lo + u_interleave; ++i) {
             ivec2 o = q + ivec2(i, j);
             if (any(lessThan(o, ivec2(0))) || any(greaterThanEqual(o, size))) continue;
-            ivec2 op = shading_pixel(o);
+            ivec2 op = shading_pixel(o, u_scale, full);
             vec4 yp = texelFetch(u_diffuse_position, op, 0);
             if (yp.w <= 0.0) continue;
             bool same = i == 0 && j == 0;
             if (!same) {
                 vec3 ny = texelFetch(u_diffuse_normal, op, 0).xyz;
                 if (dot(ny, nx.xyz) < VPL_NORMAL_COS) continue;
-                if (abs(dot(yp.xyz - xp.xyz, nx.xyz)) > tolerance) continue;
+                if (!continues_surface(xp.xyz, nx.xyz, d, yp.xyz)) continue;
             }
             sum += texelFetch(u_incident, o, 0).rgb;
             n += 1.0;

@@ -11,6 +11,7 @@
 // Then, at every pixel, the incident light becomes reflected radiance:
 // throughput x albedo / pi x E (with u_scale = 1 this is all the pass does).
 #include "common/scene.glsl"
+#include "render/igi_shading.glsl"
 
 uniform sampler2D u_incident;            // low (or full) resolution
 uniform sampler2D u_diffuse_position;    // full resolution, w = 1 where a hit
@@ -38,17 +39,17 @@ void main() {
         vec2 u = (vec2(px) - float(u_scale / 2)) / float(u_scale);
         ivec2 base = ivec2(floor(u)) - 1;
         vec3 x = texelFetch(u_diffuse_position, px, 0).xyz;
-        float tolerance = VPL_DEPTH_TOLERANCE * distance(u_eye, x);
+        float d = distance(u_eye, x);
         vec3 sum = vec3(0.0);
         float k = 0.0;
         for (int j = 0; j < 4; ++j)
             for (int i = 0; i < 4; ++i) {
                 ivec2 q = base + ivec2(i, j);
                 if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, low))) continue;
-                ivec2 qp = min(q * u_scale + u_scale / 2, full - 1);
+                ivec2 qp = shading_pixel(q, u_scale, full);
                 vec4 qx = texelFetch(u_diffuse_position, qp, 0);
                 if (qx.w <= 0.0) continue;
-                if (abs(dot(qx.xyz - x, xn.xyz)) > tolerance) continue;
+                if (!continues_surface(x, xn.xyz, d, qx.xyz)) continue;
                 float range = dot(xn.xyz, texelFetch(u_diffuse_normal, qp, 0).xyz);
                 if (range <= 0.0) continue;
                 vec2 off = u - vec2(q);

@@ -220,11 +220,7 @@ impl ScrambledHalton {
             .map(|(dim, &base)| {
                 let mut state = crate::random::rng_init(seed, [dim as u32, 0], 0x7000_0000);
                 let mut p: Vec<u32> = (0..base).collect();
-                for i in (1..base as usize).rev() {
-                    let j =
-                        ((crate::random::rng_next(&mut state) * (i + 1) as f32) as usize).min(i);
-                    p.swap(i, j);
-                }
+                crate::random::shuffle(&mut p, &mut state);
                 p
             })
             .collect();

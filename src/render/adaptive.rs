@@ -121,6 +121,19 @@ impl Adaptive {
         level: usize,
         options: &AdaptiveOptions,
     ) -> Result<LevelPlan> {
+        let plan = self.plan_level(direct, level, options)?;
+        self.pack_order(&plan.computed)?;
+        self.pack_hits(direct)?;
+        Ok(plan)
+    }
+
+    /// Plans level `level` only (adaptive SPPM packs once, after all levels).
+    pub fn plan_level(
+        &self,
+        direct: &DirectLight,
+        level: usize,
+        options: &AdaptiveOptions,
+    ) -> Result<LevelPlan> {
         self.select
             .bind()
             .texture("u_first_position", &direct.diffuse_position)
@@ -138,8 +151,6 @@ impl Adaptive {
                 plan.interpolated.push(pixel as u32);
             }
         }
-        self.pack_order(&plan.computed)?;
-        self.pack_hits(direct)?;
         Ok(plan)
     }
 

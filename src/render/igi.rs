@@ -179,10 +179,7 @@ impl Vpls {
         // subset's directions or lights.
         let mut order: Vec<i32> = (0..count as i32).collect();
         let mut state = crate::random::rng_init(seed, [count, 0], crate::layout::VPL_STREAM);
-        for i in (1..order.len()).rev() {
-            let j = ((crate::random::rng_next(&mut state) * (i + 1) as f32) as usize).min(i);
-            order.swap(i, j);
-        }
+        crate::random::shuffle(&mut order, &mut state);
         order.resize((pairs.width * pairs.height) as usize, -1);
         let order =
             Texture::from_i32_format(gpu, pairs.width, pairs.height, TexFormat::R32I, &order)?;
@@ -328,6 +325,9 @@ impl Igi {
         // per pass stays VPL_BATCH whatever the interleave.
         let per_pass = VPL_BATCH * o.interleave * o.interleave;
         let mut first = 0;
+        // The first pass's fragments are the shading points with a hit
+        // (igi_gather discards the others).
+        let points = crate::gpu::Query::occlusion(&self.gpu)?;
         self.gpu.finish();
         let t0 = std::time::Instant::now();
         while first < vpls.count {
@@ -348,8 +348,15 @@ impl Igi {
                 .int("u_end", end as i32)
                 .int("u_scale", o.downsample as i32)
                 .int("u_interleave", o.interleave as i32)
-                .float("u_min_distance", self.min_distance)
-                .draw_fullscreen(&self.incident_target, &DrawState::ADDITIVE)?;
+                .float("u_min_distance", self.min_distance);
+            if first == 0 {
+                points.begin();
+            }
+            let drawn = b.draw_fullscreen(&self.incident_target, &DrawState::ADDITIVE);
+            if first == 0 {
+                points.end();
+            }
+            drawn?;
             drop(b);
             // Bounded work per submission (llvmpipe runs a pass at once).
             self.gpu.finish();
@@ -363,6 +370,7 @@ impl Igi {
             t0.elapsed().as_secs_f64(),
             stats.passes as usize,
         );
+        stats.shading_points = points.count();
         let mut incident = &self.incident;
         if o.interleave > 1 {
             let t0 = std::time::Instant::now();
@@ -401,51 +409,22 @@ impl Igi {
             t0.elapsed().as_secs_f64(),
             1,
         );
-        stats.shading_points = self.shading_points(direct);
         self.gpu.check("IGI")?;
         Ok(stats)
-    }
-
-    /// Shading points with a hit (counted on the CPU from the first hits).
-    fn shading_points(&self, direct: &DirectLight) -> u64 {
-        let f = self.options.downsample as usize;
-        let (w, h) = (self.width as usize, self.height as usize);
-        let pos = direct.diffuse_position.read_f32();
-        let mut n = 0;
-        for qy in 0..h.div_ceil(f) {
-            for qx in 0..w.div_ceil(f) {
-                let (x, y) = ((qx * f + f / 2).min(w - 1), (qy * f + f / 2).min(h - 1));
-                n += (pos[(y * w + x) * 4 + 3] > 0.0) as u64;
-            }
-        }
-        n
     }
 
     pub fn read_indirect(&self) -> Image {
         Image::from_gl_rgba(self.width, self.height, &self.indirect.read_f32())
     }
 
-    /// The incident light at the gather's resolution, after the
-    /// discontinuity buffer when interleaving (GL order, for tests).
-    pub fn read_incident(&self) -> Vec<[f32; 4]> {
-        let t = if self.options.interleave > 1 {
+    /// The incident light at the gather's resolution as the upsampling
+    /// reads it: after the discontinuity buffer when interleaving.
+    pub fn filtered_incident(&self) -> &Texture {
+        if self.options.interleave > 1 {
             &self.filtered
         } else {
             &self.incident
-        };
-        t.read_f32()
-            .chunks(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect()
-    }
-
-    /// The gather's unfiltered incident light (GL order, for tests).
-    pub fn read_gathered(&self) -> Vec<[f32; 4]> {
-        self.incident
-            .read_f32()
-            .chunks(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect()
+        }
     }
 }
 

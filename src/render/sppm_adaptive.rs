@@ -121,7 +121,7 @@ impl SppmAdaptive {
         let mut stats = AdaptiveStats::default();
         self.pyramid.clear();
         for (level, &stride) in STRIDES.iter().enumerate() {
-            let plan = self.pyramid.select(hits, level, &self.options)?;
+            let plan = self.pyramid.plan_level(hits, level, &self.options)?;
             for &p in &plan.interpolated {
                 interpolated_at[p as usize] = level as i32;
             }
