@@ -1418,20 +1418,13 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
         (&["--adaptive-threshold", "0.2"], "--adaptive"),
     ];
     for (args, says) in refused {
-        let bad = d.join("bad.png");
         let ring = args.contains(&"--scene-name-ring");
-        let out = photonmap()
-            .args(["render", "--quiet", "--width", "16", "--height", "16"])
-            .args(args.iter().filter(|a| !a.starts_with("--scene-name")))
-            .arg(scene(if ring { "ring" } else { "cornell_box" }))
-            .arg("-o")
-            .arg(&bad)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} ran");
-        assert!(stderr.contains(says), "{args:?}: {stderr}");
-        assert!(!bad.exists(), "{args:?} wrote an image");
+        let args: Vec<&str> = args
+            .iter()
+            .copied()
+            .filter(|a| !a.starts_with("--scene-name"))
+            .collect();
+        assert_render_refused(&d, if ring { "ring" } else { "cornell_box" }, &args, says);
     }
 }
 
@@ -1487,19 +1480,7 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
         (&["--method", "igi", "--vpl-min-distance=-1"], "0 or more"),
     ];
     for (args, says) in refused {
-        let bad = d.join("bad.png");
-        let out = photonmap()
-            .args(["render", "--quiet", "--width", "16", "--height", "16"])
-            .args(args)
-            .arg(scene("cornell_box"))
-            .arg("-o")
-            .arg(&bad)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} ran");
-        assert!(stderr.contains(says), "{args:?}: {stderr}");
-        assert!(!bad.exists(), "{args:?} wrote an image");
+        assert_render_refused(&d, "cornell_box", args, says);
     }
 }
 
@@ -1538,4 +1519,22 @@ fn bench_igi_splits_each_version_by_component() {
     }
     assert!(rows[3]["options"]["interleave"] == 3 && rows[3]["options"]["downsample"] == 4);
     assert!(d.join("igi.json").is_file() && d.join("00_igi.png").is_file());
+}
+
+/// `render` of the named scene at 16 x 16 with `args` into `dir/bad.png`
+/// fails, says `says`, and writes no image.
+fn assert_render_refused(dir: &std::path::Path, name: &str, args: &[&str], says: &str) {
+    let bad = dir.join("bad.png");
+    let out = photonmap()
+        .args(["render", "--quiet", "--width", "16", "--height", "16"])
+        .args(args)
+        .arg(scene(name))
+        .arg("-o")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} ran");
+    assert!(stderr.contains(says), "{args:?}: {stderr}");
+    assert!(!bad.exists(), "{args:?} wrote an image");
 }

@@ -339,16 +339,6 @@ fn igi_converges_to_the_path_tracer_as_vpls_grow() {
     )
     .unwrap();
     let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
-    let block = |f: &dyn Fn(usize) -> f64, bx: usize, by: usize| {
-        let mut s = 0.0;
-        for y in by * 4..by * 4 + 4 {
-            for x in bx * 4..bx * 4 + 4 {
-                s += f(y * 32 + x);
-            }
-        }
-        s / 16.0
-    };
-    let lum = |p: [f64; 3]| (p[0] + p[1] + p[2]) / 3.0;
     let mut chi = Vec::new();
     for paths in [64u32, 4096] {
         let runs: Vec<photonmap::render::Image> = [1u32, 2]
@@ -364,27 +354,12 @@ fn igi_converges_to_the_path_tracer_as_vpls_grow() {
                 render(&gpu, &scene, &o, &mut ()).unwrap().image
             })
             .collect();
-        let pix =
-            |r: usize, i: usize| runs[r].pixels[i].iter().map(|&v| v as f64).sum::<f64>() / 3.0;
-        let (mut chi2, mut n, mut worst) = (0.0, 0, 0f64);
-        for by in 1..7 {
-            for bx in 1..7 {
-                let pt_mean = block(&|i| lum(pt.mean[i]), bx, by);
-                let pt_var = block(&|i| lum(pt.variance_of_mean[i]), bx, by) / 16.0;
-                let (a, b) = (block(&|i| pix(0, i), bx, by), block(&|i| pix(1, i), bx, by));
-                let var = (a - b).powi(2) / 4.0;
-                let z = (0.5 * (a + b) - pt_mean) / (pt_var + var).sqrt().max(1e-9);
-                worst = worst.max((0.5 * (a + b) / pt_mean - 1.0).abs());
-                chi2 += z * z;
-                n += 1;
-            }
-        }
+        let (_, chi2_n, worst) = common::blocks_against_path_tracer(&pt, [&runs[0], &runs[1]]);
         eprintln!(
-            "two-light box, IGI {paths} paths x 2 seeds, 4 spp: chi^2/n = {:.2}, largest relative difference {:.2}%",
-            chi2 / n as f64,
+            "two-light box, IGI {paths} paths x 2 seeds, 4 spp: chi^2/n = {chi2_n:.2}, largest relative difference {:.2}%",
             100.0 * worst
         );
-        chi.push((chi2 / n as f64, worst));
+        chi.push((chi2_n, worst));
     }
     assert!(chi[1].1 < chi[0].1, "{chi:?}");
     assert!(chi[1].0 < 3.0, "{chi:?}");

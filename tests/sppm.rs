@@ -295,47 +295,12 @@ fn sppm_agrees_with_an_independent_path_tracer() {
         sppm_image(&scene, 32, 32, 2, &o),
     ];
     let sppm_seconds = t0.elapsed().as_secs_f64();
-    // 8 x 8 blocks of 4 x 4 pixels; the outer ring of blocks (walls' edges and
-    // corners, where SPPM's disc bias is largest) left out.
-    let block = |f: &dyn Fn(usize) -> f64, bx: usize, by: usize| {
-        let mut s = 0.0;
-        for y in by * 4..by * 4 + 4 {
-            for x in bx * 4..bx * 4 + 4 {
-                s += f(y * 32 + x);
-            }
-        }
-        s / 16.0
-    };
-    let lum = |p: [f64; 3]| (p[0] + p[1] + p[2]) / 3.0;
-    let (mut worst, mut chi2, mut n) = (0f64, 0f64, 0);
-    for by in 1..7 {
-        for bx in 1..7 {
-            let pt_mean = block(&|i| lum(pt.mean[i]), bx, by);
-            let pt_var = block(&|i| lum(pt.variance_of_mean[i]), bx, by) / 16.0;
-            let a = block(
-                &|i| runs[0].pixels[i].iter().map(|&v| v as f64).sum::<f64>() / 3.0,
-                bx,
-                by,
-            );
-            let b = block(
-                &|i| runs[1].pixels[i].iter().map(|&v| v as f64).sum::<f64>() / 3.0,
-                bx,
-                by,
-            );
-            // Two independent runs: their mean's variance is (a - b)^2 / 4 in expectation.
-            let sppm_var = (a - b).powi(2) / 4.0;
-            let z = (0.5 * (a + b) - pt_mean) / (pt_var + sppm_var).sqrt().max(1e-9);
-            worst = worst.max((0.5 * (a + b) / pt_mean - 1.0).abs());
-            chi2 += z * z;
-            n += 1;
-        }
-    }
+    let (n, chi2_n, worst) = common::blocks_against_path_tracer(&pt, [&runs[0], &runs[1]]);
     eprintln!(
-        "two-light box: {n} blocks, chi^2/n = {:.2}, largest relative difference {:.2}% (path tracer 1024 spp in {pt_seconds:.1} s, SPPM 2 x 128 iterations in {sppm_seconds:.1} s)",
-        chi2 / n as f64,
+        "two-light box: {n} blocks, chi^2/n = {chi2_n:.2}, largest relative difference {:.2}% (path tracer 1024 spp in {pt_seconds:.1} s, SPPM 2 x 128 iterations in {sppm_seconds:.1} s)",
         100.0 * worst
     );
-    assert!(chi2 / (n as f64) < 3.0, "chi^2/n = {}", chi2 / n as f64);
+    assert!(chi2_n < 3.0, "chi^2/n = {chi2_n}");
 }
 
 /// Energy: inside a closed diffuse sphere (radius 1, albedo rho) with a point

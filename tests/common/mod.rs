@@ -377,3 +377,40 @@ edge1 = [0.2, 0.0, 0.0]
 edge2 = [0.0, 0.0, 0.2]
 radiance = [6.0, 6.0, 6.0]
 "#;
+
+/// Two independent 32 x 32 renders against the CPU path tracer, block by
+/// block over the interior 6 x 6 blocks of 4 x 4 pixels (the outer ring, the
+/// walls' edges and corners, left out), in mean channel value: the z of each
+/// block with the two runs' spread ((a - b)^2 / 4, their mean's variance in
+/// expectation) and the tracer's own variance. Returns (blocks, chi^2/n,
+/// largest relative difference).
+pub fn blocks_against_path_tracer(
+    pt: &photonmap::reference::path_trace::PathTraced,
+    runs: [&photonmap::render::Image; 2],
+) -> (usize, f64, f64) {
+    let block = |f: &dyn Fn(usize) -> f64, bx: usize, by: usize| {
+        let mut s = 0.0;
+        for y in by * 4..by * 4 + 4 {
+            for x in bx * 4..bx * 4 + 4 {
+                s += f(y * 32 + x);
+            }
+        }
+        s / 16.0
+    };
+    let lum = |p: [f64; 3]| (p[0] + p[1] + p[2]) / 3.0;
+    let pix = |r: usize, i: usize| runs[r].pixels[i].iter().map(|&v| v as f64).sum::<f64>() / 3.0;
+    let (mut worst, mut chi2, mut n) = (0f64, 0f64, 0);
+    for by in 1..7 {
+        for bx in 1..7 {
+            let pt_mean = block(&|i| lum(pt.mean[i]), bx, by);
+            let pt_var = block(&|i| lum(pt.variance_of_mean[i]), bx, by) / 16.0;
+            let (a, b) = (block(&|i| pix(0, i), bx, by), block(&|i| pix(1, i), bx, by));
+            let var = (a - b).powi(2) / 4.0;
+            let z = (0.5 * (a + b) - pt_mean) / (pt_var + var).sqrt().max(1e-9);
+            worst = worst.max((0.5 * (a + b) / pt_mean - 1.0).abs());
+            chi2 += z * z;
+            n += 1;
+        }
+    }
+    (n, chi2 / n as f64, worst)
+}
