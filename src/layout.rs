@@ -87,6 +87,14 @@ pub const VPL_DEPTH_TOLERANCE: f32 = 0.05;
 /// The random stream of IGI's VPL paths (seeded apart from the caustic map's).
 pub const VPL_STREAM: u32 = 0x6000_0000;
 
+/// A photon footprint's normal semi-axis as a fraction of its longer surface
+/// semi-axis (glsl/common/footprint.glsl): the ellipsoid is a thin disc, so
+/// a query on another wall at a corner is not in it. The paper leaves it open.
+pub const FOOTPRINT_THICKNESS: f32 = 0.1;
+/// Nodes of the footprint BVH one pass of the footprint estimate visits per
+/// pixel at most (bounds work per pass).
+pub const FOOTPRINT_BUDGET: u32 = 256;
+
 /// Rec. 709 luminance weights of linear RGB.
 pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
@@ -125,6 +133,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ),
         ("PI", PI_GLSL.into()),
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
+        ("FOOTPRINT_THICKNESS", format!("{FOOTPRINT_THICKNESS:?}")),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
         ("PRIMITIVE_BOX_ROW", u(PRIMITIVE_BOX_ROW)),

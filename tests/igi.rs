@@ -16,6 +16,7 @@ fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderO
     (o.width, o.height, o.seed) = (w, h, seed);
     o.global = Some(GlobalIllumination {
         igi: Some(igi),
+        differentials: None,
         ..GlobalIllumination::default()
     });
     o

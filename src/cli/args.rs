@@ -7,7 +7,7 @@ use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{DirectLighting, SppmOptions};
-use photonmap::render::{EstimateMode, EstimateOptions, IgiOptions};
+use photonmap::render::{DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel};
 
 /// A parser for a whole number in lo..=hi whose error names the range.
 pub fn in_range(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone + Send + Sync {
@@ -121,6 +121,9 @@ pub enum Method {
     /// Instant global illumination: virtual point lights for diffuse
     /// interreflection, a caustic photon map for caustics.
     Igi,
+    /// Photon differentials: every photon a footprint, summed through a BVH
+    /// photon map (no k-nearest search).
+    Differentials,
 }
 
 /// A positive finite number.
@@ -236,6 +239,93 @@ impl From<&IgiArgs> for IgiOptions {
             imperfect_visibility: a.imperfect_visibility,
             interleave: a.interleave,
             downsample: a.downsample,
+        }
+    }
+}
+
+/// Photon differentials' switches (`--method differentials`).
+#[derive(Args, Clone, Debug)]
+pub struct DifferentialsArgs {
+    /// Differentials: the smoothing factor s of diffusely reflected photons'
+    /// footprints (> 0), or auto: the one that makes the mean number of
+    /// footprints at a first hit the scene's k (a pilot map at s = 1).
+    #[arg(long, value_name = "S", default_value = "auto", value_parser = auto_or_positive)]
+    pub smoothing: AutoOr<f32>,
+    /// Differentials: the factor of photons that have been only specular
+    /// (caustics; > 0; the paper's 5).
+    #[arg(long, value_name = "S", default_value_t = 5.0, value_parser = positive_f32)]
+    pub caustic_smoothing: f32,
+    /// Differentials: r_max, the longest footprint semi-axis (> 0). Default:
+    /// the scene's photon_map.max_radius.
+    #[arg(long, value_name = "R", value_parser = positive_f32)]
+    pub footprint_max_radius: Option<f32>,
+    /// Differentials: footprints a BVH leaf (1..=1024), or auto: the paper's
+    /// threshold, total footprint area over surface area.
+    #[arg(long, value_name = "T", default_value = "auto", value_parser = auto_or_leaf_size)]
+    pub leaf_size: AutoOr<u32>,
+    /// Differentials: the kernel over a footprint.
+    #[arg(long, value_enum, default_value_t = Kernel::Constant)]
+    pub kernel: Kernel,
+}
+
+/// A value, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AutoOr<T> {
+    Auto,
+    Value(T),
+}
+
+impl<T: Copy> AutoOr<T> {
+    pub fn value(self) -> Option<T> {
+        match self {
+            AutoOr::Auto => None,
+            AutoOr::Value(v) => Some(v),
+        }
+    }
+}
+
+fn positive_f32(s: &str) -> Result<f32, String> {
+    positive(s).map(|v| v as f32)
+}
+
+fn auto_or_positive(s: &str) -> Result<AutoOr<f32>, String> {
+    if s.trim() == "auto" {
+        return Ok(AutoOr::Auto);
+    }
+    positive(s)
+        .map(|v| AutoOr::Value(v as f32))
+        .map_err(|_| format!("{s}: give a positive number, or auto"))
+}
+
+fn auto_or_leaf_size(s: &str) -> Result<AutoOr<u32>, String> {
+    if s.trim() == "auto" {
+        return Ok(AutoOr::Auto);
+    }
+    match s.trim().parse::<u32>() {
+        Ok(v) if (1..=1024).contains(&v) => Ok(AutoOr::Value(v)),
+        _ => Err(format!("{s}: the allowed range is 1..=1024, or auto")),
+    }
+}
+
+impl DifferentialsArgs {
+    /// Whether any differentials switch differs from its default.
+    pub fn any_given(&self) -> bool {
+        self.smoothing != AutoOr::Auto
+            || self.caustic_smoothing != 5.0
+            || self.footprint_max_radius.is_some()
+            || self.leaf_size != AutoOr::Auto
+            || self.kernel != Kernel::Constant
+    }
+}
+
+impl From<&DifferentialsArgs> for DifferentialsOptions {
+    fn from(a: &DifferentialsArgs) -> Self {
+        DifferentialsOptions {
+            smoothing: a.smoothing.value(),
+            caustic_smoothing: a.caustic_smoothing,
+            max_radius: a.footprint_max_radius,
+            leaf_size: a.leaf_size.value(),
+            kernel: a.kernel,
         }
     }
 }

@@ -17,7 +17,9 @@ use photonmap::render::{
 };
 use photonmap::scene::Scene;
 
-use super::args::{in_range, EstimateArgs, IgiArgs, Method, PhotonMapArgs, SceneArgs, SppmArgs};
+use super::args::{
+    in_range, DifferentialsArgs, EstimateArgs, IgiArgs, Method, PhotonMapArgs, SceneArgs, SppmArgs,
+};
 use super::progress::{ProgressReport, Work};
 
 /// Render a scene to images: PNG (sRGB), EXR (linear float RGB, with the
@@ -90,6 +92,8 @@ pub struct RenderArgs {
     pub sppm: SppmArgs,
     #[command(flatten)]
     pub igi: IgiArgs,
+    #[command(flatten)]
+    pub differentials: DifferentialsArgs,
     #[command(flatten)]
     pub photons: PhotonMapArgs,
     #[command(flatten)]
@@ -257,6 +261,8 @@ impl RenderArgs {
                 threshold: self.adaptive_threshold,
             }),
             igi: (self.method == Method::Igi).then(|| (&self.igi).into()),
+            differentials: (self.method == Method::Differentials)
+                .then(|| (&self.differentials).into()),
         });
         options
     }
@@ -287,6 +293,18 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     {
         bail!("--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
     }
+    if args.method != Method::Differentials && args.differentials.any_given() {
+        bail!("--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials");
+    }
+    if args.method == Method::Differentials
+        && (args.final_gather.is_some()
+            || args.adaptive
+            || args.reference_software.is_some()
+            || args.snapshots.is_some()
+            || args.direct_only)
+    {
+        bail!("--method differentials replaces the kNN estimate with footprints: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+    }
     if args.sppm.adaptive_pilot.is_some() {
         bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
     }
@@ -310,6 +328,7 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let gpu = super::gpu(platform)?;
     let method = match (args.method, args.final_gather.is_some()) {
         (Method::Igi, _) => "igi",
+        (Method::Differentials, _) => "differentials",
         (_, true) => "final-gather",
         _ => "paper",
     };
@@ -346,6 +365,8 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "igi": options.global.as_ref().and_then(|g| g.igi.clone()),
                 "vpls": out.vpls,
                 "igi_samples": out.igi,
+                "differentials": out.differentials,
+                "footprint_samples": out.footprint_estimates,
             }),
         })?;
     }
@@ -385,8 +406,9 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         || args.spp > 1
         || args.final_gather.is_some()
         || args.igi.any_given()
+        || args.differentials.any_given()
     {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather and IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample)");
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample) and photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel)");
     }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
@@ -545,6 +567,28 @@ fn print_summary(
             } else {
                 "none (nothing specular in the scene)"
             }
+        );
+    }
+    if let (Some(d), Some(s)) = (&out.differentials, out.footprint_estimates.first()) {
+        let pilot = d.pilot_mean_diffuse_footprints.map_or(String::new(), |m| {
+            format!(" (auto: {m:.2} at s = 1 in the pilot)")
+        });
+        eprintln!(
+            "photon differentials: {} footprints ({} diffuse, {} caustic, {} degenerate); s = {:.2}{pilot}, caustics {}, r_max {}; BVH of {} leaves of {} (auto {}); {:.1} footprints hold a first hit on average (k_PD), {:.1} nodes and {:.1} footprints examined, {} passes",
+            d.footprints,
+            d.diffuse_footprints,
+            d.footprints - d.diffuse_footprints,
+            d.degenerate_footprints,
+            d.smoothing,
+            d.caustic_smoothing,
+            d.max_radius,
+            d.leaves,
+            d.leaf_size,
+            d.auto_leaf_size,
+            s.mean_footprints,
+            s.mean_nodes,
+            s.mean_examined,
+            s.passes,
         );
     }
     if !out.adaptive.is_empty() {

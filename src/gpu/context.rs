@@ -165,7 +165,7 @@ enum EglKind {
 type EglInstance = egl::DynamicInstance<egl::EGL1_5>;
 
 struct SharedDisplay {
-    egl: EglInstance,
+    egl: Arc<EglInstance>,
     display: egl::Display,
     kind: EglKind,
 }
@@ -175,9 +175,26 @@ struct SharedDisplay {
 unsafe impl Send for SharedDisplay {}
 unsafe impl Sync for SharedDisplay {}
 
-type DisplayTable = std::sync::Mutex<Vec<((EglKind, bool), Arc<SharedDisplay>)>>;
+/// Each display asked for, or why it cannot be had: asked once per process,
+/// so that threads making contexts at once neither repeat the device probe
+/// nor load and unload libEGL under each other.
+type DisplayTable = std::sync::Mutex<
+    Vec<(
+        (EglKind, bool),
+        std::result::Result<Arc<SharedDisplay>, String>,
+    )>,
+>;
 
 static DISPLAYS: OnceLock<DisplayTable> = OnceLock::new();
+
+/// libEGL, loaded once and never unloaded (Mesa keeps threads of its own).
+struct LoadedEgl(std::result::Result<Arc<EglInstance>, String>);
+// SAFETY: the instance is a library handle and a table of function pointers
+// that EGL allows any thread to call.
+unsafe impl Send for LoadedEgl {}
+unsafe impl Sync for LoadedEgl {}
+
+static EGL: OnceLock<LoadedEgl> = OnceLock::new();
 
 struct EglContext {
     display: Arc<SharedDisplay>,
@@ -192,10 +209,17 @@ impl Drop for EglContext {
     }
 }
 
-fn load_egl() -> Result<EglInstance> {
-    // SAFETY: loading the system libEGL, whose ABI is the Khronos one.
-    let loaded = unsafe { EglInstance::load_required() };
-    loaded.map_err(|e| Error::Platform(format!("cannot load libEGL.so.1 ({e}); {EGL_HINT}")))
+fn load_egl() -> Result<Arc<EglInstance>> {
+    let loaded = EGL.get_or_init(|| {
+        // SAFETY: loading the system libEGL, whose ABI is the Khronos one.
+        let loaded = unsafe { EglInstance::load_required() };
+        LoadedEgl(
+            loaded
+                .map(Arc::new)
+                .map_err(|e| format!("cannot load libEGL.so.1 ({e}); {EGL_HINT}")),
+        )
+    });
+    loaded.0.clone().map_err(Error::Platform)
 }
 
 /// The display of `kind`, opened and initialised once per process.
@@ -204,8 +228,17 @@ fn open_display(kind: EglKind, gpu_only: bool) -> Result<Arc<SharedDisplay>> {
     let table = DISPLAYS.get_or_init(Default::default);
     let mut table = table.lock().unwrap_or_else(|p| p.into_inner());
     if let Some((_, d)) = table.iter().find(|(k, _)| *k == (kind, gpu_only)) {
-        return Ok(d.clone());
+        return d.clone().map_err(Error::Platform);
     }
+    let opened = open_new_display(kind, gpu_only);
+    table.push((
+        (kind, gpu_only),
+        opened.as_ref().map(Arc::clone).map_err(|e| e.to_string()),
+    ));
+    opened
+}
+
+fn open_new_display(kind: EglKind, gpu_only: bool) -> Result<Arc<SharedDisplay>> {
     let egl = load_egl()?;
     let client_ext = egl
         .query_string(None, egl::EXTENSIONS)
@@ -229,9 +262,7 @@ fn open_display(kind: EglKind, gpu_only: bool) -> Result<Arc<SharedDisplay>> {
             "eglInitialize on the EGL {name} display failed: {e}; {EGL_HINT}"
         ))
     })?;
-    let shared = Arc::new(SharedDisplay { egl, display, kind });
-    table.push(((kind, gpu_only), shared.clone()));
-    Ok(shared)
+    Ok(Arc::new(SharedDisplay { egl, display, kind }))
 }
 
 fn surfaceless_display(

@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod bitonic;
 pub mod build;
+pub mod differentials;
 pub mod fit;
 pub mod projection;
 pub mod stencil_routing;

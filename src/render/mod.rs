@@ -4,6 +4,7 @@
 //! and average the samples into the image.
 
 pub mod adaptive;
+pub mod differentials;
 pub mod direct;
 pub mod explain;
 pub mod final_gather;
@@ -26,6 +27,9 @@ use crate::scene::{Camera, Scene};
 pub use crate::image::Image;
 pub use crate::timing::{StageTiming, Timings};
 pub use adaptive::{Adaptive, AdaptiveOptions, AdaptiveStats};
+pub use differentials::{
+    DifferentialPhotons, DifferentialsOptions, FootprintEstimate, FootprintStats, Kernel,
+};
 pub use direct::DirectLight;
 pub use explain::ExplainLine;
 pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
@@ -66,6 +70,9 @@ pub struct GlobalIllumination {
     /// Instant global illumination (`--method igi`): VPLs for the diffuse
     /// interreflection, and the photon map for caustics only.
     pub igi: Option<IgiOptions>,
+    /// Photon differentials with a BVH photon map (`--method differentials`):
+    /// footprints instead of the kNN-grid, one map for every photon.
+    pub differentials: Option<DifferentialsOptions>,
 }
 
 impl RenderOptions {
@@ -106,6 +113,9 @@ pub struct RenderOutput {
     /// IGI's VPLs, and each eye sample's gather.
     pub vpls: Option<VplReport>,
     pub igi: Vec<IgiStats>,
+    /// Photon differentials' map, and each eye sample's estimate.
+    pub differentials: Option<DifferentialsReport>,
+    pub footprint_estimates: Vec<FootprintStats>,
     /// The last radiance estimate, and every one (view by view, sample by sample).
     pub estimate: Option<EstimateStats>,
     pub estimates: Vec<EstimateStats>,
@@ -135,6 +145,156 @@ pub struct RenderState {
     /// IGI's VPLs and gather textures (the last eye sample's).
     pub vpls: Option<Vpls>,
     pub igi: Option<Igi>,
+    /// Photon differentials' photons, footprint map and estimate textures.
+    pub differentials: Option<DifferentialsRun>,
+}
+
+/// What the photon-differentials map was made of.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct DifferentialsReport {
+    pub trace: photon::TraceReport,
+    pub footprints: u32,
+    /// Footprints of photons reflected diffusely before (the others: caustics).
+    pub diffuse_footprints: u32,
+    pub degenerate_footprints: u32,
+    /// s in use, and (auto) the pilot's mean diffuse footprints a hit at s = 1.
+    pub smoothing: f32,
+    pub pilot_mean_diffuse_footprints: Option<f64>,
+    pub caustic_smoothing: f32,
+    pub max_radius: f32,
+    pub kernel: Kernel,
+    pub leaf_size: u32,
+    pub auto_leaf_size: u32,
+    pub leaves: u32,
+    pub total_footprint_area: f64,
+    pub surface_area: f64,
+    pub delta: f32,
+}
+
+/// Photon differentials' GPU state: the photons, the map (made on the first
+/// eye sample, after the pilot when s is automatic) and the estimate.
+pub struct DifferentialsRun {
+    pub photons: DifferentialPhotons,
+    pub map: Option<photon::differentials::FootprintMap>,
+    pub estimate: FootprintEstimate,
+    builder: photon::differentials::FootprintBuilder,
+    options: DifferentialsOptions,
+    pilot_mean: Option<f64>,
+}
+
+impl DifferentialsRun {
+    fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        textures: &SceneTextures,
+        gi: &GlobalIllumination,
+        o: &DifferentialsOptions,
+        (w, h, seed): (u32, u32, u32),
+        timings: &mut Timings,
+    ) -> Result<Self> {
+        o.check()?;
+        let tracer = photon::PhotonTracer::with_config(gpu, gi.photons.trace())?;
+        let photons = DifferentialPhotons::trace(gpu, scene, textures, &tracer, seed, timings)?;
+        Ok(Self {
+            photons,
+            map: None,
+            estimate: FootprintEstimate::new(gpu, w, h, o.kernel)?,
+            builder: photon::differentials::FootprintBuilder::new(gpu)?,
+            options: o.clone(),
+            pilot_mean: None,
+        })
+    }
+
+    /// The map, built on first use: after a pilot at s = 1 over these first
+    /// hits when s is automatic ("smoothing pilot").
+    fn ensure_map(&mut self, f: &SampleFrame<'_>, timings: &mut Timings) -> Result<()> {
+        if self.map.is_none() {
+            let smoothing = match self.options.smoothing {
+                Some(s) => s,
+                None => {
+                    let t0 = std::time::Instant::now();
+                    let mut pilot_timings = Timings::default();
+                    let options = self.options.footprint_options(f.scene, 1.0);
+                    let pilot = self.builder.build(
+                        f.scene,
+                        &self.photons.frames,
+                        &self.photons.differentials,
+                        &options,
+                        &mut pilot_timings,
+                    )?;
+                    if pilot.diffuse == 0 {
+                        // Caustics only: s touches no footprint, the pilot is the map.
+                        timings.add_both(
+                            "footprint map",
+                            pilot_timings.gpu_total(),
+                            t0.elapsed().as_secs_f64(),
+                            pilot_timings.stages.iter().map(|s| s.passes).sum(),
+                        );
+                        self.map = Some(pilot);
+                        return Ok(());
+                    }
+                    let stats = self.estimate.run(
+                        f.textures,
+                        f.direct,
+                        &pilot,
+                        &mut pilot_timings,
+                        &mut |_, _| {},
+                    )?;
+                    timings.add_both(
+                        "smoothing pilot",
+                        0.0,
+                        t0.elapsed().as_secs_f64(),
+                        pilot_timings.stages.iter().map(|s| s.passes).sum(),
+                    );
+                    self.pilot_mean = Some(stats.mean_diffuse_footprints);
+                    differentials::smoothing_for(
+                        f.scene.photon_map.k,
+                        stats.mean_diffuse_footprints,
+                    )
+                    .unwrap_or(1.0)
+                }
+            };
+            let options = self.options.footprint_options(f.scene, smoothing);
+            let t0 = std::time::Instant::now();
+            let mut stages = Timings::default();
+            let map = self.builder.build(
+                f.scene,
+                &self.photons.frames,
+                &self.photons.differentials,
+                &options,
+                &mut stages,
+            )?;
+            timings.add_both(
+                "footprint map",
+                stages.gpu_total(),
+                t0.elapsed().as_secs_f64(),
+                stages.stages.iter().map(|s| s.passes).sum(),
+            );
+            self.map = Some(map);
+        }
+        Ok(())
+    }
+
+    fn report(&self) -> Option<DifferentialsReport> {
+        let m = self.map.as_ref()?;
+        Some(DifferentialsReport {
+            trace: self.photons.trace.clone(),
+            footprints: m.count,
+            diffuse_footprints: m.diffuse,
+            degenerate_footprints: m.degenerate,
+            smoothing: m.options.smoothing,
+            pilot_mean_diffuse_footprints: self.pilot_mean,
+            caustic_smoothing: m.options.caustic_smoothing,
+            max_radius: m.options.max_radius,
+            kernel: self.options.kernel,
+            leaf_size: m.leaf_size,
+            auto_leaf_size: m.auto_leaf_size,
+            leaves: m.leaves,
+            total_footprint_area: m.total_area,
+            surface_area: m.surface_area,
+            delta: m.delta,
+        })
+    }
 }
 
 /// Renders a scene: the paper's ray tracer (direct light, specular paths) and,
@@ -232,6 +392,8 @@ pub fn render_views(
         vpls,
         igi,
         igi_stats,
+        differentials,
+        footprint_stats,
         ..
     } = global;
     let mut output = finish(
@@ -250,6 +412,7 @@ pub fn render_views(
             gather,
             vpls: None,
             igi: None,
+            differentials: None,
         },
     );
     if let Some(g) = global_map {
@@ -269,6 +432,9 @@ pub fn render_views(
             .map_or(0.0, |o| o.min_distance_for(scene)),
     });
     output.igi = igi_stats;
+    output.differentials = differentials.as_ref().and_then(DifferentialsRun::report);
+    output.footprint_estimates = footprint_stats;
+    output.state.differentials = differentials;
     output.state.vpls = vpls;
     output.state.igi = igi;
     Ok(output)
@@ -302,6 +468,9 @@ struct GlobalPart {
     vpls: Option<Vpls>,
     igi: Option<Igi>,
     igi_stats: Vec<IgiStats>,
+    /// Photon differentials' run, and each eye sample's estimate.
+    differentials: Option<DifferentialsRun>,
+    footprint_stats: Vec<FootprintStats>,
 }
 
 impl GlobalPart {
@@ -365,6 +534,30 @@ impl GlobalPart {
                 (Some(vpls), Some(igi))
             }
         };
+        let differentials = match options
+            .global
+            .as_ref()
+            .map(|g| (g, g.differentials.as_ref()))
+        {
+            Some((gi, Some(o))) => {
+                if adaptive || gi.final_gather.is_some() || gi.igi.is_some() {
+                    return Err(Error::InvalidOption(
+                        "photon differentials replace the kNN estimate: drop --adaptive, --final-gather and IGI's options".into(),
+                    ));
+                }
+                observer.progress(&Progress::stage("photons", 0, 1));
+                Some(DifferentialsRun::new(
+                    gpu,
+                    scene,
+                    textures,
+                    gi,
+                    o,
+                    (w, h, options.seed),
+                    timings,
+                )?)
+            }
+            _ => None,
+        };
         Ok(Self {
             built,
             global_map,
@@ -377,6 +570,8 @@ impl GlobalPart {
             vpls,
             igi,
             igi_stats: Vec::new(),
+            differentials,
+            footprint_stats: Vec::new(),
         })
     }
 
@@ -506,6 +701,25 @@ impl GlobalPart {
                 image.add(&igi.read_indirect());
             }
         }
+        if let Some(run) = &mut self.differentials {
+            run.ensure_map(f, timings)?;
+            let map = run.map.as_ref().expect("ensure_map made it");
+            let at = f.at;
+            let stats =
+                run.estimate
+                    .run(f.textures, f.direct, map, timings, &mut |walking, hits| {
+                        observer.progress(&Progress::at(
+                            "footprint estimate",
+                            hits - walking,
+                            hits,
+                            at,
+                        ))
+                    })?;
+            self.footprint_stats.push(stats);
+            if let Some(image) = &mut image {
+                image.add(&run.estimate.read_indirect());
+            }
+        }
         Ok(image)
     }
 }
@@ -552,6 +766,8 @@ fn finish(
         adaptive: Vec::new(),
         vpls: None,
         igi: Vec::new(),
+        differentials: None,
+        footprint_estimates: Vec::new(),
         estimate: estimates.last().cloned(),
         estimates,
     }
@@ -584,6 +800,10 @@ fn build_maps(
     seed: u32,
     timings: &mut Timings,
 ) -> Result<(Option<BuiltMap>, Option<BuiltMap>)> {
+    if gi.differentials.is_some() {
+        // Photon differentials trace their own photons (DifferentialsRun).
+        return Ok((None, None));
+    }
     if gi.igi.is_some() {
         // IGI's VPLs carry the diffuse interreflection; the photon map only
         // the caustics, which VPLs cannot (light through glass or off a mirror

@@ -212,6 +212,17 @@ impl Light {
     }
 }
 
+/// The surface area of a shape (a cylinder's side, with no caps).
+pub fn surface_area(g: &Geometry) -> f32 {
+    use std::f32::consts::PI;
+    match *g {
+        Geometry::Sphere { radius, .. } => 4.0 * PI * radius * radius,
+        Geometry::Cylinder { radius, height, .. } => 2.0 * PI * radius * height,
+        Geometry::Parallelogram { edge1, edge2, .. } => edge1.cross(edge2).length(),
+        Geometry::Triangle { .. } => triangle_area(g),
+    }
+}
+
 /// The area of a triangle (0 for any other geometry).
 pub fn triangle_area(g: &Geometry) -> f32 {
     match *g {

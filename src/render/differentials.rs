@@ -1,0 +1,326 @@
+//! Photon differentials with a BVH photon map (Fabianowski and Dingliana
+//! 2009) as a third method beside photon mapping and IGI, on the same passes
+//! (`--method differentials`):
+//!
+//! 1. **Photons** are traced by the photon passes as for the kNN map (the
+//!    scene's stored count, projection maps where it stores caustics only),
+//!    and `photon::differentials` gives each record its differentials, its
+//!    footprint and the footprint BVH.
+//! 2. **The estimate** at each eye path's first diffuse hit sums every
+//!    footprint that holds it (`footprint_gather`: a stackless walk of the
+//!    implicit BVH, a bounded number of nodes a pass, ended by occlusion
+//!    query), with a constant or Epanechnikov kernel; no k nearest are
+//!    searched for.
+//! 3. **The image**: direct light and specular paths from the ray tracer, plus
+//!    throughput x albedo / pi x the footprints' irradiance.
+//!
+//! The smoothing factor s of diffusely reflected photons is the user's or
+//! (`auto`) chosen so that the mean number of footprints holding a first hit
+//! (the paper's k_PD) is the scene's k, the kNN estimate's photon count: the
+//! paper finds k_PM ~ k_PD gives equal quality. A pilot map built with s = 1
+//! measures that mean over the first eye sample's hits, and s scales it by
+//! sqrt(k / mean) (footprint areas grow as s^2).
+
+use crate::error::Error;
+use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
+use crate::layout::FOOTPRINT_BUDGET;
+use crate::photon::differentials::{
+    trace_differentials, DifferentialFrames, FootprintMap, FootprintOptions,
+};
+use crate::photon::{PhotonFrames, PhotonTracer, TraceReport};
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+
+use super::{DirectLight, Image, Timings};
+
+/// The density-estimation kernel over a footprint's ellipse.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kernel {
+    /// 1 / A inside (the paper's main results).
+    #[default]
+    Constant,
+    /// 2 (1 - u^2) / A (the paper's figure 4, right).
+    Epanechnikov,
+}
+
+/// How `--method differentials` runs.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct DifferentialsOptions {
+    /// s; None: chosen so that k_PD equals the scene's k (a pilot map).
+    pub smoothing: Option<f32>,
+    /// The factor of photons that have been only specular (the paper: 5).
+    pub caustic_smoothing: f32,
+    /// r_max (None: the scene's photon_map.max_radius).
+    pub max_radius: Option<f32>,
+    /// T (None: the paper's automatic threshold).
+    pub leaf_size: Option<u32>,
+    pub kernel: Kernel,
+}
+
+impl Default for DifferentialsOptions {
+    fn default() -> Self {
+        Self {
+            smoothing: None,
+            caustic_smoothing: 5.0,
+            max_radius: None,
+            leaf_size: None,
+            kernel: Kernel::Constant,
+        }
+    }
+}
+
+impl DifferentialsOptions {
+    pub fn check(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::InvalidOption(what));
+        let positive = |v: f32| v > 0.0 && v.is_finite();
+        if let Some(s) = self.smoothing {
+            if !positive(s) {
+                return bad(format!("--smoothing {s}: give a factor above 0, or auto"));
+            }
+        }
+        if !positive(self.caustic_smoothing) {
+            return bad(format!(
+                "--caustic-smoothing {}: give a factor above 0",
+                self.caustic_smoothing
+            ));
+        }
+        if let Some(r) = self.max_radius {
+            if !positive(r) {
+                return bad(format!("--footprint-max-radius {r}: give a radius above 0"));
+            }
+        }
+        if let Some(t) = self.leaf_size {
+            if !(1..=1024).contains(&t) {
+                return bad(format!(
+                    "--leaf-size {t}: the allowed range is 1..=1024, or auto"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn footprint_options(&self, scene: &Scene, smoothing: f32) -> FootprintOptions {
+        FootprintOptions {
+            smoothing,
+            caustic_smoothing: self.caustic_smoothing,
+            max_radius: self.max_radius.unwrap_or(scene.photon_map.max_radius),
+            leaf_size: self.leaf_size,
+        }
+    }
+}
+
+/// The photons of a render with their differentials.
+pub struct DifferentialPhotons {
+    pub frames: PhotonFrames,
+    pub differentials: DifferentialFrames,
+    pub trace: TraceReport,
+}
+
+impl DifferentialPhotons {
+    /// Traces the scene's photons (to its stored count) and their differentials.
+    pub fn trace(
+        gpu: &Gpu,
+        scene: &Scene,
+        textures: &SceneTextures,
+        tracer: &PhotonTracer,
+        seed: u32,
+        timings: &mut Timings,
+    ) -> Result<Self> {
+        gpu.finish();
+        let t0 = std::time::Instant::now();
+        let (frames, trace) = tracer.trace_to_stored(scene, textures, seed)?;
+        gpu.finish();
+        timings.add_both(
+            "trace photons",
+            trace.gpu_seconds,
+            t0.elapsed().as_secs_f64(),
+            frames.frames as usize,
+        );
+        let t0 = std::time::Instant::now();
+        let differentials = trace_differentials(gpu, scene, textures, &frames)?;
+        gpu.finish();
+        timings.add_both(
+            "photon differentials",
+            0.0,
+            t0.elapsed().as_secs_f64(),
+            frames.frames as usize,
+        );
+        Ok(Self {
+            frames,
+            differentials,
+            trace,
+        })
+    }
+}
+
+/// What one footprint estimate did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FootprintStats {
+    pub passes: u32,
+    /// Pixels with a first diffuse hit.
+    pub query_pixels: u64,
+    /// Mean footprints holding a first hit (k_PD), and of them those of
+    /// diffusely reflected photons.
+    pub mean_footprints: f64,
+    pub mean_diffuse_footprints: f64,
+    /// Mean BVH nodes visited and footprints examined per first hit.
+    pub mean_nodes: f64,
+    pub mean_examined: f64,
+    pub wall_seconds: f64,
+}
+
+/// The footprint estimate's textures and programs at one image size.
+pub struct FootprintEstimate {
+    gpu: Gpu,
+    init: Program,
+    gather: Program,
+    compose: Program,
+    kernel: Kernel,
+    /// rgb: the footprints' irradiance, w: footprints holding the hit.
+    pub sum: Texture,
+    /// node (0: done), nodes visited, footprints examined, diffuse footprints.
+    pub walk: Texture,
+    state_target: Target,
+    /// Reflected indirect light.
+    pub indirect: Texture,
+    indirect_target: Target,
+    width: u32,
+    height: u32,
+}
+
+impl FootprintEstimate {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, kernel: Kernel) -> Result<Self> {
+        let sum = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let walk = Texture::new(gpu, width, height, TexFormat::Rgba32I)?;
+        let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            init: Program::fullscreen(gpu, "render/footprint_init.frag")?,
+            gather: Program::fullscreen(gpu, "render/footprint_gather.frag")?,
+            compose: Program::fullscreen(gpu, "render/footprint_compose.frag")?,
+            kernel,
+            state_target: Target::new(gpu, &[&sum, &walk])?,
+            indirect_target: Target::new(gpu, &[&indirect])?,
+            sum,
+            walk,
+            indirect,
+            width,
+            height,
+        })
+    }
+
+    /// The estimate at `direct`'s first hits, composed into `indirect`. Adds
+    /// "footprint estimate" to `timings`; `on_pass(still walking, hits)`.
+    pub fn run(
+        &self,
+        textures: &SceneTextures,
+        direct: &DirectLight,
+        map: &FootprintMap,
+        timings: &mut Timings,
+        on_pass: &mut dyn FnMut(u64, u64),
+    ) -> Result<FootprintStats> {
+        let gpu = &self.gpu;
+        gpu.finish();
+        let t0 = std::time::Instant::now();
+        let hits = Query::occlusion(gpu)?;
+        self.init
+            .bind()
+            .texture("u_query_position", &direct.diffuse_position)
+            .draw_fullscreen(&self.state_target, &DrawState::PLAIN)?;
+        let mut stats = FootprintStats::default();
+        loop {
+            crate::interrupt::check()?;
+            gpu.texture_barrier();
+            let mut b = self.gather.bind();
+            b.texture("u_query_position", &direct.diffuse_position)
+                .texture("u_query_normal", &direct.diffuse_normal)
+                .texture("u_state_sum", &self.sum)
+                .texture("u_state_walk", &self.walk)
+                .texture("u_box_min", &map.box_min)
+                .texture("u_box_max", &map.box_max)
+                .int("u_box_width", map.box_width as i32)
+                .texture("u_footprint0", &map.footprints[0])
+                .texture("u_footprint1", &map.footprints[1])
+                .texture("u_footprint2", &map.footprints[2])
+                .texture("u_footprint3", &map.footprints[3])
+                .int("u_footprint_width", map.width as i32)
+                .int("u_count", map.count as i32)
+                .int("u_leaves", map.leaves as i32)
+                .int("u_leaf_size", map.leaf_size as i32)
+                .int("u_budget", FOOTPRINT_BUDGET as i32)
+                .int(
+                    "u_epanechnikov",
+                    i32::from(self.kernel == Kernel::Epanechnikov),
+                );
+            hits.begin();
+            let drawn = b.draw_fullscreen(&self.state_target, &DrawState::PLAIN);
+            hits.end();
+            drawn?;
+            drop(b);
+            // The fragments drawn are the pixels that were still walking.
+            let walking = hits.count();
+            if stats.passes == 0 {
+                stats.query_pixels = walking;
+            }
+            if walking == 0 {
+                break;
+            }
+            stats.passes += 1;
+            on_pass(walking, stats.query_pixels);
+        }
+        gpu.texture_barrier();
+        let mut b = self.compose.bind();
+        textures.bind(&mut b);
+        b.texture("u_state_sum", &self.sum)
+            .texture("u_diffuse_normal", &direct.diffuse_normal)
+            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
+            .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
+        drop(b);
+        gpu.finish();
+        stats.wall_seconds = t0.elapsed().as_secs_f64();
+        timings.add_both(
+            "footprint estimate",
+            0.0,
+            stats.wall_seconds,
+            stats.passes as usize + 2,
+        );
+        gpu.check("footprint estimate")?;
+        self.summarise(direct, &mut stats);
+        Ok(stats)
+    }
+
+    /// Means over the first hits, from a read-back of the state (not timed).
+    fn summarise(&self, direct: &DirectLight, stats: &mut FootprintStats) {
+        let sum = self.sum.read_f32();
+        let walk = self.walk.read_i32();
+        let hit = direct.diffuse_position.read_f32();
+        let (mut n, mut k, mut kd, mut nodes, mut examined) = (0u64, 0f64, 0f64, 0f64, 0f64);
+        for i in 0..(self.width * self.height) as usize {
+            if hit[4 * i + 3] > 0.0 {
+                n += 1;
+                k += f64::from(sum[4 * i + 3]);
+                nodes += f64::from(walk[4 * i + 1]);
+                examined += f64::from(walk[4 * i + 2]);
+                kd += f64::from(walk[4 * i + 3]);
+            }
+        }
+        let n = n.max(1) as f64;
+        stats.mean_footprints = k / n;
+        stats.mean_diffuse_footprints = kd / n;
+        stats.mean_nodes = nodes / n;
+        stats.mean_examined = examined / n;
+    }
+
+    pub fn read_indirect(&self) -> Image {
+        Image::from_gl_rgba(self.width, self.height, &self.indirect.read_f32())
+    }
+}
+
+/// The smoothing factor that makes the mean of diffuse footprints holding a
+/// first hit `k`, from a pilot's mean at s = 1 (areas grow as s^2); None when
+/// the pilot found none (a scene with no diffusely reflected photon, whose
+/// footprints s does not touch).
+pub fn smoothing_for(k: u32, pilot_mean_diffuse: f64) -> Option<f32> {
+    (pilot_mean_diffuse > 0.0).then(|| (k as f64 / pilot_mean_diffuse).sqrt() as f32)
+}
