@@ -2,6 +2,7 @@
 
 pub mod adaptive;
 pub mod bvh;
+pub mod differentials;
 pub mod final_gather;
 pub mod igi;
 pub mod intersect;

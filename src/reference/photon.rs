@@ -27,7 +27,7 @@ pub struct PhotonRecord {
     pub outgoing: Vec4,
 }
 
-fn primitive_normal(scene: &Scene, prim: usize, p: Vec3) -> Vec3 {
+pub(super) fn primitive_normal(scene: &Scene, prim: usize, p: Vec3) -> Vec3 {
     use crate::scene::Geometry::*;
     match scene.shapes[prim].geometry {
         Sphere { center, .. } => (p - center).normalize(),

@@ -1,0 +1,349 @@
+//! Twins of photon differentials and the footprint BVH
+//! (glsl/photon/differentials.frag, footprint_keys.frag, footprints.frag,
+//! footprint_leaves.frag, footprint_reduce.frag; glsl/common/footprint.glsl;
+//! glsl/render/footprint_gather.frag), line for line, on records read back
+//! from the GPU.
+
+use glam::Vec3;
+
+use crate::layout::FOOTPRINT_THICKNESS;
+use crate::photon::differentials::FootprintOptions;
+use crate::scene::pack::PackedScene;
+use crate::scene::{Geometry, Light, Material, Scene};
+
+use super::photon::{basis_around, primitive_normal, PhotonRecord};
+use super::ray_trace::fresnel_dielectric;
+use super::shading::{shading_normal, specular_shaded};
+
+/// Two positional and two directional differentials (units of Delta).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Differentials {
+    pub dp: [Vec3; 2],
+    pub dd: [Vec3; 2],
+}
+
+/// One record's differentials: dp at its hit, and as the photon leaves.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RecordDifferentials {
+    pub axis: [Vec3; 2],
+    /// Reflected diffusely before this hit.
+    pub diffuse_at_hit: bool,
+    pub out: Differentials,
+    pub diffuse_out: bool,
+}
+
+/// Emission: a point light's orthonormal pair about d scaled by
+/// sqrt(measure); an area light's re-emission from a footprint of `measure`.
+pub fn emission(d: Vec3, point: bool, measure: f32) -> Differentials {
+    let (t0, t1) = basis_around(d);
+    let v = if point { 0.0 } else { measure.sqrt() };
+    let s = if point { measure.sqrt() } else { 1.0 };
+    Differentials {
+        dp: [v * t0, v * t1],
+        dd: [s * t0, s * t1],
+    }
+}
+
+/// Igehy's transfer to the hit p (normal nf) from `origin` along unit d.
+pub fn transfer(diff: &Differentials, origin: Vec3, p: Vec3, d: Vec3, nf: Vec3) -> [Vec3; 2] {
+    let t = (p - origin).dot(d);
+    [0, 1].map(|k| {
+        let moved = diff.dp[k] + t * diff.dd[k];
+        moved - moved.dot(nf) / d.dot(nf) * d
+    })
+}
+
+/// Re-emission at a diffuse hit (equation 13): roulette survival q widens
+/// the footprint to area / q; the new directional pair is orthonormal about
+/// `next` and the positional one v times it.
+pub fn reemit(dp_hit: [Vec3; 2], q: f32, next: Vec3) -> Differentials {
+    let v = (dp_hit[0].cross(dp_hit[1]).length() / q).sqrt();
+    let (t0, t1) = basis_around(next);
+    Differentials {
+        dp: [v * t0, v * t1],
+        dd: [t0, t1],
+    }
+}
+
+/// Reflection of directional differentials about unit m (facing d), whose
+/// own differentials are dn.
+pub fn reflect(d: Vec3, m: Vec3, dd: [Vec3; 2], dn: [Vec3; 2]) -> [Vec3; 2] {
+    let dm = d.dot(m);
+    let mut out = dd;
+    for k in 0..2 {
+        let ddm = dd[k].dot(m) + d.dot(dn[k]);
+        out[k] = dd[k] - 2.0 * (dm * dn[k] + ddm * m);
+    }
+    out
+}
+
+/// Refraction of directional differentials with eta = n_i / n_t; cos_t is
+/// the transmitted cosine.
+pub fn refract(d: Vec3, m: Vec3, eta: f32, cos_t: f32, dd: [Vec3; 2], dn: [Vec3; 2]) -> [Vec3; 2] {
+    let dm = d.dot(m);
+    let mu = -eta * dm - cos_t;
+    let mut out = dd;
+    for k in 0..2 {
+        let ddm = dd[k].dot(m) + d.dot(dn[k]);
+        let dmu = (-eta - eta * eta * dm / cos_t) * ddm;
+        out[k] = eta * dd[k] + mu * dn[k] + dmu * m;
+    }
+    out
+}
+
+/// The normal's differential along dp on a sphere or cylinder (0 elsewhere).
+pub fn normal_differential(g: &Geometry, dp: Vec3, side: f32) -> Vec3 {
+    match *g {
+        Geometry::Sphere { radius, .. } => side * dp / radius,
+        Geometry::Cylinder { axis, radius, .. } => side * (dp - dp.dot(axis) * axis) / radius,
+        _ => Vec3::ZERO,
+    }
+}
+
+/// The light a frame-0 record left from (glsl `emitting_light`): the point
+/// light at p, the area light whose primitive it left, or the triangle light
+/// holding that primitive.
+fn emitting_light(scene: &Scene, packed: &PackedScene, p: Vec3, prim: i32) -> usize {
+    let texels = crate::layout::LIGHT_TEXELS as usize;
+    for (l, light) in scene.lights.iter().enumerate() {
+        let found = match *light {
+            Light::Point { position, .. } => prim < 0 && position == p,
+            Light::Area { .. } => packed.lights[l * texels + 5][2] as i32 == prim,
+            Light::Triangles { first, count, .. } => {
+                (first..first + count).contains(&(prim as usize))
+            }
+        };
+        if found {
+            return l;
+        }
+    }
+    0
+}
+
+/// Every record's differentials (frames stacked, row 0 of frame 0 first),
+/// given each light's measure (`photon::differentials::light_measures`).
+pub fn record_differentials(
+    scene: &Scene,
+    records: &[PhotonRecord],
+    per_frame: usize,
+    measures: &[f32],
+) -> Vec<RecordDifferentials> {
+    let packed = PackedScene::new(scene);
+    let mut out = vec![RecordDifferentials::default(); records.len()];
+    for (i, r) in records.iter().enumerate() {
+        let frame = i / per_frame;
+        if frame == 0 {
+            if r.incoming.w == 0.0 {
+                continue;
+            }
+            let p = r.position.truncate();
+            let l = emitting_light(scene, &packed, p, r.outgoing.w as i32);
+            let point = matches!(scene.lights[l], Light::Point { .. });
+            out[i].out = emission(r.outgoing.truncate(), point, measures[l]);
+            continue;
+        }
+        if r.position.w < 0.0 {
+            continue;
+        }
+        let prev = out[i - per_frame];
+        let origin = records[i - per_frame].position.truncate();
+        let d = r.incoming.truncate();
+        let p = r.position.truncate();
+        let prim = r.outgoing.w as usize;
+        let n = primitive_normal(scene, prim, p);
+        let side = if n.dot(d) < 0.0 { 1.0 } else { -1.0 };
+        let nf = side * n;
+        let dp = transfer(&prev.out, origin, p, d, nf);
+        let mut rec = RecordDifferentials {
+            axis: dp,
+            diffuse_at_hit: prev.diffuse_out,
+            out: Differentials::default(),
+            diffuse_out: prev.diffuse_out,
+        };
+        if r.incoming.w == 0.0 {
+            out[i] = rec;
+            continue;
+        }
+        let shape = &scene.shapes[prim];
+        let next = r.outgoing.truncate();
+        let ior = match scene.materials[r.position.w as usize] {
+            Material::Diffuse { albedo } => {
+                rec.out = reemit(dp, albedo.max_element(), next);
+                rec.diffuse_out = true;
+                out[i] = rec;
+                continue;
+            }
+            Material::Glass { ior } => ior,
+            _ => 0.0,
+        };
+        let entering = n.dot(d) < 0.0;
+        let reflected = next.dot(nf) > 0.0;
+        let mut m = nf;
+        if shape.normals.is_some() {
+            let ms = shading_normal(shape, p, n) * side;
+            let u = if reflected { 0.0 } else { 0.99999994 };
+            let (again, used) = specular_shaded(d, nf, ms, ior, entering, u);
+            if used && again.dot(next) > 0.9999 {
+                m = ms;
+            }
+        }
+        let dn = dp.map(|v| normal_differential(&shape.geometry, v, side));
+        let dm = d.dot(m);
+        let (dd, q) = if reflected || ior == 0.0 {
+            let q = if ior != 0.0 {
+                fresnel_dielectric(-dm, if entering { 1.0 / ior } else { ior }).0
+            } else {
+                1.0
+            };
+            (reflect(d, m, prev.out.dd, dn), q)
+        } else {
+            let eta = if entering { 1.0 / ior } else { ior };
+            let (f, cos_t) = fresnel_dielectric(-dm, eta);
+            (refract(d, m, eta, cos_t, prev.out.dd, dn), 1.0 - f)
+        };
+        let widen = if q > 0.0 { 1.0 / q.sqrt() } else { 1.0 };
+        rec.out = Differentials {
+            dp: dp.map(|v| v * widen),
+            dd: dd.map(|v| v * widen),
+        };
+        out[i] = rec;
+    }
+    out
+}
+
+/// A footprint (glsl/common/footprint.glsl's records).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Footprint {
+    pub p: Vec3,
+    pub area: f32,
+    pub a: Vec3,
+    pub diffuse: bool,
+    pub b: Vec3,
+    pub thickness: f32,
+    pub power: Vec3,
+}
+
+impl Footprint {
+    /// The normal semi-axis c.
+    pub fn c(&self) -> Vec3 {
+        self.a.cross(self.b).normalize() * self.thickness
+    }
+
+    /// The box of the ellipsoid.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let c = self.c();
+        let e = (self.a * self.a + self.b * self.b + c * c).map(f32::sqrt);
+        (self.p - e, self.p + e)
+    }
+
+    /// alpha^2 + beta^2 + gamma^2 of x.
+    pub fn distance2(&self, x: Vec3) -> f32 {
+        let (a, b, c) = (self.a, self.b, self.c());
+        let e = x - self.p;
+        let (bc, ca, ab) = (b.cross(c), c.cross(a), a.cross(b));
+        let det = a.dot(bc);
+        let u = Vec3::new(bc.dot(e), ca.dot(e), ab.dot(e)) / det;
+        u.dot(u)
+    }
+}
+
+/// A record's footprint (footprints.frag).
+pub fn footprint(
+    record: &PhotonRecord,
+    diff: &RecordDifferentials,
+    options: &FootprintOptions,
+    delta: f32,
+    power_scale: f32,
+) -> Footprint {
+    let semi_axis = |dp: Vec3| {
+        let axis = if diff.diffuse_at_hit {
+            options.smoothing * delta * dp * dp.length().powf(-0.75)
+        } else {
+            options.caustic_smoothing * delta * dp
+        };
+        let r = axis.length();
+        if r > options.max_radius {
+            axis * (options.max_radius / r)
+        } else {
+            axis
+        }
+    };
+    let a = semi_axis(diff.axis[0]);
+    let mut b = semi_axis(diff.axis[1]);
+    if a.cross(b).dot(record.incoming.truncate()) > 0.0 {
+        b = -b;
+    }
+    let mut area = std::f32::consts::PI * a.cross(b).length();
+    if area.is_nan() || area <= 0.0 || area.is_infinite() {
+        area = 0.0;
+    }
+    Footprint {
+        p: record.position.truncate(),
+        area,
+        a,
+        diffuse: diff.diffuse_at_hit,
+        b,
+        thickness: FOOTPRINT_THICKNESS * a.length().max(b.length()),
+        power: record.power.truncate() * power_scale,
+    }
+}
+
+fn spread_bits(mut v: u32) -> u32 {
+    v = v.wrapping_mul(0x0001_0001) & 0xFF00_00FF;
+    v = v.wrapping_mul(0x0000_0101) & 0x0F00_F00F;
+    v = v.wrapping_mul(0x0000_0011) & 0xC30C_30C3;
+    v = v.wrapping_mul(0x0000_0005) & 0x4924_9249;
+    v
+}
+
+/// The 30-bit Morton code of p (footprint_keys.frag).
+pub fn morton(p: Vec3, lo: Vec3, scale: Vec3) -> u32 {
+    let q = ((p - lo) * scale)
+        .floor()
+        .clamp(Vec3::ZERO, Vec3::splat(1023.0));
+    (spread_bits(q.x as u32) << 2) | (spread_bits(q.y as u32) << 1) | spread_bits(q.z as u32)
+}
+
+/// Node boxes of the implicit tree over `footprints` (in order): index = node
+/// (root 1; leaves from `leaves`), as footprint_leaves and footprint_reduce.
+pub fn node_boxes(footprints: &[Footprint], leaf_size: u32) -> (u32, Vec<(Vec3, Vec3)>) {
+    let n = footprints.len() as u32;
+    let leaves = n.div_ceil(leaf_size).next_power_of_two();
+    let empty = (Vec3::splat(3.0e38), Vec3::splat(-3.0e38));
+    let mut boxes = vec![empty; 2 * leaves as usize];
+    for j in 0..leaves {
+        let first = (j * leaf_size).min(n) as usize;
+        let end = ((j + 1) * leaf_size).min(n) as usize;
+        let mut b = empty;
+        for f in footprints[first..end].iter().filter(|f| f.area > 0.0) {
+            let (lo, hi) = f.bounds();
+            b = (b.0.min(lo), b.1.max(hi));
+        }
+        boxes[(leaves + j) as usize] = b;
+    }
+    for i in (1..leaves as usize).rev() {
+        let (l, r) = (boxes[2 * i], boxes[2 * i + 1]);
+        boxes[i] = (l.0.min(r.0), l.1.max(r.1));
+    }
+    (leaves, boxes)
+}
+
+/// The footprint estimate at x (normal nq) by brute force over every
+/// footprint: the irradiance, and how many footprints hold x.
+pub fn estimate(footprints: &[Footprint], x: Vec3, nq: Vec3, epanechnikov: bool) -> (Vec3, u32) {
+    let mut sum = Vec3::ZERO;
+    let mut count = 0;
+    for f in footprints.iter().filter(|f| f.area > 0.0) {
+        if f.c().dot(nq) <= 0.0 {
+            continue;
+        }
+        let u2 = f.distance2(x);
+        if u2.is_nan() || u2 > 1.0 {
+            continue;
+        }
+        let kernel = if epanechnikov { 2.0 * (1.0 - u2) } else { 1.0 };
+        sum += f.power * (kernel / f.area);
+        count += 1;
+    }
+    (sum, count)
+}
