@@ -1521,6 +1521,122 @@ fn bench_igi_splits_each_version_by_component() {
     assert!(d.join("igi.json").is_file() && d.join("00_igi.png").is_file());
 }
 
+/// Photon differentials as a user runs them: the JSON reports the map (its
+/// footprints, s chosen by the pilot, the automatic leaf size) and the
+/// estimate; their switches without `--method differentials`, the kNN
+/// estimate's accelerations with it, and impossible values are refused with
+/// a reason, writing nothing.
+#[test]
+fn differentials_run_and_refuse_what_they_cannot_do() {
+    let d = tmp("differentials");
+    let png = d.join("pd.png");
+    let out = photonmap()
+        .args([
+            "render", "--quiet", "--json", "--width", "40", "--height", "36",
+        ])
+        .args([
+            "--method",
+            "differentials",
+            "--kernel",
+            "epanechnikov",
+            "--set",
+            "photon_map.photons_stored=4000",
+        ])
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    assert!(png.exists());
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["method"], "differentials");
+    let map = &json["differentials"];
+    assert!(map["footprints"].as_u64().unwrap() >= 4000, "{map}");
+    assert_eq!(map["kernel"], "epanechnikov");
+    // Auto: s = sqrt(k / the pilot's mean at s = 1), k = 500 in CORNELL BOX.
+    let pilot = map["pilot_mean_diffuse_footprints"].as_f64().unwrap();
+    let s = map["smoothing"].as_f64().unwrap();
+    assert!((s - (500.0 / pilot).sqrt()).abs() < 1e-3 * s, "{map}");
+    assert_eq!(map["leaf_size"], map["auto_leaf_size"]);
+    let sample = &json["footprint_samples"][0];
+    assert!(
+        sample["mean_footprints"].as_f64().unwrap() > 1.0,
+        "{sample}"
+    );
+    assert!(sample["passes"].as_u64().unwrap() >= 1);
+    let refused: [(&[&str], &str); 7] = [
+        (&["--leaf-size", "8"], "--method differentials"),
+        (
+            &["--method", "sppm", "--smoothing", "3"],
+            "photon differentials'",
+        ),
+        (&["--method", "differentials", "--adaptive"], "--adaptive"),
+        (
+            &["--method", "differentials", "--final-gather", "2"],
+            "--final-gather",
+        ),
+        (
+            &["--method", "differentials", "--leaf-size", "0"],
+            "1..=1024",
+        ),
+        (&["--method", "differentials", "--smoothing=0"], "positive"),
+        (
+            &["--method", "differentials", "--direct-only"],
+            "--direct-only",
+        ),
+    ];
+    for (args, says) in refused {
+        assert_render_refused(&d, "cornell_box", args, says);
+    }
+}
+
+/// `bench differentials --quick` on RING: both methods, the leaf sizes with
+/// the automatic one last, and the footprint scales each beside the
+/// kNN-grid at the k_PD they reached; errors against the SPPM reference.
+#[test]
+fn bench_differentials_compares_methods_leaf_sizes_and_k() {
+    let d = tmp("bench-differentials");
+    let out = photonmap()
+        .args([
+            "bench",
+            "differentials",
+            "--scene",
+            "ring",
+            "--quick",
+            "--json",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&d)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let methods = v["methods"].as_array().unwrap();
+    assert_eq!(methods[0]["method"], "kNN-grid");
+    assert_eq!(methods[1]["method"], "differentials");
+    let leaves = v["leaf_sizes"].as_array().unwrap();
+    assert_eq!(leaves.len(), 5);
+    assert!(leaves[4]["label"]
+        .as_str()
+        .unwrap()
+        .starts_with("leaf size auto"));
+    let pairs = v["k_pairs"].as_array().unwrap();
+    for pair in pairs.chunks(2) {
+        let k_pd = pair[0]["k"].as_f64().unwrap();
+        assert_eq!(
+            pair[1]["k"].as_f64().unwrap(),
+            k_pd.round().max(1.0),
+            "{pair:?}"
+        );
+    }
+    for r in methods.iter().chain(leaves).chain(pairs) {
+        assert!(r["rmse"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    assert!(d.join("differentials.json").is_file());
+}
+
 /// `render` of the named scene at 16 x 16 with `args` into `dir/bad.png`
 /// fails, says `says`, and writes no image.
 fn assert_render_refused(dir: &std::path::Path, name: &str, args: &[&str], says: &str) {

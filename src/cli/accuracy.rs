@@ -17,7 +17,8 @@ use photonmap::photon::{BuildMethod, GridKind};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
 use photonmap::render::{
-    render, AdaptiveOptions, EstimateMode, FinalGatherOptions, IgiOptions, Image,
+    render, AdaptiveOptions, DifferentialsOptions, EstimateMode, FinalGatherOptions, IgiOptions,
+    Image, Kernel,
 };
 use photonmap::scene::{embedded, Light, Scene};
 
@@ -57,7 +58,8 @@ pub struct AccuracyArgs {
 #[derive(Serialize, Clone, Debug)]
 pub struct AccuracyRun {
     pub label: String,
-    /// "paper" (the one-shot kNN estimate), "final-gather", "sppm" or "igi".
+    /// "paper" (the one-shot kNN estimate), "final-gather", "sppm", "igi" or
+    /// "differentials".
     pub method: String,
     pub photons_stored: u32,
     pub k: u32,
@@ -76,6 +78,8 @@ pub struct AccuracyRun {
     pub grid: GridKind,
     /// IGI's options (method "igi").
     pub igi: Option<IgiOptions>,
+    /// Photon differentials' options (method "differentials").
+    pub differentials: Option<DifferentialsOptions>,
     /// Wall seconds of one render (mean over the seeds).
     pub seconds: f64,
     /// RMSE of one render against the reference (mean over the seeds).
@@ -132,6 +136,7 @@ impl Config {
                 adaptive: false,
                 grid: GridKind::Uniform,
                 igi: None,
+                differentials: None,
                 seconds: 0.0,
                 rmse: 0.0,
                 bias_rmse: 0.0,
@@ -227,6 +232,7 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
         }));
     }
     out.extend(igi_rows(&base, quick));
+    out.extend(differentials_rows(&base, quick));
     // Adaptive SPPM (a pilot of an eighth of the iterations, then the
     // gather only where the plan computes), beside the full runs above.
     for it in if quick { vec![16] } else { vec![16, 64] } {
@@ -292,6 +298,31 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
             c.run.spp = 4;
             out.push(c);
         }
+    }
+    out
+}
+
+/// Photon differentials: automatic smoothing (k_PD = the scene's k), four
+/// times the photons, the Epanechnikov kernel, and 4 spp.
+fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
+    let pd = |label: &str, kernel: Kernel, spp: u32| {
+        base.with(label.into(), |r| {
+            r.method = "differentials".into();
+            r.spp = spp;
+            r.differentials = Some(DifferentialsOptions {
+                kernel,
+                ..DifferentialsOptions::default()
+            });
+        })
+    };
+    let mut out = vec![pd("differentials", Kernel::Constant, 1)];
+    if !quick {
+        // The estimate is cheap: more photons at about the kNN-grid's time.
+        let mut more = pd("differentials, photons x4", Kernel::Constant, 1);
+        more.run.photons_stored *= 4;
+        out.push(more);
+        out.push(pd("differentials, Epanechnikov", Kernel::Epanechnikov, 1));
+        out.push(pd("differentials, 4 spp", Kernel::Constant, 4));
     }
     out
 }
@@ -410,6 +441,7 @@ fn render_config(
     });
     gi.adaptive = c.adaptive.then(AdaptiveOptions::default);
     gi.igi = c.igi.clone();
+    gi.differentials = c.differentials.clone();
     let wall = std::time::Instant::now();
     let image = if c.method == "sppm" {
         let sppm = SppmOptions {
@@ -639,10 +671,11 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
     for (method, colour) in [
         ("sppm", "#2ca02c"),
         ("igi", "#9467bd"),
+        ("differentials", "#ff7f0e"),
         ("photon map", "#1f77b4"),
     ] {
         let kind = |m: &str| match m {
-            "sppm" | "igi" => m.to_string(),
+            "sppm" | "igi" | "differentials" => m.to_string(),
             _ => "photon map".into(),
         };
         let others = r
@@ -707,6 +740,7 @@ pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
             (true, _) => [214, 39, 40],
             (false, "sppm") => [44, 160, 44],
             (false, "igi") => [148, 103, 189],
+            (false, "differentials") => [255, 127, 14],
             _ => [31, 119, 180],
         };
         for dy in -3..=3i64 {

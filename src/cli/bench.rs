@@ -26,6 +26,9 @@ pub enum BenchCommand {
     /// one at a time, and their remedies: time by component (their figures 4
     /// and 5) and error against the SPPM reference.
     Igi(super::igi_bench::IgiBenchArgs),
+    /// Photon differentials against the kNN-grid at the same photons: time
+    /// and error, the BVH's leaf size (their Table 1), and k_PM ~ k_PD.
+    Differentials(super::differentials_bench::DifferentialsBenchArgs),
     /// Whether the stencil test skips fragment work on this driver (the
     /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
     Mask(MaskArgs),
@@ -88,6 +91,7 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
         BenchCommand::Mask(a) => run_mask(&a, platform),
         BenchCommand::Meshes(a) => super::meshes::run(&a, platform),
         BenchCommand::Igi(a) => super::igi_bench::run(&a, platform),
+        BenchCommand::Differentials(a) => super::differentials_bench::run(&a, platform),
         BenchCommand::Build(a) => {
             if a.min_log2 > a.max_log2 {
                 bail!(

@@ -275,7 +275,7 @@ fn print_table(report: &IgiBench) {
     }
 }
 
-fn slug(label: &str) -> String {
+pub(super) fn slug(label: &str) -> String {
     label
         .chars()
         .map(|c| {

@@ -6,6 +6,7 @@ pub mod args;
 pub mod bench;
 pub mod compare;
 pub mod convert;
+pub mod differentials_bench;
 pub mod igi_bench;
 pub mod info;
 pub mod meshes;

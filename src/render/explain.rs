@@ -75,6 +75,14 @@ impl RenderOutput {
                     ));
                 }
             }
+            (Some(gi), None) if gi.differentials.is_some() => {
+                lines.push(line(
+                    "photons, kNN map, kNN estimate",
+                    0,
+                    false,
+                    "skipped: photon differentials give every photon a footprint and sum the footprints at a hit (below)".into(),
+                ));
+            }
             (Some(gi), None) if gi.igi.is_some() => lines.push(line(
                 "caustic map, estimate",
                 0,
@@ -149,6 +157,55 @@ impl RenderOutput {
                     } else {
                         "at every pixel".to_string()
                     }
+                ),
+            ));
+        }
+        if let (Some(o), Some(d)) = (&gi.differentials, &self.differentials) {
+            let passes: u32 = self.footprint_estimates.iter().map(|s| s.passes).sum();
+            let k: f64 = self
+                .footprint_estimates
+                .first()
+                .map_or(0.0, |s| s.mean_footprints);
+            lines.push(line(
+                "photon differentials",
+                0,
+                true,
+                format!(
+                    "{} photons traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {} caustic: {}), semi-axes at most {}",
+                    d.trace.photons_used,
+                    d.footprints,
+                    d.diffuse_footprints,
+                    match (d.diffuse_footprints, d.pilot_mean_diffuse_footprints) {
+                        (0, _) => "s touches none".to_string(),
+                        (_, Some(m)) => format!("s = {:.3}, chosen by a pilot map at s = 1 ({m:.4} at a hit) so that k_PD is the scene's k", d.smoothing),
+                        (_, None) => format!("s = {:.3} as given", d.smoothing),
+                    },
+                    d.footprints - d.diffuse_footprints,
+                    d.caustic_smoothing,
+                    d.max_radius
+                ),
+            ));
+            lines.push(line(
+                "footprint BVH",
+                0,
+                true,
+                format!(
+                    "30-bit Morton codes sorted by the bitonic passes; {} leaves of {} footprints ({}: total footprint area {:.4} over surface area {:.4}), boxes by one reduction pass a level",
+                    d.leaves,
+                    d.leaf_size,
+                    if o.leaf_size.is_some() { format!("given; auto would be {}", d.auto_leaf_size) } else { "auto".into() },
+                    d.total_footprint_area,
+                    d.surface_area
+                ),
+            ));
+            lines.push(line(
+                "footprint estimate",
+                passes as usize,
+                true,
+                format!(
+                    "a stackless walk of the BVH at every first hit, at most {} nodes a pass, ended by occlusion query; {:?} kernel; {k:.1} footprints hold a hit on average (k_PD)",
+                    crate::layout::FOOTPRINT_BUDGET,
+                    o.kernel
                 ),
             ));
         }

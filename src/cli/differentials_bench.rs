@@ -1,0 +1,406 @@
+//! `photonmap bench differentials`: photon differentials (Fabianowski and
+//! Dingliana 2009) against the kNN-grid on one scene, at the same photons:
+//!
+//! - **Methods**: the kNN-grid at the scene's defaults and photon
+//!   differentials at theirs; time by component, error against the SPPM
+//!   reference over all pixels and over the caustic pixels (where the
+//!   reference exceeds the direct-only image by more than 10% of the
+//!   reference's mean), and k (the kNN's) or k_PD (footprints at a hit).
+//! - **Leaf size** (their Table 1): the estimate's time with leaves of 1 to
+//!   512 footprints and with the automatic threshold.
+//! - **k_PM ~ k_PD** (their Table 2's claim): footprints scaled by m (both
+//!   smoothing factors; k_PD grows as m^2), each beside the kNN-grid with k
+//!   set to the k_PD measured.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+use serde::Serialize;
+
+use photonmap::gpu::{Gpu, Platform};
+use photonmap::image::write_atomically;
+use photonmap::metrics::compare;
+use photonmap::render::{render, DifferentialsOptions, Image, RenderOptions, RenderOutput};
+use photonmap::scene::{embedded, Scene};
+
+use super::accuracy::default_reference;
+use super::args::in_range;
+use super::reference::{read_reference, reference_options};
+
+#[derive(Args)]
+pub struct DifferentialsBenchArgs {
+    /// Scene file or embedded name.
+    #[arg(long, required_unless_present = "triangles")]
+    pub scene: Option<PathBuf>,
+    /// Render `bench meshes`'s stage instead, its ball a mesh of about this
+    /// many triangles (1024..=4194304).
+    #[arg(long, value_name = "N", value_parser = in_range(1024, 1 << 22), conflicts_with = "scene")]
+    pub triangles: Option<u32>,
+    /// SPPM reference EXR (default: the scene's, as `bench accuracy` finds
+    /// it; none for the mesh stage). Images render at its size.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Fewer leaf sizes and footprint scales.
+    #[arg(long)]
+    pub quick: bool,
+    /// Folder for each row's PNG (default photonmap-out/differentials/<scene>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[arg(long)]
+    pub json: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// One render.
+#[derive(Serialize, Clone, Debug)]
+pub struct Row {
+    pub label: String,
+    pub method: String,
+    /// k of the kNN estimate, or k_PD (mean footprints at a first hit).
+    pub k: f64,
+    pub leaf_size: Option<u32>,
+    pub smoothing: Option<f32>,
+    pub caustic_smoothing: Option<f32>,
+    pub seconds: f64,
+    /// Wall seconds: photons (tracing, differentials), map (build, BVH,
+    /// smoothing pilot), estimate.
+    pub photons: f64,
+    pub map: f64,
+    pub estimate: f64,
+    /// Mean BVH nodes visited and footprints examined at a first hit.
+    pub nodes: Option<f64>,
+    pub examined: Option<f64>,
+    pub rmse: Option<f64>,
+    pub ssim: Option<f64>,
+    pub caustic_rmse: Option<f64>,
+    /// The caustic pixels' mean over the reference's (1: no bias in the sum).
+    pub caustic_mean_ratio: Option<f64>,
+}
+
+#[derive(Serialize)]
+pub struct DifferentialsBench {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub reference: Option<String>,
+    pub caustic_pixels: usize,
+    pub renderer: String,
+    pub methods: Vec<Row>,
+    pub leaf_sizes: Vec<Row>,
+    pub k_pairs: Vec<Row>,
+}
+
+fn component(stage: &str) -> usize {
+    match stage {
+        "trace photons" | "photon differentials" => 0,
+        "build map" | "footprint map" | "smoothing pilot" => 1,
+        "radiance estimate" | "footprint estimate" => 2,
+        _ => 3,
+    }
+}
+
+struct Bench<'a> {
+    gpu: &'a Gpu,
+    scene: &'a Scene,
+    scale: u32,
+    reference: Option<&'a Image>,
+    caustic: Option<Vec<bool>>,
+    dir: PathBuf,
+    progress: Box<dyn Fn(&str)>,
+    rendered: usize,
+}
+
+impl Bench<'_> {
+    fn options(&self) -> RenderOptions {
+        reference_options(self.scene, self.scale, 7)
+    }
+
+    fn row(&mut self, label: &str, o: &RenderOptions) -> Result<(Row, RenderOutput)> {
+        self.row_on(self.scene, label, o)
+    }
+
+    /// A row of `scene` (the bench's, or it with another k).
+    fn row_on(
+        &mut self,
+        scene: &Scene,
+        label: &str,
+        o: &RenderOptions,
+    ) -> Result<(Row, RenderOutput)> {
+        (self.progress)(label);
+        let r = render(self.gpu, scene, o, &mut ())?;
+        let mut parts = [0.0f64; 4];
+        for s in &r.timings.stages {
+            parts[component(&s.name)] += s.wall_seconds;
+        }
+        let (rmse, ssim, caustic_rmse, ratio) = match self.reference {
+            Some(img) => {
+                let m = compare(&r.image, img, None)?;
+                let (c, ratio) = match &self.caustic {
+                    Some(mask) if mask.iter().any(|&b| b) => {
+                        let mean = |i: &Image| -> f64 {
+                            i.pixels
+                                .iter()
+                                .zip(mask)
+                                .filter(|(_, &m)| m)
+                                .map(|(p, _)| f64::from(p[0] + p[1] + p[2]))
+                                .sum()
+                        };
+                        (
+                            Some(compare(&r.image, img, Some(mask))?.rmse),
+                            Some(mean(&r.image) / mean(img)),
+                        )
+                    }
+                    _ => (None, None),
+                };
+                (Some(m.rmse), Some(m.ssim), c, ratio)
+            }
+            None => (None, None, None, None),
+        };
+        let file = format!("{:02}_{}.png", self.rendered, super::igi_bench::slug(label));
+        self.rendered += 1;
+        write_atomically(&self.dir.join(file), &r.image.png_bytes()?)?;
+        let pd = r.differentials.as_ref();
+        let stats = r.footprint_estimates.first();
+        let row = Row {
+            label: label.into(),
+            method: if pd.is_some() {
+                "differentials"
+            } else {
+                "kNN-grid"
+            }
+            .into(),
+            k: stats.map_or(scene.photon_map.k as f64, |s| s.mean_footprints),
+            leaf_size: pd.map(|d| d.leaf_size),
+            smoothing: pd.map(|d| d.smoothing),
+            caustic_smoothing: pd.map(|d| d.caustic_smoothing),
+            seconds: r.timings.wall_seconds,
+            photons: parts[0],
+            map: parts[1],
+            estimate: parts[2],
+            nodes: stats.map(|s| s.mean_nodes),
+            examined: stats.map(|s| s.mean_examined),
+            rmse,
+            ssim,
+            caustic_rmse,
+            caustic_mean_ratio: ratio,
+        };
+        Ok((row, r))
+    }
+}
+
+pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
+    let (scene, name): (Scene, String) = match (a.triangles, &a.scene) {
+        (Some(n), _) => (super::meshes::stage(n)?, format!("stage_{n}")),
+        (None, Some(s)) => (embedded::load_path_or_name(s)?, super::accuracy::stem(s)),
+        (None, None) => bail!("give --scene or --triangles"),
+    };
+    let reference = match (&a.reference, &a.scene) {
+        (Some(r), _) => Some(r.clone()),
+        (None, Some(s)) if a.triangles.is_none() => {
+            Some(default_reference(s)).filter(|r| r.is_file())
+        }
+        _ => None,
+    };
+    let reference = reference
+        .map(|r| -> Result<(PathBuf, Image)> { Ok((r.clone(), read_reference(&r)?.0)) })
+        .transpose()?;
+    let scale = match &reference {
+        Some((path, img)) => {
+            if img.width == 0 || !scene.camera.width.is_multiple_of(img.width) {
+                bail!(
+                    "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
+                    path.display(),
+                    img.width,
+                    img.height,
+                    scene.camera.width,
+                    scene.camera.height
+                );
+            }
+            scene.camera.width / img.width
+        }
+        None => 1,
+    };
+    let gpu = super::gpu(platform)?;
+    let dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| super::out_dir("differentials").join(&name));
+    std::fs::create_dir_all(&dir)?;
+    let mut bench = Bench {
+        gpu: &gpu,
+        scene: &scene,
+        scale,
+        reference: reference.as_ref().map(|(_, i)| i),
+        caustic: None,
+        dir: dir.clone(),
+        progress: Box::new(super::progress_lines(a.quiet)),
+        rendered: 0,
+    };
+    // The caustic pixels: the reference above the direct-only image.
+    if let Some((_, img)) = &reference {
+        let direct = render(&gpu, &scene, &bench.options().direct_only(), &mut ())?;
+        let mean = img
+            .pixels
+            .iter()
+            .map(|p| p.iter().sum::<f32>() / 3.0)
+            .sum::<f32>()
+            / img.pixels.len().max(1) as f32;
+        bench.caustic = Some(
+            img.pixels
+                .iter()
+                .zip(&direct.image.pixels)
+                .map(|(r, d)| (0..3).map(|c| r[c] - d[c]).sum::<f32>() / 3.0 > 0.1 * mean)
+                .collect(),
+        );
+    }
+    let with_pd = |d: DifferentialsOptions, b: &Bench| {
+        let mut o = b.options();
+        o.global
+            .as_mut()
+            .expect("global illumination")
+            .differentials = Some(d);
+        o
+    };
+    let mut methods = Vec::new();
+    methods.push(bench.row("kNN-grid", &bench.options())?.0);
+    let (pd, out) = bench.row(
+        "differentials",
+        &with_pd(DifferentialsOptions::default(), &bench),
+    )?;
+    let auto = out
+        .differentials
+        .as_ref()
+        .expect("a differentials render reports its map")
+        .clone();
+    methods.push(pd);
+
+    let sizes: Vec<u32> = if a.quick {
+        vec![4, 16, 64, 256]
+    } else {
+        (0..10).map(|i| 1 << i).collect()
+    };
+    let mut leaf_sizes = Vec::new();
+    let fixed = DifferentialsOptions {
+        smoothing: Some(auto.smoothing),
+        ..DifferentialsOptions::default()
+    };
+    for t in sizes {
+        let o = with_pd(
+            DifferentialsOptions {
+                leaf_size: Some(t),
+                ..fixed.clone()
+            },
+            &bench,
+        );
+        leaf_sizes.push(bench.row(&format!("leaf size {t}"), &o)?.0);
+    }
+    let o = with_pd(fixed.clone(), &bench);
+    leaf_sizes.push(
+        bench
+            .row(&format!("leaf size auto ({})", auto.auto_leaf_size), &o)?
+            .0,
+    );
+
+    let scales: &[f32] = if a.quick {
+        &[0.5, 1.0]
+    } else {
+        &[
+            0.5,
+            std::f32::consts::FRAC_1_SQRT_2,
+            1.0,
+            std::f32::consts::SQRT_2,
+        ]
+    };
+    let mut k_pairs = Vec::new();
+    for &m in scales {
+        let o = with_pd(
+            DifferentialsOptions {
+                smoothing: Some(auto.smoothing * m),
+                caustic_smoothing: auto.caustic_smoothing * m,
+                ..DifferentialsOptions::default()
+            },
+            &bench,
+        );
+        let (row, _) = bench.row(&format!("footprints x {m:.2}"), &o)?;
+        let k = (row.k.round() as u32).max(1);
+        k_pairs.push(row);
+        let mut s = scene.clone();
+        s.photon_map.k = k;
+        let o = bench.options();
+        k_pairs.push(bench.row_on(&s, &format!("kNN-grid, k = {k}"), &o)?.0);
+    }
+
+    let report = DifferentialsBench {
+        scene: name,
+        width: (scene.camera.width / scale).max(1),
+        height: (scene.camera.height / scale).max(1),
+        reference: reference.as_ref().map(|(p, _)| p.display().to_string()),
+        caustic_pixels: bench
+            .caustic
+            .as_ref()
+            .map_or(0, |m| m.iter().filter(|&&b| b).count()),
+        renderer: gpu.capabilities().gl_renderer,
+        methods,
+        leaf_sizes,
+        k_pairs,
+    };
+    write_atomically(
+        &dir.join("differentials.json"),
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )?;
+    if a.json {
+        return super::print_json(&report);
+    }
+    print_table(&report);
+    eprintln!("wrote {}", dir.display());
+    Ok(())
+}
+
+fn print_table(r: &DifferentialsBench) {
+    println!(
+        "{} ({} x {}, {}; {} caustic pixels)",
+        r.scene, r.width, r.height, r.renderer, r.caustic_pixels
+    );
+    println!(
+        "{:<26} {:>7} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>8} {:>8} {:>7}",
+        "run",
+        "k",
+        "seconds",
+        "photons",
+        "map",
+        "estimate",
+        "nodes",
+        "examined",
+        "RMSE",
+        "SSIM",
+        "caustic",
+        "c. mean"
+    );
+    let opt = |v: Option<f64>, p: usize| v.map_or("-".into(), |v| format!("{v:.p$}"));
+    for (title, rows) in [
+        ("methods", &r.methods),
+        ("leaf size (Table 1)", &r.leaf_sizes),
+        ("k_PM ~ k_PD", &r.k_pairs),
+    ] {
+        println!("-- {title}");
+        for x in rows {
+            println!(
+                "{:<26} {:>7.1} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>7} {:>8} {:>9} {:>8} {:>8} {:>7}",
+                x.label,
+                x.k,
+                x.seconds,
+                x.photons,
+                x.map,
+                x.estimate,
+                opt(x.nodes, 1),
+                opt(x.examined, 1),
+                opt(x.rmse, 5),
+                opt(x.ssim, 4),
+                opt(x.caustic_rmse, 5),
+                opt(x.caustic_mean_ratio, 3),
+            );
+        }
+    }
+}
