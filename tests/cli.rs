@@ -1554,10 +1554,15 @@ fn differentials_run_and_refuse_what_they_cannot_do() {
     let map = &json["differentials"];
     assert!(map["footprints"].as_u64().unwrap() >= 4000, "{map}");
     assert_eq!(map["kernel"], "epanechnikov");
-    // Auto: s = sqrt(k / the pilot's mean at s = 1), k = 500 in CORNELL BOX.
-    let pilot = map["pilot_mean_diffuse_footprints"].as_f64().unwrap();
+    // Auto: s = sqrt((k - caustic) / diffuse), the pilot's means at s = 1,
+    // k = 500 in CORNELL BOX.
+    let diffuse = map["pilot_mean_diffuse_footprints"].as_f64().unwrap();
+    let caustic = map["pilot_mean_footprints"].as_f64().unwrap() - diffuse;
     let s = map["smoothing"].as_f64().unwrap();
-    assert!((s - (500.0 / pilot).sqrt()).abs() < 1e-3 * s, "{map}");
+    assert!(
+        (s - ((500.0 - caustic) / diffuse).sqrt()).abs() < 1e-3 * s,
+        "{map}"
+    );
     assert_eq!(map["leaf_size"], map["auto_leaf_size"]);
     let sample = &json["footprint_samples"][0];
     assert!(
@@ -1565,8 +1570,10 @@ fn differentials_run_and_refuse_what_they_cannot_do() {
         "{sample}"
     );
     assert!(sample["passes"].as_u64().unwrap() >= 1);
-    let refused: [(&[&str], &str); 7] = [
+    let refused: [(&[&str], &str); 9] = [
         (&["--leaf-size", "8"], "--method differentials"),
+        (&["--method", "differentials", "--grid", "hash"], "--grid"),
+        (&["--method", "differentials", "--tile", "8"], "--tile"),
         (
             &["--method", "sppm", "--smoothing", "3"],
             "photon differentials'",

@@ -10,11 +10,11 @@
 //     = 1 if the photon had been reflected diffusely before this hit;
 //   state 0..2: dp and dd as the photon leaves (after the interaction);
 //     axis2.w = the diffuse flag it leaves with.
-// Emission: a point light's directional differentials are an orthonormal
-// pair about d scaled by sqrt(measure) (equation 8; measure = its share of
-// the photons and of its solid angle: kept fraction / pick probability);
-// an area light (ours: the paper has point lights only) re-emits as a diffuse
-// surface does, from a footprint of pi x its area per photon. Transfer:
+// Emission: the directional differentials are an orthonormal pair about d
+// (equation 8) scaled by sqrt(kept fraction / pick probability), the light's
+// share of the photons and of its directions; an area light's (ours: the
+// paper has point lights only) positional ones are the same pair scaled by
+// sqrt(area / (4 pi p)), a footprint of pi x its area per photon. Transfer:
 // Igehy's equations. Mirror and glass: reflection and refraction of the
 // differentials about the normal used, with the normal's own differential on
 // spheres and cylinders (flat primitives, shaded triangles included: 0). A
@@ -36,7 +36,7 @@ uniform sampler2D u_axis2;
 uniform sampler2D u_state0;
 uniform sampler2D u_state1;
 uniform sampler2D u_state2;
-uniform sampler2D u_light_measure; // texel l: .x = light l's measure per photon
+uniform sampler2D u_light_measure; // texel l: (directional, positional) measures
 uniform int u_frame;
 uniform int u_frame_height;
 
@@ -61,7 +61,7 @@ int emitting_light(vec3 p, int prim) {
         if (kind == LIGHT_POINT) {
             if (prim < 0 && all(equal(light_texel(l, 1).xyz, p))) return l;
         } else if (kind == LIGHT_AREA) {
-            if (int(light_texel(l, 5).z) == prim) return l;
+            if (prim >= 0 && int(light_texel(l, 5).z) == prim) return l;
         } else {
             vec4 range = light_texel(l, 1);
             for (int i = 0; i < int(range.y); ++i) {
@@ -101,10 +101,8 @@ void main() {
         vec3 t[2];
         basis_around(d, t[0], t[1]);
         int l = emitting_light(position.xyz, int(outgoing.w));
-        float measure = texelFetch(u_light_measure, ivec2(l, 0), 0).x;
-        bool point = int(light_texel(l, 0).x) == LIGHT_POINT;
-        float v = point ? 0.0 : sqrt(measure);
-        float s = point ? sqrt(measure) : 1.0;
+        vec2 measure = texelFetch(u_light_measure, ivec2(l, 0), 0).xy;
+        float s = sqrt(measure.x), v = sqrt(measure.y);
         for (int k = 0; k < 2; ++k) {
             dp[k] = v * t[k];
             dd[k] = s * t[k];

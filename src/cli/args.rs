@@ -58,6 +58,21 @@ pub struct PhotonMapArgs {
     pub hash_buckets: Option<u32>,
 }
 
+impl PhotonMapArgs {
+    /// The first switch given that only the kNN map's build reads.
+    pub fn build_switch_given(&self) -> Option<&'static str> {
+        [
+            (self.build != BuildMethod::Bitonic, "--build"),
+            (self.stencil_m != 4, "--stencil-m"),
+            (self.feed != VertexFeed::VertexFetch, "--feed"),
+            (self.grid != GridKind::Uniform, "--grid"),
+            (self.hash_buckets.is_some(), "--hash-buckets"),
+        ]
+        .into_iter()
+        .find_map(|(given, name)| given.then_some(name))
+    }
+}
+
 impl From<&PhotonMapArgs> for PhotonConfig {
     fn from(a: &PhotonMapArgs) -> Self {
         PhotonConfig {
@@ -94,6 +109,20 @@ pub struct EstimateArgs {
     /// default), or both.
     #[arg(long, value_enum, default_value_t = LeakTest::Visibility)]
     pub leak_test: LeakTest,
+}
+
+impl EstimateArgs {
+    /// The first switch given that only the kNN estimate reads.
+    pub fn switch_given(&self) -> Option<&'static str> {
+        [
+            (self.tile != 16, "--tile"),
+            (self.mask.is_some(), "--mask"),
+            (self.budget != 64, "--budget"),
+            (self.leak_test != LeakTest::Visibility, "--leak-test"),
+        ]
+        .into_iter()
+        .find_map(|(given, name)| given.then_some(name))
+    }
 }
 
 impl From<&EstimateArgs> for EstimateOptions {
@@ -247,8 +276,9 @@ impl From<&IgiArgs> for IgiOptions {
 #[derive(Args, Clone, Debug)]
 pub struct DifferentialsArgs {
     /// Differentials: the smoothing factor s of diffusely reflected photons'
-    /// footprints (> 0), or auto: the one that makes the mean number of
-    /// footprints at a first hit the scene's k (a pilot map at s = 1).
+    /// footprints (> 0), or auto: the one that aims the mean number of
+    /// footprints at a first hit (k_PD) at the scene's k (a pilot map at
+    /// s = 1; the summary line reports the k_PD reached).
     #[arg(long, value_name = "S", default_value = "auto", value_parser = auto_or_positive)]
     pub smoothing: AutoOr<f32>,
     /// Differentials: the factor of photons that have been only specular

@@ -3,9 +3,10 @@
 //!
 //! - **Methods**: the kNN-grid at the scene's defaults and photon
 //!   differentials at theirs; time by component, error against the SPPM
-//!   reference over all pixels and over the caustic pixels (where the
+//!   reference over all pixels and over the indirect pixels (where the
 //!   reference exceeds the direct-only image by more than 10% of the
-//!   reference's mean), and k (the kNN's) or k_PD (footprints at a hit).
+//!   reference's mean: caustics in GLASS BALL and RING, every bounce of
+//!   light in CORNELL BOX), and k (the kNN's) or k_PD (footprints at a hit).
 //! - **Leaf size** (their Table 1): the estimate's time with leaves of 1 to
 //!   512 footprints and with the automatic threshold.
 //! - **k_PM ~ k_PD** (their Table 2's claim): footprints scaled by m (both
@@ -74,9 +75,9 @@ pub struct Row {
     pub examined: Option<f64>,
     pub rmse: Option<f64>,
     pub ssim: Option<f64>,
-    pub caustic_rmse: Option<f64>,
-    /// The caustic pixels' mean over the reference's (1: no bias in the sum).
-    pub caustic_mean_ratio: Option<f64>,
+    pub indirect_rmse: Option<f64>,
+    /// The indirect pixels' mean over the reference's (1: no bias in the sum).
+    pub indirect_mean_ratio: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -85,7 +86,7 @@ pub struct DifferentialsBench {
     pub width: u32,
     pub height: u32,
     pub reference: Option<String>,
-    pub caustic_pixels: usize,
+    pub indirect_pixels: usize,
     pub renderer: String,
     pub methods: Vec<Row>,
     pub leaf_sizes: Vec<Row>,
@@ -106,7 +107,7 @@ struct Bench<'a> {
     scene: &'a Scene,
     scale: u32,
     reference: Option<&'a Image>,
-    caustic: Option<Vec<bool>>,
+    indirect: Option<Vec<bool>>,
     dir: PathBuf,
     progress: Box<dyn Fn(&str)>,
     rendered: usize,
@@ -134,10 +135,10 @@ impl Bench<'_> {
         for s in &r.timings.stages {
             parts[component(&s.name)] += s.wall_seconds;
         }
-        let (rmse, ssim, caustic_rmse, ratio) = match self.reference {
+        let (rmse, ssim, indirect_rmse, ratio) = match self.reference {
             Some(img) => {
                 let m = compare(&r.image, img, None)?;
-                let (c, ratio) = match &self.caustic {
+                let (c, ratio) = match &self.indirect {
                     Some(mask) if mask.iter().any(|&b| b) => {
                         let mean = |i: &Image| -> f64 {
                             i.pixels
@@ -183,8 +184,8 @@ impl Bench<'_> {
             examined: stats.map(|s| s.mean_examined),
             rmse,
             ssim,
-            caustic_rmse,
-            caustic_mean_ratio: ratio,
+            indirect_rmse,
+            indirect_mean_ratio: ratio,
         };
         Ok((row, r))
     }
@@ -233,12 +234,12 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
         scene: &scene,
         scale,
         reference: reference.as_ref().map(|(_, i)| i),
-        caustic: None,
+        indirect: None,
         dir: dir.clone(),
         progress: Box::new(super::progress_lines(a.quiet)),
         rendered: 0,
     };
-    // The caustic pixels: the reference above the direct-only image.
+    // The indirect pixels: the reference above the direct-only image.
     if let Some((_, img)) = &reference {
         let direct = render(&gpu, &scene, &bench.options().direct_only(), &mut ())?;
         let mean = img
@@ -247,7 +248,7 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
             .map(|p| p.iter().sum::<f32>() / 3.0)
             .sum::<f32>()
             / img.pixels.len().max(1) as f32;
-        bench.caustic = Some(
+        bench.indirect = Some(
             img.pixels
                 .iter()
                 .zip(&direct.image.pixels)
@@ -337,8 +338,8 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
         width: (scene.camera.width / scale).max(1),
         height: (scene.camera.height / scale).max(1),
         reference: reference.as_ref().map(|(p, _)| p.display().to_string()),
-        caustic_pixels: bench
-            .caustic
+        indirect_pixels: bench
+            .indirect
             .as_ref()
             .map_or(0, |m| m.iter().filter(|&&b| b).count()),
         renderer: gpu.capabilities().gl_renderer,
@@ -360,8 +361,8 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
 
 fn print_table(r: &DifferentialsBench) {
     println!(
-        "{} ({} x {}, {}; {} caustic pixels)",
-        r.scene, r.width, r.height, r.renderer, r.caustic_pixels
+        "{} ({} x {}, {}; {} indirect pixels)",
+        r.scene, r.width, r.height, r.renderer, r.indirect_pixels
     );
     println!(
         "{:<26} {:>7} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>8} {:>8} {:>7}",
@@ -375,8 +376,8 @@ fn print_table(r: &DifferentialsBench) {
         "examined",
         "RMSE",
         "SSIM",
-        "caustic",
-        "c. mean"
+        "indirect",
+        "i. mean"
     );
     let opt = |v: Option<f64>, p: usize| v.map_or("-".into(), |v| format!("{v:.p$}"));
     for (title, rows) in [
@@ -398,8 +399,8 @@ fn print_table(r: &DifferentialsBench) {
                 opt(x.examined, 1),
                 opt(x.rmse, 5),
                 opt(x.ssim, 4),
-                opt(x.caustic_rmse, 5),
-                opt(x.caustic_mean_ratio, 3),
+                opt(x.indirect_rmse, 5),
+                opt(x.indirect_mean_ratio, 3),
             );
         }
     }

@@ -305,6 +305,15 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     {
         bail!("--method differentials replaces the kNN estimate with footprints: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
     }
+    if args.method == Method::Differentials {
+        if let Some(s) = args
+            .photons
+            .build_switch_given()
+            .or(args.estimate.switch_given())
+        {
+            bail!("{s} sets the kNN-grid's map or estimate, which --method differentials does not build: drop it");
+        }
+    }
     if args.sppm.adaptive_pilot.is_some() {
         bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
     }
@@ -571,7 +580,7 @@ fn print_summary(
     }
     if let (Some(d), Some(s)) = (&out.differentials, out.footprint_estimates.first()) {
         let pilot = d.pilot_mean_diffuse_footprints.map_or(String::new(), |m| {
-            format!(" (auto: {m:.2} at s = 1 in the pilot)")
+            format!(" (auto: {m:.4} diffuse footprints a hit at s = 1 in the pilot)")
         });
         eprintln!(
             "photon differentials: {} footprints ({} diffuse, {} caustic, {} degenerate); s = {:.2}{pilot}, caustics {}, r_max {}; BVH of {} leaves of {} (auto {}); {:.1} footprints hold a first hit on average (k_PD), {:.1} nodes and {:.1} footprints examined, {} passes",

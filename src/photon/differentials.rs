@@ -41,10 +41,16 @@ pub struct DifferentialFrames {
     pub state: [Texture; 3],
 }
 
-/// Each light's measure per photon (`differentials.frag`): a point light's
-/// solid-angle factor (kept fraction / pick probability), an area light's
-/// footprint at emission (area x kept fraction / (4 pi x pick probability)).
-pub fn light_measures(scene: &Scene, frames: &PhotonFrames) -> Vec<f32> {
+/// Each light's measures per photon (`differentials.frag`), in units of the
+/// spacing Delta = 2 sqrt(pi / n): [directional, positional]. The
+/// directional one, kept fraction / pick probability, scales the emitted
+/// directional differentials' area (a light picked with probability p sends
+/// n p photons, into the kept fraction of its directions). The positional
+/// one, area / (4 pi p), is the squared length of an area light's positional
+/// differentials, so that its footprint at emission is pi times the area of
+/// the light per photon (A / (n p)), as a point light's is pi times the area
+/// per photon at any distance; 0 for a point light.
+pub fn light_measures(scene: &Scene, frames: &PhotonFrames) -> Vec<[f32; 2]> {
     let packed = PackedScene::new(scene);
     let texels = frames.projection.as_ref().map(|p| p.texels(scene));
     scene
@@ -60,12 +66,13 @@ pub fn light_measures(scene: &Scene, frames: &PhotonFrames) -> Vec<f32> {
                 ),
             };
             if probability <= 0.0 {
-                return 0.0;
+                return [0.0, 0.0];
             }
-            match light {
-                Light::Point { .. } => kept / probability,
-                _ => light.area(&scene.shapes) * kept / (4.0 * std::f32::consts::PI * probability),
-            }
+            let positional = match light {
+                Light::Point { .. } => 0.0,
+                _ => light.area(&scene.shapes) / (4.0 * std::f32::consts::PI * probability),
+            };
+            [kept / probability, positional]
         })
         .collect()
 }
@@ -97,7 +104,7 @@ pub fn trace_differentials(
     let measures = light_measures(scene, frames);
     let mut data = vec![0f32; measures.len().max(1) * 4];
     for (l, m) in measures.iter().enumerate() {
-        data[4 * l] = *m;
+        data[4 * l..4 * l + 2].copy_from_slice(m);
     }
     let measure = Texture::from_f32(
         gpu,
@@ -168,8 +175,10 @@ pub struct FootprintMap {
     pub auto_leaf_size: u32,
     /// Footprints whose photon had been reflected diffusely.
     pub diffuse: u32,
-    /// Footprints with no area (skipped).
+    /// Footprints with no area (skipped), and the share of the stored power
+    /// they carry.
     pub degenerate: u32,
+    pub degenerate_power_fraction: f64,
     /// Sum of the footprints' areas, and the scene's surface area.
     pub total_area: f64,
     pub surface_area: f64,
@@ -321,13 +330,18 @@ impl FootprintBuilder {
         // The footprints' total area (the automatic leaf size), by read-back.
         let f0 = footprints[0].read_f32();
         let f1 = footprints[1].read_f32();
+        let f3 = footprints[3].read_f32();
         let (mut total_area, mut degenerate, mut diffuse) = (0f64, 0u32, 0u32);
+        let (mut power, mut lost) = (0f64, 0f64);
         for i in 0..count as usize {
             let area = f0[4 * i + 3];
+            let p: f64 = f3[4 * i..4 * i + 3].iter().map(|&c| f64::from(c)).sum();
+            power += p;
             if area > 0.0 {
                 total_area += f64::from(area);
             } else {
                 degenerate += 1;
+                lost += p;
             }
             diffuse += u32::from(f1[4 * i + 3] != 0.0);
         }
@@ -383,6 +397,7 @@ impl FootprintBuilder {
             auto_leaf_size: auto,
             diffuse,
             degenerate,
+            degenerate_power_fraction: if power > 0.0 { lost / power } else { 0.0 },
             total_area,
             surface_area,
             delta,

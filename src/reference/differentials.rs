@@ -30,14 +30,15 @@ pub struct RecordDifferentials {
     pub diffuse_at_hit: bool,
     pub out: Differentials,
     pub diffuse_out: bool,
+    /// The geometric normal at the hit, facing the photon's arrival.
+    pub normal: Vec3,
 }
 
-/// Emission: a point light's orthonormal pair about d scaled by
-/// sqrt(measure); an area light's re-emission from a footprint of `measure`.
-pub fn emission(d: Vec3, point: bool, measure: f32) -> Differentials {
+/// Emission: the orthonormal pair about d scaled by the square roots of the
+/// light's [directional, positional] measures.
+pub fn emission(d: Vec3, [directional, positional]: [f32; 2]) -> Differentials {
     let (t0, t1) = basis_around(d);
-    let v = if point { 0.0 } else { measure.sqrt() };
-    let s = if point { measure.sqrt() } else { 1.0 };
+    let (s, v) = (directional.sqrt(), positional.sqrt());
     Differentials {
         dp: [v * t0, v * t1],
         dd: [s * t0, s * t1],
@@ -108,7 +109,7 @@ fn emitting_light(scene: &Scene, packed: &PackedScene, p: Vec3, prim: i32) -> us
     for (l, light) in scene.lights.iter().enumerate() {
         let found = match *light {
             Light::Point { position, .. } => prim < 0 && position == p,
-            Light::Area { .. } => packed.lights[l * texels + 5][2] as i32 == prim,
+            Light::Area { .. } => prim >= 0 && packed.lights[l * texels + 5][2] as i32 == prim,
             Light::Triangles { first, count, .. } => {
                 (first..first + count).contains(&(prim as usize))
             }
@@ -126,7 +127,7 @@ pub fn record_differentials(
     scene: &Scene,
     records: &[PhotonRecord],
     per_frame: usize,
-    measures: &[f32],
+    measures: &[[f32; 2]],
 ) -> Vec<RecordDifferentials> {
     let packed = PackedScene::new(scene);
     let mut out = vec![RecordDifferentials::default(); records.len()];
@@ -138,8 +139,7 @@ pub fn record_differentials(
             }
             let p = r.position.truncate();
             let l = emitting_light(scene, &packed, p, r.outgoing.w as i32);
-            let point = matches!(scene.lights[l], Light::Point { .. });
-            out[i].out = emission(r.outgoing.truncate(), point, measures[l]);
+            out[i].out = emission(r.outgoing.truncate(), measures[l]);
             continue;
         }
         if r.position.w < 0.0 {
@@ -159,6 +159,7 @@ pub fn record_differentials(
             diffuse_at_hit: prev.diffuse_out,
             out: Differentials::default(),
             diffuse_out: prev.diffuse_out,
+            normal: nf,
         };
         if r.incoming.w == 0.0 {
             out[i] = rec;
@@ -346,4 +347,45 @@ pub fn estimate(footprints: &[Footprint], x: Vec3, nq: Vec3, epanechnikov: bool)
         count += 1;
     }
     (sum, count)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Equation 13's invariant: the re-emitted differentials, carried back to
+    /// the surface they leave (v along the new direction), span the incoming
+    /// footprint's area widened by 1 / q; and between parallel planes the area
+    /// grows as (v + t)^2 along the normal.
+    #[test]
+    fn reemission_keeps_the_footprint_area_and_grows_as_v_plus_t_squared() {
+        let dp = [Vec3::new(0.3, 0.0, 0.1), Vec3::new(-0.05, 0.0, 0.4)];
+        let q = 0.6;
+        let up = Vec3::Y;
+        let out = reemit(dp, q, up);
+        let area_in = dp[0].cross(dp[1]).length();
+        let v2 = out.dp[0].cross(out.dp[1]).length();
+        assert!((v2 * q - area_in).abs() < 1e-6 * area_in, "{v2} {area_in}");
+        // To a parallel plane t = 2 above, along the normal.
+        let t = 2.0;
+        let at = transfer(&out, Vec3::ZERO, t * up, up, -up);
+        let area = at[0].cross(at[1]).length();
+        let v = v2.sqrt();
+        assert!((area - (v + t) * (v + t)).abs() < 1e-5 * area, "{area}");
+    }
+
+    /// A point light's emission: unit orthogonal directional differentials
+    /// scaled by sqrt(directional measure), no positional ones; an area
+    /// light's positional ones have the squared length of its positional measure.
+    #[test]
+    fn emission_scales_by_the_lights_measures() {
+        let d = Vec3::new(0.2, -0.9, 0.3).normalize();
+        let point = emission(d, [0.25, 0.0]);
+        assert_eq!(point.dp, [Vec3::ZERO; 2]);
+        for k in 0..2 {
+            assert!((point.dd[k].length() - 0.5).abs() < 1e-6 && point.dd[k].dot(d).abs() < 1e-6);
+        }
+        let area = emission(d, [1.0, 4.0]);
+        assert!((area.dp[0].cross(area.dp[1]).length() - 4.0).abs() < 1e-5);
+    }
 }

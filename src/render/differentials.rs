@@ -15,11 +15,15 @@
 //!    throughput x albedo / pi x the footprints' irradiance.
 //!
 //! The smoothing factor s of diffusely reflected photons is the user's or
-//! (`auto`) chosen so that the mean number of footprints holding a first hit
-//! (the paper's k_PD) is the scene's k, the kNN estimate's photon count: the
+//! (`auto`) chosen to aim the mean number of footprints holding a first hit
+//! (the paper's k_PD) at the scene's k, the kNN estimate's photon count: the
 //! paper finds k_PM ~ k_PD gives equal quality. A pilot map built with s = 1
-//! measures that mean over the first eye sample's hits, and s scales it by
-//! sqrt(k / mean) (footprint areas grow as s^2).
+//! measures, over the first eye sample's hits, the mean count of caustic
+//! footprints (which s does not scale) and of diffuse ones; s =
+//! sqrt((k - caustic) / diffuse), since footprint areas grow as s^2. Where
+//! the caustic ones alone reach k, s aims the diffuse ones at one a hit.
+//! Clamping to r_max breaks the s^2 law, so the k_PD reached is reported and
+//! may fall short of k.
 
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
@@ -317,10 +321,12 @@ impl FootprintEstimate {
     }
 }
 
-/// The smoothing factor that makes the mean of diffuse footprints holding a
-/// first hit `k`, from a pilot's mean at s = 1 (areas grow as s^2); None when
-/// the pilot found none (a scene with no diffusely reflected photon, whose
-/// footprints s does not touch).
-pub fn smoothing_for(k: u32, pilot_mean_diffuse: f64) -> Option<f32> {
-    (pilot_mean_diffuse > 0.0).then(|| (k as f64 / pilot_mean_diffuse).sqrt() as f32)
+/// The smoothing factor that aims the mean of all footprints holding a first
+/// hit at `k`, from a pilot's means at s = 1 of all and of diffuse footprints
+/// (only the diffuse ones grow, as s^2); at least one diffuse footprint a hit.
+/// None when the pilot found no diffuse one (s then touches no footprint).
+pub fn smoothing_for(k: u32, pilot_mean_all: f64, pilot_mean_diffuse: f64) -> Option<f32> {
+    let caustic = (pilot_mean_all - pilot_mean_diffuse).max(0.0);
+    let target = (k as f64 - caustic).max(1.0);
+    (pilot_mean_diffuse > 0.0).then(|| (target / pilot_mean_diffuse).sqrt() as f32)
 }

@@ -168,7 +168,7 @@ impl RenderOutput {
                 .map_or(0.0, |s| s.mean_footprints);
             lines.push(line(
                 "photon differentials",
-                0,
+                d.frames_traced as usize,
                 true,
                 format!(
                     "{} photons traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {} caustic: {}), semi-axes at most {}",
@@ -177,7 +177,7 @@ impl RenderOutput {
                     d.diffuse_footprints,
                     match (d.diffuse_footprints, d.pilot_mean_diffuse_footprints) {
                         (0, _) => "s touches none".to_string(),
-                        (_, Some(m)) => format!("s = {:.3}, chosen by a pilot map at s = 1 ({m:.4} at a hit) so that k_PD is the scene's k", d.smoothing),
+                        (_, Some(m)) => format!("s = {:.3}, chosen by a pilot map at s = 1 ({m:.4} diffuse footprints at a hit) to aim k_PD at the scene's k", d.smoothing),
                         (_, None) => format!("s = {:.3} as given", d.smoothing),
                     },
                     d.footprints - d.diffuse_footprints,

@@ -153,12 +153,17 @@ pub struct RenderState {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct DifferentialsReport {
     pub trace: photon::TraceReport,
+    pub frames_traced: u32,
     pub footprints: u32,
     /// Footprints of photons reflected diffusely before (the others: caustics).
     pub diffuse_footprints: u32,
     pub degenerate_footprints: u32,
-    /// s in use, and (auto) the pilot's mean diffuse footprints a hit at s = 1.
+    /// The share of the stored power those carry (lost to the estimate).
+    pub degenerate_power_fraction: f64,
+    /// s in use, and (auto) the pilot's mean footprints a hit at s = 1, all
+    /// and diffuse.
     pub smoothing: f32,
+    pub pilot_mean_footprints: Option<f64>,
     pub pilot_mean_diffuse_footprints: Option<f64>,
     pub caustic_smoothing: f32,
     pub max_radius: f32,
@@ -179,7 +184,8 @@ pub struct DifferentialsRun {
     pub estimate: FootprintEstimate,
     builder: photon::differentials::FootprintBuilder,
     options: DifferentialsOptions,
-    pilot_mean: Option<f64>,
+    /// The pilot's mean footprints a hit: all, and diffuse.
+    pilot_mean: Option<(f64, f64)>,
 }
 
 impl DifferentialsRun {
@@ -246,9 +252,10 @@ impl DifferentialsRun {
                         t0.elapsed().as_secs_f64(),
                         pilot_timings.stages.iter().map(|s| s.passes).sum(),
                     );
-                    self.pilot_mean = Some(stats.mean_diffuse_footprints);
+                    self.pilot_mean = Some((stats.mean_footprints, stats.mean_diffuse_footprints));
                     differentials::smoothing_for(
                         f.scene.photon_map.k,
+                        stats.mean_footprints,
                         stats.mean_diffuse_footprints,
                     )
                     .unwrap_or(1.0)
@@ -279,11 +286,14 @@ impl DifferentialsRun {
         let m = self.map.as_ref()?;
         Some(DifferentialsReport {
             trace: self.photons.trace.clone(),
+            frames_traced: self.photons.frames.frames,
             footprints: m.count,
             diffuse_footprints: m.diffuse,
             degenerate_footprints: m.degenerate,
+            degenerate_power_fraction: m.degenerate_power_fraction,
             smoothing: m.options.smoothing,
-            pilot_mean_diffuse_footprints: self.pilot_mean,
+            pilot_mean_footprints: self.pilot_mean.map(|m| m.0),
+            pilot_mean_diffuse_footprints: self.pilot_mean.map(|m| m.1),
             caustic_smoothing: m.options.caustic_smoothing,
             max_radius: m.options.max_radius,
             kernel: self.options.kernel,
