@@ -64,7 +64,7 @@ fn main() {
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     std::fs::write(
         out.join("glsl_sources.rs"),
-        table("GLSL_SOURCES", "glsl", &["glsl", "vert", "frag"]),
+        table("GLSL_SOURCES", "glsl", &["glsl", "vert", "geom", "frag"]),
     )
     .unwrap();
     std::fs::write(

@@ -95,6 +95,10 @@ pub const FOOTPRINT_THICKNESS: f32 = 0.1;
 /// pixel at most (bounds work per pass).
 pub const FOOTPRINT_BUDGET: u32 = 256;
 
+/// Progressive radiosity's patch power texture: patch p at texel
+/// (p mod PATCH_ROW, p / PATCH_ROW).
+pub const PATCH_ROW: u32 = 1024;
+
 /// Rec. 709 luminance weights of linear RGB.
 pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
@@ -134,6 +138,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PI", PI_GLSL.into()),
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
         ("FOOTPRINT_THICKNESS", format!("{FOOTPRINT_THICKNESS:?}")),
+        ("PATCH_ROW", u(PATCH_ROW)),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
         ("PRIMITIVE_BOX_ROW", u(PRIMITIVE_BOX_ROW)),

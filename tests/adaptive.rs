@@ -34,6 +34,7 @@ fn options(w: u32, h: u32, gather: bool, adaptive: bool, build: BuildMethod) -> 
         adaptive: adaptive.then(AdaptiveOptions::default),
         igi: None,
         differentials: None,
+        radiosity: None,
     });
     o
 }

@@ -1598,6 +1598,74 @@ fn differentials_run_and_refuse_what_they_cannot_do() {
     }
 }
 
+/// Radiosity as a user runs it: the JSON reports the patches, the shots and
+/// the convergence after each; its switches without `--method radiosity`,
+/// the one-map estimate's accelerations with it, and impossible values are
+/// refused with a reason, writing nothing.
+#[test]
+fn radiosity_runs_and_refuses_what_it_cannot_do() {
+    let d = tmp("radiosity");
+    let png = d.join("rad.png");
+    let out = photonmap()
+        .args([
+            "render", "--quiet", "--json", "--width", "32", "--height", "32",
+        ])
+        .args([
+            "--method",
+            "radiosity",
+            "--elements",
+            "8",
+            "--substructure",
+            "2",
+            "--item-buffer",
+            "64",
+            "--set",
+            "photon_map.photons_stored=2000",
+        ])
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    assert!(png.exists());
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["method"], "radiosity");
+    let r = &json["radiosity"];
+    assert_eq!(r["element_resolution"], 8);
+    assert_eq!(r["converged"], true);
+    let curve = r["convergence"].as_array().unwrap();
+    assert_eq!(curve.len() as u64, r["shots"].as_u64().unwrap() + 1);
+    let unshot: Vec<f64> = curve
+        .iter()
+        .map(|p| p["unshot_fraction"].as_f64().unwrap())
+        .collect();
+    assert!(
+        unshot[0] > 0.9 && *unshot.last().unwrap() < 1e-2,
+        "{unshot:?}"
+    );
+    let refused: [(&[&str], &str); 5] = [
+        (&["--elements", "8"], "--method radiosity"),
+        (&["--method", "radiosity", "--adaptive"], "--adaptive"),
+        (
+            &[
+                "--method",
+                "radiosity",
+                "--elements",
+                "8",
+                "--substructure",
+                "3",
+            ],
+            "divisor",
+        ),
+        (&["--method", "radiosity", "--convergence", "2"], "(0, 1)"),
+        (&["--method", "sppm", "--max-shots", "4"], "radiosity"),
+    ];
+    for (args, says) in refused {
+        assert_render_refused(&d, "cornell_box", args, says);
+    }
+}
+
 /// `bench differentials --quick` on RING: both methods, the leaf sizes with
 /// the automatic one last, and the footprint scales each beside the
 /// kNN-grid at the k_PD they reached; errors against the SPPM reference.

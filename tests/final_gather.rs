@@ -31,6 +31,7 @@ fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -
         adaptive: None,
         igi: None,
         differentials: None,
+        radiosity: None,
     });
     o
 }

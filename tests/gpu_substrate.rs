@@ -200,6 +200,8 @@ fn every_glsl_file_compiles() {
                 vec!["photon/route.vert"]
             }
             "render/knn_search.frag" => vec!["common/fullscreen.vert", "render/tile.vert"],
+            "radiosity/select.frag" => vec!["radiosity/select.vert"],
+            "radiosity/item_buffer.frag" => vec!["radiosity/item_buffer.vert"],
             _ => vec!["common/fullscreen.vert"],
         }
     };
@@ -230,14 +232,31 @@ fn every_glsl_file_compiles() {
             _ => vec![vec![]],
         }
     };
+    // Programs with a geometry stage: (vertex, geometry, fragment).
+    let staged = [(
+        "radiosity/item_buffer.vert",
+        "radiosity/item_buffer.geom",
+        "radiosity/item_buffer.frag",
+    )];
     let mut compiled = 0;
     for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".frag")) {
+        if let Some((v, g, f)) = staged.iter().find(|s| s.2 == name) {
+            Program::with_geometry(&gpu, v, g, f, &[]).unwrap_or_else(|e| panic!("{e}"));
+            compiled += 1;
+            continue;
+        }
         for vertex in vertices_of(name) {
             for defines in variants(name) {
                 Program::new(&gpu, vertex, name, &defines).unwrap_or_else(|e| panic!("{e}"));
                 compiled += 1;
             }
         }
+    }
+    for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".geom")) {
+        assert!(
+            staged.iter().any(|s| s.1 == name),
+            "glsl/{name} is in no staged program, so nothing compiles it"
+        );
     }
     for (name, _) in glsl_files().filter(|(n, _)| n.ends_with(".vert")) {
         let used =

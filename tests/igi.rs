@@ -17,6 +17,7 @@ fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderO
     o.global = Some(GlobalIllumination {
         igi: Some(igi),
         differentials: None,
+        radiosity: None,
         ..GlobalIllumination::default()
     });
     o

@@ -18,7 +18,7 @@ use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
 use photonmap::render::{
     render, AdaptiveOptions, DifferentialsOptions, EstimateMode, FinalGatherOptions, IgiOptions,
-    Image, Kernel,
+    Image, Kernel, RadiosityOptions,
 };
 use photonmap::scene::{embedded, Light, Scene};
 
@@ -80,6 +80,8 @@ pub struct AccuracyRun {
     pub igi: Option<IgiOptions>,
     /// Photon differentials' options (method "differentials").
     pub differentials: Option<DifferentialsOptions>,
+    /// Radiosity's options (method "radiosity").
+    pub radiosity: Option<RadiosityOptions>,
     /// Wall seconds of one render (mean over the seeds).
     pub seconds: f64,
     /// RMSE of one render against the reference (mean over the seeds).
@@ -137,6 +139,7 @@ impl Config {
                 grid: GridKind::Uniform,
                 igi: None,
                 differentials: None,
+                radiosity: None,
                 seconds: 0.0,
                 rmse: 0.0,
                 bias_rmse: 0.0,
@@ -233,6 +236,10 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     }
     out.extend(igi_rows(&base, quick));
     out.extend(differentials_rows(&base, quick));
+    // Radiosity solves diffuse interreflection, which caustics-only scenes leave out.
+    if !scene.photon_map.caustics_only {
+        out.extend(radiosity_rows(&base, quick));
+    }
     // Adaptive SPPM (a pilot of an eighth of the iterations, then the
     // gather only where the plan computes), beside the full runs above.
     for it in if quick { vec![16] } else { vec![16, 64] } {
@@ -323,6 +330,27 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
         out.push(more);
         out.push(pd("differentials, Epanechnikov", Kernel::Epanechnikov, 1));
         out.push(pd("differentials, 4 spp", Kernel::Constant, 4));
+    }
+    out
+}
+
+/// Progressive radiosity: its defaults, the chapter's ~10,000 elements of
+/// CORNELL BOX (32 x 32 a patch side), and 4 spp.
+fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
+    let rad = |label: &str, resolution: u32, spp: u32| {
+        base.with(label.into(), |r| {
+            r.method = "radiosity".into();
+            r.spp = spp;
+            r.radiosity = Some(RadiosityOptions {
+                resolution,
+                ..RadiosityOptions::default()
+            });
+        })
+    };
+    let mut out = vec![rad("radiosity", 16, 1)];
+    if !quick {
+        out.push(rad("radiosity, 32 elements", 32, 1));
+        out.push(rad("radiosity, 4 spp", 16, 4));
     }
     out
 }
@@ -442,6 +470,7 @@ fn render_config(
     gi.adaptive = c.adaptive.then(AdaptiveOptions::default);
     gi.igi = c.igi.clone();
     gi.differentials = c.differentials.clone();
+    gi.radiosity = c.radiosity.clone();
     let wall = std::time::Instant::now();
     let image = if c.method == "sppm" {
         let sppm = SppmOptions {
@@ -672,10 +701,11 @@ pub fn svg_plot(r: &AccuracyReport) -> String {
         ("sppm", "#2ca02c"),
         ("igi", "#9467bd"),
         ("differentials", "#ff7f0e"),
+        ("radiosity", "#8c564b"),
         ("photon map", "#1f77b4"),
     ] {
         let kind = |m: &str| match m {
-            "sppm" | "igi" | "differentials" => m.to_string(),
+            "sppm" | "igi" | "differentials" | "radiosity" => m.to_string(),
             _ => "photon map".into(),
         };
         let others = r
@@ -741,6 +771,7 @@ pub fn png_plot(r: &AccuracyReport) -> Vec<u8> {
             (false, "sppm") => [44, 160, 44],
             (false, "igi") => [148, 103, 189],
             (false, "differentials") => [255, 127, 14],
+            (false, "radiosity") => [140, 86, 75],
             _ => [31, 119, 180],
         };
         for dy in -3..=3i64 {

@@ -7,7 +7,9 @@ use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{DirectLighting, SppmOptions};
-use photonmap::render::{DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel};
+use photonmap::render::{
+    DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel, RadiosityOptions,
+};
 
 /// A parser for a whole number in lo..=hi whose error names the range.
 pub fn in_range(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone + Send + Sync {
@@ -153,6 +155,9 @@ pub enum Method {
     /// Photon differentials: every photon a footprint, summed through a BVH
     /// photon map (no k-nearest search).
     Differentials,
+    /// Progressive refinement radiosity: texels of an element atlas shoot
+    /// and gather through item buffers; caustics from a caustic photon map.
+    Radiosity,
 }
 
 /// A positive finite number.
@@ -296,6 +301,59 @@ pub struct DifferentialsArgs {
     /// Differentials: the kernel over a footprint.
     #[arg(long, value_enum, default_value_t = Kernel::Constant)]
     pub kernel: Kernel,
+}
+
+/// Progressive radiosity's switches (`--method radiosity`).
+#[derive(Args, Clone, Debug)]
+pub struct RadiosityArgs {
+    /// Radiosity: elements per side of each patch (each side of a diffuse
+    /// primitive) (2..=256).
+    #[arg(long, value_name = "N", default_value_t = 16, value_parser = in_range(2, 256))]
+    pub elements: u32,
+    /// Radiosity: shooters per side of a shooting patch, its elements merged
+    /// S x S (substructuring; a divisor of --elements, 1..=8).
+    #[arg(long, value_name = "S", default_value_t = 4, value_parser = in_range(1, 8))]
+    pub substructure: u32,
+    /// Radiosity: texels per side of each item buffer (16..=2048).
+    #[arg(long, value_name = "N", default_value_t = 256, value_parser = in_range(16, 2048))]
+    pub item_buffer: u32,
+    /// Radiosity: shots at most (1..=1000000).
+    #[arg(long, default_value_t = 10_000, value_parser = in_range(1, 1_000_000))]
+    pub max_shots: u32,
+    /// Radiosity: converged once no patch holds this fraction of the emitted
+    /// power unshot (0 < F < 1).
+    #[arg(long, value_name = "F", default_value_t = 1e-4, value_parser = open_fraction)]
+    pub convergence: f32,
+}
+
+fn open_fraction(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!("{s}: the allowed range is (0, 1)")),
+    }
+}
+
+impl RadiosityArgs {
+    pub fn any_given(&self) -> bool {
+        let d = RadiosityOptions::default();
+        self.elements != d.resolution
+            || self.substructure != d.substructure
+            || self.item_buffer != d.item_buffer
+            || self.max_shots != d.max_shots
+            || self.convergence != d.convergence
+    }
+}
+
+impl From<&RadiosityArgs> for RadiosityOptions {
+    fn from(a: &RadiosityArgs) -> Self {
+        RadiosityOptions {
+            resolution: a.elements,
+            substructure: a.substructure,
+            item_buffer: a.item_buffer,
+            max_shots: a.max_shots,
+            convergence: a.convergence,
+        }
+    }
 }
 
 /// A value, or `auto`.

@@ -15,19 +15,20 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
-use photonmap::render::{render, DifferentialsOptions, Image, RenderOptions, RenderOutput};
-use photonmap::scene::{embedded, Scene};
+use photonmap::render::{
+    render, DifferentialsOptions, DifferentialsReport, Image, RenderOptions, RenderOutput,
+};
+use photonmap::scene::Scene;
 
-use super::accuracy::default_reference;
 use super::args::in_range;
-use super::reference::{read_reference, reference_options};
+use super::reference::reference_options;
 
 #[derive(Args)]
 pub struct DifferentialsBenchArgs {
@@ -192,37 +193,8 @@ impl Bench<'_> {
 }
 
 pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name): (Scene, String) = match (a.triangles, &a.scene) {
-        (Some(n), _) => (super::meshes::stage(n)?, format!("stage_{n}")),
-        (None, Some(s)) => (embedded::load_path_or_name(s)?, super::accuracy::stem(s)),
-        (None, None) => bail!("give --scene or --triangles"),
-    };
-    let reference = match (&a.reference, &a.scene) {
-        (Some(r), _) => Some(r.clone()),
-        (None, Some(s)) if a.triangles.is_none() => {
-            Some(default_reference(s)).filter(|r| r.is_file())
-        }
-        _ => None,
-    };
-    let reference = reference
-        .map(|r| -> Result<(PathBuf, Image)> { Ok((r.clone(), read_reference(&r)?.0)) })
-        .transpose()?;
-    let scale = match &reference {
-        Some((path, img)) => {
-            if img.width == 0 || !scene.camera.width.is_multiple_of(img.width) {
-                bail!(
-                    "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
-                    path.display(),
-                    img.width,
-                    img.height,
-                    scene.camera.width,
-                    scene.camera.height
-                );
-            }
-            scene.camera.width / img.width
-        }
-        None => 1,
-    };
+    let (scene, name, reference, scale) =
+        super::igi_bench::scene_and_reference(&a.scene, a.triangles, &a.reference)?;
     let gpu = super::gpu(platform)?;
     let dir = a
         .out
@@ -277,61 +249,8 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
         .clone();
     methods.push(pd);
 
-    let sizes: Vec<u32> = if a.quick {
-        vec![4, 16, 64, 256]
-    } else {
-        (0..10).map(|i| 1 << i).collect()
-    };
-    let mut leaf_sizes = Vec::new();
-    let fixed = DifferentialsOptions {
-        smoothing: Some(auto.smoothing),
-        ..DifferentialsOptions::default()
-    };
-    for t in sizes {
-        let o = with_pd(
-            DifferentialsOptions {
-                leaf_size: Some(t),
-                ..fixed.clone()
-            },
-            &bench,
-        );
-        leaf_sizes.push(bench.row(&format!("leaf size {t}"), &o)?.0);
-    }
-    let o = with_pd(fixed.clone(), &bench);
-    leaf_sizes.push(
-        bench
-            .row(&format!("leaf size auto ({})", auto.auto_leaf_size), &o)?
-            .0,
-    );
-
-    let scales: &[f32] = if a.quick {
-        &[0.5, 1.0]
-    } else {
-        &[
-            0.5,
-            std::f32::consts::FRAC_1_SQRT_2,
-            1.0,
-            std::f32::consts::SQRT_2,
-        ]
-    };
-    let mut k_pairs = Vec::new();
-    for &m in scales {
-        let o = with_pd(
-            DifferentialsOptions {
-                smoothing: Some(auto.smoothing * m),
-                caustic_smoothing: auto.caustic_smoothing * m,
-                ..DifferentialsOptions::default()
-            },
-            &bench,
-        );
-        let (row, _) = bench.row(&format!("footprints x {m:.2}"), &o)?;
-        let k = (row.k.round() as u32).max(1);
-        k_pairs.push(row);
-        let mut s = scene.clone();
-        s.photon_map.k = k;
-        let o = bench.options();
-        k_pairs.push(bench.row_on(&s, &format!("kNN-grid, k = {k}"), &o)?.0);
-    }
+    let leaf_sizes = leaf_rows(&mut bench, &auto, a.quick)?;
+    let k_pairs = k_rows(&mut bench, &scene, &auto, a.quick)?;
 
     let report = DifferentialsBench {
         scene: name,
@@ -357,6 +276,94 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
     print_table(&report);
     eprintln!("wrote {}", dir.display());
     Ok(())
+}
+
+/// Their Table 1: the map at s fixed to the automatic run's, with each leaf
+/// size, then the automatic one.
+fn leaf_rows(bench: &mut Bench<'_>, auto: &DifferentialsReport, quick: bool) -> Result<Vec<Row>> {
+    let with_pd = |d: DifferentialsOptions, b: &Bench| {
+        let mut o = b.options();
+        o.global
+            .as_mut()
+            .expect("global illumination")
+            .differentials = Some(d);
+        o
+    };
+    let sizes: Vec<u32> = if quick {
+        vec![4, 16, 64, 256]
+    } else {
+        (0..10).map(|i| 1 << i).collect()
+    };
+    let mut leaf_sizes = Vec::new();
+    let fixed = DifferentialsOptions {
+        smoothing: Some(auto.smoothing),
+        ..DifferentialsOptions::default()
+    };
+    for t in sizes {
+        let o = with_pd(
+            DifferentialsOptions {
+                leaf_size: Some(t),
+                ..fixed.clone()
+            },
+            bench,
+        );
+        leaf_sizes.push(bench.row(&format!("leaf size {t}"), &o)?.0);
+    }
+    let o = with_pd(fixed.clone(), bench);
+    leaf_sizes.push(
+        bench
+            .row(&format!("leaf size auto ({})", auto.auto_leaf_size), &o)?
+            .0,
+    );
+
+    Ok(leaf_sizes)
+}
+
+/// k_PM ~ k_PD: footprints scaled by m beside the kNN-grid at the k_PD reached.
+fn k_rows(
+    bench: &mut Bench<'_>,
+    scene: &Scene,
+    auto: &DifferentialsReport,
+    quick: bool,
+) -> Result<Vec<Row>> {
+    let with_pd = |d: DifferentialsOptions, b: &Bench| {
+        let mut o = b.options();
+        o.global
+            .as_mut()
+            .expect("global illumination")
+            .differentials = Some(d);
+        o
+    };
+    let scales: &[f32] = if quick {
+        &[0.5, 1.0]
+    } else {
+        &[
+            0.5,
+            std::f32::consts::FRAC_1_SQRT_2,
+            1.0,
+            std::f32::consts::SQRT_2,
+        ]
+    };
+    let mut k_pairs = Vec::new();
+    for &m in scales {
+        let o = with_pd(
+            DifferentialsOptions {
+                smoothing: Some(auto.smoothing * m),
+                caustic_smoothing: auto.caustic_smoothing * m,
+                ..DifferentialsOptions::default()
+            },
+            bench,
+        );
+        let (row, _) = bench.row(&format!("footprints x {m:.2}"), &o)?;
+        let k = (row.k.round() as u32).max(1);
+        k_pairs.push(row);
+        let mut s = scene.clone();
+        s.photon_map.k = k;
+        let o = bench.options();
+        k_pairs.push(bench.row_on(&s, &format!("kNN-grid, k = {k}"), &o)?.0);
+    }
+
+    Ok(k_pairs)
 }
 
 fn print_table(r: &DifferentialsBench) {

@@ -138,37 +138,7 @@ fn component(stage: &str) -> usize {
 }
 
 pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name): (Scene, String) = match (a.triangles, &a.scene) {
-        (Some(n), _) => (super::meshes::stage(n)?, format!("stage_{n}")),
-        (None, Some(s)) => (embedded::load_path_or_name(s)?, super::accuracy::stem(s)),
-        (None, None) => bail!("give --scene or --triangles"),
-    };
-    let reference = match (&a.reference, &a.scene) {
-        (Some(r), _) => Some(r.clone()),
-        (None, Some(s)) if a.triangles.is_none() => {
-            Some(default_reference(s)).filter(|r| r.is_file())
-        }
-        _ => None,
-    };
-    let reference = reference
-        .map(|r| -> Result<(PathBuf, Image)> { Ok((r.clone(), read_reference(&r)?.0)) })
-        .transpose()?;
-    let scale = match &reference {
-        Some((path, img)) => {
-            if img.width == 0 || !scene.camera.width.is_multiple_of(img.width) {
-                bail!(
-                    "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
-                    path.display(),
-                    img.width,
-                    img.height,
-                    scene.camera.width,
-                    scene.camera.height
-                );
-            }
-            scene.camera.width / img.width
-        }
-        None => 1,
-    };
+    let (scene, name, reference, scale) = scene_and_reference(&a.scene, a.triangles, &a.reference)?;
     let gpu = super::gpu(platform)?;
     let progress = super::progress_lines(a.quiet);
     let dir = a
@@ -238,6 +208,51 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
     print_table(&report);
     eprintln!("wrote {}", dir.display());
     Ok(())
+}
+
+/// The scene (a file or embedded name, or `bench meshes`' stage of about
+/// `triangles` triangles), its name, its SPPM reference when there is one
+/// (given, or the scene's as `bench accuracy` finds it; none for the stage),
+/// and the reference's scale below the scene's resolution.
+#[allow(clippy::type_complexity)]
+pub(super) fn scene_and_reference(
+    scene: &Option<PathBuf>,
+    triangles: Option<u32>,
+    reference: &Option<PathBuf>,
+) -> Result<(Scene, String, Option<(PathBuf, Image)>, u32)> {
+    let a_scene = scene;
+    let (scene, name): (Scene, String) = match (triangles, a_scene) {
+        (Some(n), _) => (super::meshes::stage(n)?, format!("stage_{n}")),
+        (None, Some(s)) => (embedded::load_path_or_name(s)?, super::accuracy::stem(s)),
+        (None, None) => bail!("give --scene or --triangles"),
+    };
+    let reference = match (reference, a_scene) {
+        (Some(r), _) => Some(r.clone()),
+        (None, Some(s)) if triangles.is_none() => {
+            Some(default_reference(s)).filter(|r| r.is_file())
+        }
+        _ => None,
+    };
+    let reference = reference
+        .map(|r| -> Result<(PathBuf, Image)> { Ok((r.clone(), read_reference(&r)?.0)) })
+        .transpose()?;
+    let scale = match &reference {
+        Some((path, img)) => {
+            if img.width == 0 || !scene.camera.width.is_multiple_of(img.width) {
+                bail!(
+                    "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
+                    path.display(),
+                    img.width,
+                    img.height,
+                    scene.camera.width,
+                    scene.camera.height
+                );
+            }
+            scene.camera.width / img.width
+        }
+        None => 1,
+    };
+    Ok((scene, name, reference, scale))
 }
 
 fn print_table(report: &IgiBench) {

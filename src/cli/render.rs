@@ -18,7 +18,8 @@ use photonmap::render::{
 use photonmap::scene::Scene;
 
 use super::args::{
-    in_range, DifferentialsArgs, EstimateArgs, IgiArgs, Method, PhotonMapArgs, SceneArgs, SppmArgs,
+    in_range, DifferentialsArgs, EstimateArgs, IgiArgs, Method, PhotonMapArgs, RadiosityArgs,
+    SceneArgs, SppmArgs,
 };
 use super::progress::{ProgressReport, Work};
 
@@ -94,6 +95,8 @@ pub struct RenderArgs {
     pub igi: IgiArgs,
     #[command(flatten)]
     pub differentials: DifferentialsArgs,
+    #[command(flatten)]
+    pub radiosity: RadiosityArgs,
     #[command(flatten)]
     pub photons: PhotonMapArgs,
     #[command(flatten)]
@@ -263,6 +266,7 @@ impl RenderArgs {
             igi: (self.method == Method::Igi).then(|| (&self.igi).into()),
             differentials: (self.method == Method::Differentials)
                 .then(|| (&self.differentials).into()),
+            radiosity: (self.method == Method::Radiosity).then(|| (&self.radiosity).into()),
         });
         options
     }
@@ -281,39 +285,7 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     if args.method == Method::Sppm {
         return run_sppm(args, platform);
     }
-    if args.method != Method::Igi && args.igi.any_given() {
-        bail!("--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi");
-    }
-    if args.method == Method::Igi
-        && (args.final_gather.is_some()
-            || args.adaptive
-            || args.reference_software.is_some()
-            || args.snapshots.is_some()
-            || args.direct_only)
-    {
-        bail!("--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
-    }
-    if args.method != Method::Differentials && args.differentials.any_given() {
-        bail!("--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials");
-    }
-    if args.method == Method::Differentials
-        && (args.final_gather.is_some()
-            || args.adaptive
-            || args.reference_software.is_some()
-            || args.snapshots.is_some()
-            || args.direct_only)
-    {
-        bail!("--method differentials replaces the kNN estimate with footprints: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
-    }
-    if args.method == Method::Differentials {
-        if let Some(s) = args
-            .photons
-            .build_switch_given()
-            .or(args.estimate.switch_given())
-        {
-            bail!("{s} sets the kNN-grid's map or estimate, which --method differentials does not build: drop it");
-        }
-    }
+    check_method_switches(args)?;
     if args.sppm.adaptive_pilot.is_some() {
         bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
     }
@@ -338,6 +310,7 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let method = match (args.method, args.final_gather.is_some()) {
         (Method::Igi, _) => "igi",
         (Method::Differentials, _) => "differentials",
+        (Method::Radiosity, _) => "radiosity",
         (_, true) => "final-gather",
         _ => "paper",
     };
@@ -376,6 +349,7 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "igi_samples": out.igi,
                 "differentials": out.differentials,
                 "footprint_samples": out.footprint_estimates,
+                "radiosity": out.radiosity,
             }),
         })?;
     }
@@ -384,6 +358,56 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     }
     if !args.quiet {
         print_summary(&out, &options, &written);
+    }
+    Ok(())
+}
+
+/// Refuses each method's switches without it, and what it cannot combine with.
+fn check_method_switches(args: &RenderArgs) -> Result<()> {
+    if args.method != Method::Igi && args.igi.any_given() {
+        bail!("--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi");
+    }
+    if args.method == Method::Igi
+        && (args.final_gather.is_some()
+            || args.adaptive
+            || args.reference_software.is_some()
+            || args.snapshots.is_some()
+            || args.direct_only)
+    {
+        bail!("--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+    }
+    if args.method != Method::Differentials && args.differentials.any_given() {
+        bail!("--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials");
+    }
+    if args.method == Method::Differentials
+        && (args.final_gather.is_some()
+            || args.adaptive
+            || args.reference_software.is_some()
+            || args.snapshots.is_some()
+            || args.direct_only)
+    {
+        bail!("--method differentials replaces the kNN estimate with footprints: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+    }
+    if args.method != Method::Radiosity && args.radiosity.any_given() {
+        bail!("--elements, --substructure, --item-buffer, --max-shots and --convergence are radiosity's: add --method radiosity");
+    }
+    if args.method == Method::Radiosity
+        && (args.final_gather.is_some()
+            || args.adaptive
+            || args.reference_software.is_some()
+            || args.snapshots.is_some()
+            || args.direct_only)
+    {
+        bail!("--method radiosity computes the diffuse interreflection itself: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+    }
+    if args.method == Method::Differentials {
+        if let Some(s) = args
+            .photons
+            .build_switch_given()
+            .or(args.estimate.switch_given())
+        {
+            bail!("{s} sets the kNN-grid's map or estimate, which --method differentials does not build: drop it");
+        }
     }
     Ok(())
 }
@@ -416,8 +440,9 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         || args.final_gather.is_some()
         || args.igi.any_given()
         || args.differentials.any_given()
+        || args.radiosity.any_given()
     {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample) and photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel)");
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence)");
     }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
@@ -571,6 +596,24 @@ fn print_summary(
             v.min_distance,
             s.vpls_per_point,
             s.shading_points,
+            if out.photons.is_some() {
+                "from the caustic photon map"
+            } else {
+                "none (nothing specular in the scene)"
+            }
+        );
+    }
+    if let Some(r) = &out.radiosity {
+        eprintln!(
+            "radiosity: {} patches, {} elements ({} x {} a patch); {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}",
+            r.patches,
+            r.elements,
+            r.element_resolution,
+            r.element_resolution,
+            r.shots,
+            r.seconds,
+            if r.converged { "converged" } else { "stopped at --max-shots" },
+            100.0 * r.unshot_fraction,
             if out.photons.is_some() {
                 "from the caustic photon map"
             } else {

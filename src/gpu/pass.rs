@@ -146,6 +146,26 @@ impl Bindings<'_> {
         Ok(())
     }
 
+    /// The vertices of `vertices` as triangles (three a triangle), over the
+    /// viewport (x, y, w, h) of `target`.
+    pub fn draw_triangles(
+        &mut self,
+        target: &Target,
+        state: &DrawState,
+        viewport: [i32; 4],
+        vertices: &VertexBuffer,
+    ) -> Result<()> {
+        self.prepare(target, state, viewport)?;
+        // SAFETY: gpu module doc; the vertex array is the buffer's own and
+        // describes `count` vertices.
+        unsafe {
+            self.gl.bind_vertex_array(Some(vertices.vao));
+            self.gl
+                .draw_arrays(glow::TRIANGLES, 0, vertices.count as i32);
+        }
+        Ok(())
+    }
+
     /// Every vertex of `vertices` as a point.
     pub fn draw_vertices(
         &mut self,

@@ -234,6 +234,18 @@ impl Program {
         Self::from_lookup(gpu, &lookup, vertex, fragment, defines)
     }
 
+    /// A program with a geometry stage between the vertex and fragment ones.
+    pub fn with_geometry(
+        gpu: &Gpu,
+        vertex: &str,
+        geometry: &str,
+        fragment: &str,
+        defines: &[(&str, String)],
+    ) -> Result<Self> {
+        let lookup = |n: &str| source_of(n).map(str::to_string);
+        Self::build(gpu, &lookup, [vertex, fragment], Some(geometry), defines)
+    }
+
     /// Builds from any source lookup: the embedded tree, or (in tests) a tree
     /// with a deliberately broken file.
     pub fn from_lookup(
@@ -243,18 +255,50 @@ impl Program {
         fragment: &str,
         defines: &[(&str, String)],
     ) -> Result<Self> {
+        Self::build(gpu, lookup, [vertex, fragment], None, defines)
+    }
+
+    fn build(
+        gpu: &Gpu,
+        lookup: &dyn Fn(&str) -> Option<String>,
+        [vertex, fragment]: [&str; 2],
+        geometry: Option<&str>,
+        defines: &[(&str, String)],
+    ) -> Result<Self> {
         let defines = with_layout(defines);
         let vs_source = preprocess(lookup, vertex, &defines)?;
         let fs_source = preprocess(lookup, fragment, &defines)?;
+        let gs_source = geometry
+            .map(|g| preprocess(lookup, g, &defines))
+            .transpose()?;
         let mut declared = declared_uniforms(&vs_source.text);
         declared.extend(declared_uniforms(&fs_source.text));
+        if let Some(g) = &gs_source {
+            declared.extend(declared_uniforms(&g.text));
+        }
         let vs = compile(gpu, glow::VERTEX_SHADER, vertex, &vs_source)?;
         let gl = gpu.gl();
+        let gs = match (geometry, &gs_source) {
+            (Some(name), Some(source)) => match compile(gpu, glow::GEOMETRY_SHADER, name, source) {
+                Ok(gs) => Some(gs),
+                Err(e) => {
+                    // SAFETY: gpu module doc; the shader was made just above.
+                    unsafe { gl.delete_shader(vs) };
+                    return Err(e);
+                }
+            },
+            _ => None,
+        };
         let fs = match compile(gpu, glow::FRAGMENT_SHADER, fragment, &fs_source) {
             Ok(fs) => fs,
             Err(e) => {
-                // SAFETY: gpu module doc; the shader was made just above.
-                unsafe { gl.delete_shader(vs) };
+                // SAFETY: gpu module doc; the shaders were made just above.
+                unsafe {
+                    gl.delete_shader(vs);
+                    if let Some(gs) = gs {
+                        gl.delete_shader(gs);
+                    }
+                }
                 return Err(e);
             }
         };
@@ -267,9 +311,15 @@ impl Program {
             })?;
             gl.attach_shader(raw, vs);
             gl.attach_shader(raw, fs);
+            if let Some(gs) = gs {
+                gl.attach_shader(raw, gs);
+            }
             gl.link_program(raw);
             gl.delete_shader(vs);
             gl.delete_shader(fs);
+            if let Some(gs) = gs {
+                gl.delete_shader(gs);
+            }
             if !gl.get_program_link_status(raw) {
                 let log = gl.get_program_info_log(raw);
                 gl.delete_program(raw);

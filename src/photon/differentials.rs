@@ -241,6 +241,43 @@ pub fn auto_leaf_size(total_area: f64, surface_area: f64) -> u32 {
     }
 }
 
+/// Sums over the footprints, read back: their area, the degenerate ones and
+/// the power they carry, and those of diffusely reflected photons.
+struct FootprintTotals {
+    area: f64,
+    degenerate: u32,
+    degenerate_power_fraction: f64,
+    diffuse: u32,
+}
+
+impl FootprintTotals {
+    fn read(footprints: &[Texture; 4], count: u32) -> Self {
+        let f0 = footprints[0].read_f32();
+        let f1 = footprints[1].read_f32();
+        let f3 = footprints[3].read_f32();
+        let (mut area, mut degenerate, mut diffuse) = (0f64, 0u32, 0u32);
+        let (mut power, mut lost) = (0f64, 0f64);
+        for i in 0..count as usize {
+            let a = f0[4 * i + 3];
+            let p: f64 = f3[4 * i..4 * i + 3].iter().map(|&c| f64::from(c)).sum();
+            power += p;
+            if a > 0.0 {
+                area += f64::from(a);
+            } else {
+                degenerate += 1;
+                lost += p;
+            }
+            diffuse += u32::from(f1[4 * i + 3] != 0.0);
+        }
+        Self {
+            area,
+            degenerate,
+            degenerate_power_fraction: if power > 0.0 { lost / power } else { 0.0 },
+            diffuse,
+        }
+    }
+}
+
 /// The passes that build a footprint map.
 pub struct FootprintBuilder {
     gpu: Gpu,
@@ -328,28 +365,50 @@ impl FootprintBuilder {
             )?;
         clock.stop(timings, "footprints", 1);
         // The footprints' total area (the automatic leaf size), by read-back.
-        let f0 = footprints[0].read_f32();
-        let f1 = footprints[1].read_f32();
-        let f3 = footprints[3].read_f32();
-        let (mut total_area, mut degenerate, mut diffuse) = (0f64, 0u32, 0u32);
-        let (mut power, mut lost) = (0f64, 0f64);
-        for i in 0..count as usize {
-            let area = f0[4 * i + 3];
-            let p: f64 = f3[4 * i..4 * i + 3].iter().map(|&c| f64::from(c)).sum();
-            power += p;
-            if area > 0.0 {
-                total_area += f64::from(area);
-            } else {
-                degenerate += 1;
-                lost += p;
-            }
-            diffuse += u32::from(f1[4 * i + 3] != 0.0);
-        }
+        let totals = FootprintTotals::read(&footprints, count);
+        let (total_area, degenerate, diffuse) = (totals.area, totals.degenerate, totals.diffuse);
         let surface_area = receiving_area(scene);
         let auto = auto_leaf_size(total_area, surface_area);
         let leaf_size = options.leaf_size.unwrap_or(auto).max(1);
 
         let clock = StageClock::start(gpu, &query);
+        let (box_min, box_max, box_width, leaves, passes) =
+            self.boxes(&footprints, w, count, leaf_size)?;
+        clock.stop(timings, "footprint BVH", passes);
+        gpu.check("footprint BVH")?;
+        Ok(FootprintMap {
+            footprints,
+            width: w,
+            count,
+            sorted,
+            box_min,
+            box_max,
+            box_width,
+            leaves,
+            leaf_size,
+            auto_leaf_size: auto,
+            diffuse,
+            degenerate,
+            degenerate_power_fraction: totals.degenerate_power_fraction,
+            total_area,
+            surface_area,
+            delta,
+            options: *options,
+            morton_lo: lo,
+            morton_scale: scale,
+        })
+    }
+
+    /// The implicit tree's boxes: the leaves of `leaf_size` footprints, then
+    /// one reduction pass a level. Returns (min, max, box width, leaves, passes).
+    fn boxes(
+        &self,
+        footprints: &[Texture; 4],
+        w: u32,
+        count: u32,
+        leaf_size: u32,
+    ) -> Result<(Texture, Texture, u32, u32, usize)> {
+        let gpu = &self.gpu;
         let leaves = count.div_ceil(leaf_size).next_power_of_two();
         let box_width = (2 * leaves).min(BOX_ROW_TEXELS);
         let box_height = (2 * leaves) / box_width;
@@ -382,28 +441,6 @@ impl FootprintBuilder {
             start /= 2;
         }
         drop(target);
-        clock.stop(timings, "footprint BVH", passes);
-        gpu.check("footprint BVH")?;
-        Ok(FootprintMap {
-            footprints,
-            width: w,
-            count,
-            sorted,
-            box_min,
-            box_max,
-            box_width,
-            leaves,
-            leaf_size,
-            auto_leaf_size: auto,
-            diffuse,
-            degenerate,
-            degenerate_power_fraction: if power > 0.0 { lost / power } else { 0.0 },
-            total_area,
-            surface_area,
-            delta,
-            options: *options,
-            morton_lo: lo,
-            morton_scale: scale,
-        })
+        Ok((box_min, box_max, box_width, leaves, passes))
     }
 }

@@ -9,6 +9,7 @@ pub mod intersect;
 pub mod knn;
 pub mod path_trace;
 pub mod photon;
+pub mod radiosity;
 pub mod random;
 pub mod ray_trace;
 pub mod shading;

@@ -83,6 +83,12 @@ impl RenderOutput {
                     "skipped: photon differentials give every photon a footprint and sum the footprints at a hit (below)".into(),
                 ));
             }
+            (Some(gi), None) if gi.radiosity.is_some() => lines.push(line(
+                "caustic map, estimate",
+                0,
+                false,
+                "skipped: radiosity takes caustics from a caustic photon map, and the scene has no mirror or glass to make them".into(),
+            )),
             (Some(gi), None) if gi.igi.is_some() => lines.push(line(
                 "caustic map, estimate",
                 0,
@@ -160,6 +166,46 @@ impl RenderOutput {
                 ),
             ));
         }
+        lines.extend(self.method_lines(gi));
+        if let Some(a) = &gi.adaptive {
+            let computed: u64 = self.adaptive.iter().map(|s| s.computed).sum();
+            let all: u64 = self.adaptive.iter().map(|s| s.pixels_with_hits).sum();
+            lines.push(line(
+                "adaptive sampling",
+                3 * adaptive::STRIDES.len() * self.adaptive.len(),
+                true,
+                format!(
+                    "global light computed at {computed} of {all} pixels with a diffuse hit, interpolated at the rest (strides 8, 4, 2, 1, each a plan, pack and store pass; threshold {}); each level's estimate above runs on its packed pixels",
+                    a.threshold
+                ),
+            ));
+        }
+        lines
+    }
+
+    /// Radiosity's and photon differentials' lines, when chosen.
+    fn method_lines(&self, gi: &super::GlobalIllumination) -> Vec<ExplainLine> {
+        let mut lines = Vec::new();
+        if let (Some(o), Some(r)) = (&gi.radiosity, &self.radiosity) {
+            lines.push(line(
+                "radiosity",
+                0,
+                true,
+                format!(
+                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; the photon map above, if any, is a caustic map",
+                    r.patches,
+                    r.elements,
+                    r.element_resolution,
+                    r.element_resolution,
+                    r.shots,
+                    o.substructure,
+                    o.substructure,
+                    o.item_buffer,
+                    if r.converged { "converged" } else { "stopped at --max-shots" },
+                    100.0 * r.unshot_fraction
+                ),
+            ));
+        }
         if let (Some(o), Some(d)) = (&gi.differentials, &self.differentials) {
             let passes: u32 = self.footprint_estimates.iter().map(|s| s.passes).sum();
             let k: f64 = self
@@ -206,19 +252,6 @@ impl RenderOutput {
                     "a stackless walk of the BVH at every first hit, at most {} nodes a pass, ended by occlusion query; {:?} kernel; {k:.1} footprints hold a hit on average (k_PD)",
                     crate::layout::FOOTPRINT_BUDGET,
                     o.kernel
-                ),
-            ));
-        }
-        if let Some(a) = &gi.adaptive {
-            let computed: u64 = self.adaptive.iter().map(|s| s.computed).sum();
-            let all: u64 = self.adaptive.iter().map(|s| s.pixels_with_hits).sum();
-            lines.push(line(
-                "adaptive sampling",
-                3 * adaptive::STRIDES.len() * self.adaptive.len(),
-                true,
-                format!(
-                    "global light computed at {computed} of {all} pixels with a diffuse hit, interpolated at the rest (strides 8, 4, 2, 1, each a plan, pack and store pass; threshold {}); each level's estimate above runs on its packed pixels",
-                    a.threshold
                 ),
             ));
         }

@@ -12,6 +12,7 @@ pub mod igi;
 pub mod observer;
 pub mod plan;
 pub mod radiance_estimate;
+pub mod radiosity;
 pub mod ray_rates;
 pub mod ray_trace;
 pub mod software;
@@ -39,6 +40,7 @@ pub use plan::PassPlan;
 pub use radiance_estimate::{
     EstimateMode, EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate,
 };
+pub use radiosity::{Radiosity, RadiosityOptions, RadiosityReport};
 pub use ray_trace::{HitBuffers, RayBuffers, RayTracer};
 
 /// How one render runs (what the scene file does not fix).
@@ -73,6 +75,9 @@ pub struct GlobalIllumination {
     /// Photon differentials with a BVH photon map (`--method differentials`):
     /// footprints instead of the kNN-grid, one map for every photon.
     pub differentials: Option<DifferentialsOptions>,
+    /// Progressive refinement radiosity (`--method radiosity`): the diffuse
+    /// interreflection from an element atlas, caustics from a caustic map.
+    pub radiosity: Option<RadiosityOptions>,
 }
 
 impl RenderOptions {
@@ -116,6 +121,8 @@ pub struct RenderOutput {
     /// Photon differentials' map, and each eye sample's estimate.
     pub differentials: Option<DifferentialsReport>,
     pub footprint_estimates: Vec<FootprintStats>,
+    /// The radiosity solution's report.
+    pub radiosity: Option<RadiosityReport>,
     /// The last radiance estimate, and every one (view by view, sample by sample).
     pub estimate: Option<EstimateStats>,
     pub estimates: Vec<EstimateStats>,
@@ -147,6 +154,8 @@ pub struct RenderState {
     pub igi: Option<Igi>,
     /// Photon differentials' photons, footprint map and estimate textures.
     pub differentials: Option<DifferentialsRun>,
+    /// The radiosity solution's atlas and passes.
+    pub radiosity: Option<Radiosity>,
 }
 
 /// What the photon-differentials map was made of.
@@ -404,6 +413,7 @@ pub fn render_views(
         igi_stats,
         differentials,
         footprint_stats,
+        radiosity,
         ..
     } = global;
     let mut output = finish(
@@ -423,6 +433,7 @@ pub fn render_views(
             vpls: None,
             igi: None,
             differentials: None,
+            radiosity: None,
         },
     );
     if let Some(g) = global_map {
@@ -442,12 +453,28 @@ pub fn render_views(
             .map_or(0.0, |o| o.min_distance_for(scene)),
     });
     output.igi = igi_stats;
-    output.differentials = differentials.as_ref().and_then(DifferentialsRun::report);
-    output.footprint_estimates = footprint_stats;
-    output.state.differentials = differentials;
     output.state.vpls = vpls;
     output.state.igi = igi;
+    output.attach_methods(differentials, footprint_stats, radiosity);
     Ok(output)
+}
+
+impl RenderOutput {
+    /// Photon differentials' and radiosity's reports and GPU state.
+    fn attach_methods(
+        &mut self,
+        differentials: Option<DifferentialsRun>,
+        footprint_stats: Vec<FootprintStats>,
+        radiosity: Option<(Radiosity, RadiosityReport)>,
+    ) {
+        self.differentials = differentials.as_ref().and_then(DifferentialsRun::report);
+        self.footprint_estimates = footprint_stats;
+        self.state.differentials = differentials;
+        if let Some((r, report)) = radiosity {
+            self.radiosity = Some(report);
+            self.state.radiosity = Some(r);
+        }
+    }
 }
 
 /// One eye sample's first hits, ready for the global half.
@@ -481,6 +508,7 @@ struct GlobalPart {
     /// Photon differentials' run, and each eye sample's estimate.
     differentials: Option<DifferentialsRun>,
     footprint_stats: Vec<FootprintStats>,
+    radiosity: Option<(Radiosity, RadiosityReport)>,
 }
 
 impl GlobalPart {
@@ -544,30 +572,9 @@ impl GlobalPart {
                 (Some(vpls), Some(igi))
             }
         };
-        let differentials = match options
-            .global
-            .as_ref()
-            .map(|g| (g, g.differentials.as_ref()))
-        {
-            Some((gi, Some(o))) => {
-                if adaptive || gi.final_gather.is_some() || gi.igi.is_some() {
-                    return Err(Error::InvalidOption(
-                        "photon differentials replace the kNN estimate: drop --adaptive, --final-gather and IGI's options".into(),
-                    ));
-                }
-                observer.progress(&Progress::stage("photons", 0, 1));
-                Some(DifferentialsRun::new(
-                    gpu,
-                    scene,
-                    textures,
-                    gi,
-                    o,
-                    (w, h, options.seed),
-                    timings,
-                )?)
-            }
-            _ => None,
-        };
+        let differentials =
+            differentials_run(gpu, scene, textures, options, adaptive, timings, observer)?;
+        let radiosity = radiosity_run(gpu, scene, textures, options, adaptive, timings, observer)?;
         Ok(Self {
             built,
             global_map,
@@ -582,6 +589,7 @@ impl GlobalPart {
             igi_stats: Vec::new(),
             differentials,
             footprint_stats: Vec::new(),
+            radiosity,
         })
     }
 
@@ -711,6 +719,12 @@ impl GlobalPart {
                 image.add(&igi.read_indirect());
             }
         }
+        if let Some((r, _)) = &self.radiosity {
+            r.run(f.textures, f.direct, timings)?;
+            if let Some(image) = &mut image {
+                image.add(&r.read_indirect());
+            }
+        }
         if let Some(run) = &mut self.differentials {
             run.ensure_map(f, timings)?;
             let map = run.map.as_ref().expect("ensure_map made it");
@@ -732,6 +746,86 @@ impl GlobalPart {
         }
         Ok(image)
     }
+}
+
+/// Photon differentials' photons, when chosen (refusing other methods' options).
+#[allow(clippy::too_many_arguments)]
+fn differentials_run(
+    gpu: &Gpu,
+    scene: &Scene,
+    textures: &SceneTextures,
+    options: &RenderOptions,
+    adaptive: bool,
+    timings: &mut Timings,
+    observer: &mut dyn RenderObserver,
+) -> Result<Option<DifferentialsRun>> {
+    let (w, h) = (options.width, options.height);
+    Ok(
+        match options
+            .global
+            .as_ref()
+            .map(|g| (g, g.differentials.as_ref()))
+        {
+            Some((gi, Some(o))) => {
+                if adaptive || gi.final_gather.is_some() || gi.igi.is_some() {
+                    return Err(Error::InvalidOption(
+                    "photon differentials replace the kNN estimate: drop --adaptive, --final-gather and IGI's options".into(),
+                ));
+                }
+                observer.progress(&Progress::stage("photons", 0, 1));
+                Some(DifferentialsRun::new(
+                    gpu,
+                    scene,
+                    textures,
+                    gi,
+                    o,
+                    (w, h, options.seed),
+                    timings,
+                )?)
+            }
+            _ => None,
+        },
+    )
+}
+
+/// The radiosity solution, when chosen (refusing other methods' options).
+#[allow(clippy::too_many_arguments)]
+fn radiosity_run(
+    gpu: &Gpu,
+    scene: &Scene,
+    textures: &SceneTextures,
+    options: &RenderOptions,
+    adaptive: bool,
+    timings: &mut Timings,
+    observer: &mut dyn RenderObserver,
+) -> Result<Option<(Radiosity, RadiosityReport)>> {
+    let (w, h) = (options.width, options.height);
+    Ok(
+        match options.global.as_ref().map(|g| (g, g.radiosity.as_ref())) {
+            Some((gi, Some(o))) => {
+                if adaptive
+                    || gi.final_gather.is_some()
+                    || gi.igi.is_some()
+                    || gi.differentials.is_some()
+                {
+                    return Err(Error::InvalidOption(
+                    "radiosity computes the diffuse interreflection itself: drop --adaptive, --final-gather and the other methods' options".into(),
+                ));
+                }
+                let r = Radiosity::new(gpu, scene, w, h, o)?;
+                let report = r.solve(scene, textures, timings, &mut |shot, unshot| {
+                    observer.progress(&Progress::stage(
+                        "radiosity",
+                        ((1.0 - unshot) * 1000.0) as u64,
+                        1000,
+                    ));
+                    let _ = shot;
+                })?;
+                Some((r, report))
+            }
+            _ => None,
+        },
+    )
 }
 
 /// Refuses what no render can do before any GPU work.
@@ -778,6 +872,7 @@ fn finish(
         igi: Vec::new(),
         differentials: None,
         footprint_estimates: Vec::new(),
+        radiosity: None,
         estimate: estimates.last().cloned(),
         estimates,
     }
@@ -814,8 +909,8 @@ fn build_maps(
         // Photon differentials trace their own photons (DifferentialsRun).
         return Ok((None, None));
     }
-    if gi.igi.is_some() {
-        // IGI's VPLs carry the diffuse interreflection; the photon map only
+    if gi.igi.is_some() || gi.radiosity.is_some() {
+        // IGI's VPLs (radiosity's elements) carry the diffuse interreflection; the photon map only
         // the caustics, which VPLs cannot (light through glass or off a mirror
         // onto the first hit), and none in a scene with nothing specular.
         if !scene.has_specular() {

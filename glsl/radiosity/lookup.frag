@@ -1,0 +1,57 @@
+#version 450 core
+// Radiosity at each eye path's first diffuse hit: the primitive under the hit
+// (a short ray back into the surface along its normal), the hit's (u, v) on
+// that primitive's patch for the side the eye sees, and the elements around
+// it bilinearly (only elements that exist). The image takes the indirect
+// part, L = throughput x (B - B_direct) / pi: direct light is the ray
+// tracer's shadow rays.
+#include "common/scene.glsl"
+#include "common/sampling.glsl"
+#include "radiosity/parameterisation.glsl"
+
+uniform sampler2D u_diffuse_position;   // w > 0 where a first diffuse hit
+uniform sampler2D u_diffuse_normal;     // facing the eye
+uniform sampler2D u_diffuse_throughput;
+uniform sampler2D u_radiosity;
+uniform sampler2D u_direct;
+uniform sampler2D u_element_position;   // w = area
+uniform isampler2D u_patch_of;
+uniform int u_patch_of_width;
+uniform int u_res;
+uniform int u_tile_columns;
+
+layout(location = 0) out vec4 o_radiance;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    o_radiance = vec4(0.0);
+    vec4 x = texelFetch(u_diffuse_position, px, 0);
+    if (x.w <= 0.0) return;
+    vec3 nf = texelFetch(u_diffuse_normal, px, 0).xyz;
+    float back = 4.0 * offset_scale(x.xyz);
+    vec4 hit;
+    int prim = closest_hit(x.xyz + back * nf, -nf, hit);
+    if (prim < 0) return;
+    int side = dot(geometric_normal(prim, x.xyz), nf) >= 0.0 ? 0 : 1;
+    int k = 2 * prim + side;
+    int pid = texelFetch(u_patch_of, ivec2(k % u_patch_of_width, k / u_patch_of_width), 0).x;
+    if (pid < 0) return;
+    vec2 uv = patch_uv(prim, x.xyz) * float(u_res) - 0.5;
+    ivec2 base = ivec2(pid % u_tile_columns, pid / u_tile_columns) * u_res;
+    ivec2 i0 = ivec2(floor(uv));
+    vec2 f = uv - vec2(i0);
+    vec3 b = vec3(0.0);
+    float wsum = 0.0;
+    for (int j = 0; j < 2; ++j) {
+        for (int i = 0; i < 2; ++i) {
+            ivec2 e = clamp(i0 + ivec2(i, j), ivec2(0), ivec2(u_res - 1));
+            ivec2 t = base + e;
+            if (texelFetch(u_element_position, t, 0).w <= 0.0) continue;
+            float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
+            b += w * (texelFetch(u_radiosity, t, 0).rgb - texelFetch(u_direct, t, 0).rgb);
+            wsum += w;
+        }
+    }
+    if (wsum > 0.0) b /= wsum;
+    o_radiance = vec4(texelFetch(u_diffuse_throughput, px, 0).rgb * max(b, vec3(0.0)) / PI, 0.0);
+}
