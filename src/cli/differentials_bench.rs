@@ -27,22 +27,12 @@ use photonmap::render::{
 };
 use photonmap::scene::Scene;
 
-use super::args::in_range;
 use super::reference::reference_options;
 
 #[derive(Args)]
 pub struct DifferentialsBenchArgs {
-    /// Scene file or embedded name.
-    #[arg(long, required_unless_present = "triangles")]
-    pub scene: Option<PathBuf>,
-    /// Render `bench meshes`'s stage instead, its ball a mesh of about this
-    /// many triangles (1024..=4194304).
-    #[arg(long, value_name = "N", value_parser = in_range(1024, 1 << 22), conflicts_with = "scene")]
-    pub triangles: Option<u32>,
-    /// SPPM reference EXR (default: the scene's, as `bench accuracy` finds
-    /// it; none for the mesh stage). Images render at its size.
-    #[arg(long)]
-    pub reference: Option<PathBuf>,
+    #[command(flatten)]
+    pub scene: super::igi_bench::BenchScene,
     /// Fewer leaf sizes and footprint scales.
     #[arg(long)]
     pub quick: bool,
@@ -75,6 +65,9 @@ pub struct Row {
     pub nodes: Option<f64>,
     pub examined: Option<f64>,
     pub rmse: Option<f64>,
+    /// Relative MSE: not dominated, as RMSE is at 1 spp, by a bright
+    /// emitter's aliased edge against the antialiased reference.
+    pub rel_mse: Option<f64>,
     pub ssim: Option<f64>,
     pub indirect_rmse: Option<f64>,
     /// The indirect pixels' mean over the reference's (1: no bias in the sum).
@@ -136,7 +129,7 @@ impl Bench<'_> {
         for s in &r.timings.stages {
             parts[component(&s.name)] += s.wall_seconds;
         }
-        let (rmse, ssim, indirect_rmse, ratio) = match self.reference {
+        let (rmse, rel_mse, ssim, indirect_rmse, ratio) = match self.reference {
             Some(img) => {
                 let m = compare(&r.image, img, None)?;
                 let (c, ratio) = match &self.indirect {
@@ -156,9 +149,9 @@ impl Bench<'_> {
                     }
                     _ => (None, None),
                 };
-                (Some(m.rmse), Some(m.ssim), c, ratio)
+                (Some(m.rmse), Some(m.rel_mse), Some(m.ssim), c, ratio)
             }
-            None => (None, None, None, None),
+            None => (None, None, None, None, None),
         };
         let file = format!("{:02}_{}.png", self.rendered, super::igi_bench::slug(label));
         self.rendered += 1;
@@ -184,6 +177,7 @@ impl Bench<'_> {
             nodes: stats.map(|s| s.mean_nodes),
             examined: stats.map(|s| s.mean_examined),
             rmse,
+            rel_mse,
             ssim,
             indirect_rmse,
             indirect_mean_ratio: ratio,
@@ -193,8 +187,7 @@ impl Bench<'_> {
 }
 
 pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name, reference, scale) =
-        super::igi_bench::scene_and_reference(&a.scene, a.triangles, &a.reference)?;
+    let (scene, name, reference, scale) = super::igi_bench::scene_and_reference(&a.scene)?;
     let gpu = super::gpu(platform)?;
     let dir = a
         .out
@@ -372,7 +365,7 @@ fn print_table(r: &DifferentialsBench) {
         r.scene, r.width, r.height, r.renderer, r.indirect_pixels
     );
     println!(
-        "{:<26} {:>7} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>8} {:>8} {:>7}",
+        "{:<26} {:>7} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>9} {:>9} {:>8} {:>8} {:>7}",
         "run",
         "k",
         "seconds",
@@ -382,6 +375,7 @@ fn print_table(r: &DifferentialsBench) {
         "nodes",
         "examined",
         "RMSE",
+        "rel. MSE",
         "SSIM",
         "indirect",
         "i. mean"
@@ -395,7 +389,7 @@ fn print_table(r: &DifferentialsBench) {
         println!("-- {title}");
         for x in rows {
             println!(
-                "{:<26} {:>7.1} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>7} {:>8} {:>9} {:>8} {:>8} {:>7}",
+                "{:<26} {:>7.1} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>7} {:>8} {:>9} {:>9} {:>8} {:>8} {:>7}",
                 x.label,
                 x.k,
                 x.seconds,
@@ -405,6 +399,7 @@ fn print_table(r: &DifferentialsBench) {
                 opt(x.nodes, 1),
                 opt(x.examined, 1),
                 opt(x.rmse, 5),
+                opt(x.rel_mse, 5),
                 opt(x.ssim, 4),
                 opt(x.indirect_rmse, 5),
                 opt(x.indirect_mean_ratio, 3),

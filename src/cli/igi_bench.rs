@@ -22,8 +22,9 @@ use super::accuracy::default_reference;
 use super::args::in_range;
 use super::reference::{read_reference, reference_options};
 
+/// The scene a method benchmark renders, and its reference.
 #[derive(Args)]
-pub struct IgiBenchArgs {
+pub struct BenchScene {
     /// Scene file or embedded name.
     #[arg(long, required_unless_present = "triangles")]
     pub scene: Option<PathBuf>,
@@ -35,6 +36,12 @@ pub struct IgiBenchArgs {
     /// none for the mesh stage). Images render at its size.
     #[arg(long)]
     pub reference: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct IgiBenchArgs {
+    #[command(flatten)]
+    pub scene: BenchScene,
     /// Light paths for VPLs (1..=1048576).
     #[arg(long, default_value_t = 64, value_parser = in_range(1, 1 << 20))]
     pub vpl_paths: u32,
@@ -138,7 +145,7 @@ fn component(stage: &str) -> usize {
 }
 
 pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name, reference, scale) = scene_and_reference(&a.scene, a.triangles, &a.reference)?;
+    let (scene, name, reference, scale) = scene_and_reference(&a.scene)?;
     let gpu = super::gpu(platform)?;
     let progress = super::progress_lines(a.quiet);
     let dir = a
@@ -216,11 +223,9 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
 /// and the reference's scale below the scene's resolution.
 #[allow(clippy::type_complexity)]
 pub(super) fn scene_and_reference(
-    scene: &Option<PathBuf>,
-    triangles: Option<u32>,
-    reference: &Option<PathBuf>,
+    s: &BenchScene,
 ) -> Result<(Scene, String, Option<(PathBuf, Image)>, u32)> {
-    let a_scene = scene;
+    let (a_scene, triangles, reference) = (&s.scene, s.triangles, &s.reference);
     let (scene, name): (Scene, String) = match (triangles, a_scene) {
         (Some(n), _) => (super::meshes::stage(n)?, format!("stage_{n}")),
         (None, Some(s)) => (embedded::load_path_or_name(s)?, super::accuracy::stem(s)),

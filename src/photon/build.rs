@@ -133,6 +133,29 @@ pub struct BuiltMap {
     pub build_stages: Timings,
 }
 
+/// `PhotonTracer::trace_to_stored`, added to `timings` as "trace photons":
+/// wall time over every attempt at the stored count, GPU time of the kept trace.
+pub fn trace_timed(
+    gpu: &Gpu,
+    tracer: &PhotonTracer,
+    scene: &Scene,
+    textures: &SceneTextures,
+    seed: u32,
+    timings: &mut Timings,
+) -> Result<(super::PhotonFrames, TraceReport)> {
+    gpu.finish();
+    let t0 = std::time::Instant::now();
+    let (frames, trace) = tracer.trace_to_stored(scene, textures, seed)?;
+    gpu.finish();
+    timings.add_both(
+        "trace photons",
+        trace.gpu_seconds,
+        t0.elapsed().as_secs_f64(),
+        frames.frames as usize,
+    );
+    Ok((frames, trace))
+}
+
 /// Traces the scene's photons and builds its map, adding the stages "trace
 /// photons" and "build map" (GPU time and wall clock) to `timings`.
 pub fn build_map(
@@ -144,17 +167,7 @@ pub fn build_map(
     timings: &mut Timings,
 ) -> Result<BuiltMap> {
     let tracer = PhotonTracer::with_config(gpu, config.trace())?;
-    gpu.finish();
-    let t0 = std::time::Instant::now();
-    let (frames, trace) = tracer.trace_to_stored(scene, textures, seed)?;
-    gpu.finish();
-    // Wall time covers every attempt at the stored count; GPU time the kept trace.
-    timings.add_both(
-        "trace photons",
-        trace.gpu_seconds,
-        t0.elapsed().as_secs_f64(),
-        frames.frames as usize,
-    );
+    let (frames, trace) = trace_timed(gpu, &tracer, scene, textures, seed, timings)?;
     // The scene's grid bounds, or (when it fixes none) the box of the photons.
     let grid = fit::grid_for(gpu, scene, &frames)?
         .with_storage(config.storage(scene.photon_map.photons_stored));

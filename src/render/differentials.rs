@@ -131,16 +131,8 @@ impl DifferentialPhotons {
         seed: u32,
         timings: &mut Timings,
     ) -> Result<Self> {
-        gpu.finish();
-        let t0 = std::time::Instant::now();
-        let (frames, trace) = tracer.trace_to_stored(scene, textures, seed)?;
-        gpu.finish();
-        timings.add_both(
-            "trace photons",
-            trace.gpu_seconds,
-            t0.elapsed().as_secs_f64(),
-            frames.frames as usize,
-        );
+        let (frames, trace) =
+            crate::photon::build::trace_timed(gpu, tracer, scene, textures, seed, timings)?;
         let t0 = std::time::Instant::now();
         let differentials = trace_differentials(gpu, scene, textures, &frames)?;
         gpu.finish();
