@@ -1,20 +1,35 @@
 //! Progressive refinement radiosity (`--method radiosity`): the oriented-disc
 //! form factor on the axis of a shooter is the analytic point-to-disc one;
 //! one shot's energy equals its twin's with shadow rays for visibility, so
-//! the item buffer sees what shadow rays see; in a closed box nearly all the
-//! shot power is received; and a diffuse sphere around a point light reaches
-//! its analytic steady state.
+//! the item buffer sees what shadow rays see (but where a shooter's texel
+//! straddles an edge, and by no more than those shooters give); a closed
+//! sphere around a point light receives all its power and converges to what
+//! the twin's shots give; and no light reaches the inside of a closed diffuse
+//! ball lit from outside.
 
 mod common;
 
 use glam::{Vec2, Vec3};
-use photonmap::reference::radiosity::{received, sub_shooters};
+use photonmap::reference::radiosity::{received, sub_shooters, Shooter};
 use photonmap::reference::ray_trace::closest_hit;
+use photonmap::render::radiosity::onto_surface;
 use photonmap::render::{
     render, GlobalIllumination, RadiosityOptions, RenderOptions, RenderOutput,
 };
 use photonmap::sampling::basis_around;
 use photonmap::scene::{load_scene_str, Scene};
+
+/// The shooters moved onto the first shape's surface, as the GPU's are.
+fn on_surface(shooters: Vec<Shooter>, s: &Scene) -> Vec<Shooter> {
+    let g = &s.shapes[0].geometry;
+    shooters
+        .into_iter()
+        .map(|sh| Shooter {
+            position: onto_surface(g, sh.position, sh.normal),
+            ..sh
+        })
+        .collect()
+}
 
 fn scene(text: &str) -> Scene {
     load_scene_str(text, std::path::Path::new("r.toml")).unwrap()
@@ -98,8 +113,8 @@ fn on_the_axis_the_form_factor_is_the_analytic_point_to_disc_one() {
         "on the axis: {} (analytic rho B F = {analytic}, F = {point_to_disc})",
         direct[t][0]
     );
-    assert!((direct[t][0] - analytic).abs() <= 1e-5 * analytic);
-    assert!((analytic - 0.5 * b * point_to_disc).abs() <= 1e-5 * analytic);
+    // The disc form factor on the axis is the point-to-disc one (A = pi a^2).
+    assert!((direct[t][0] - 0.5 * b * point_to_disc).abs() <= 1e-5 * analytic);
 }
 
 /// The first patch a ray from `o` along `d` meets (primitive and side, as
@@ -150,7 +165,8 @@ fn the_item_buffer_sees_what_shadow_rays_see() {
         let nx = Vec3::from_slice(&e.normal[t][..3]);
         let rho = Vec3::from_slice(&e.albedo[t][..3]);
         let own = e.normal[t][3] as i32;
-        let (mut cpu, mut straddles) = (Vec3::ZERO, false);
+        // What the shooters whose texel straddles an edge give, at most.
+        let (mut cpu, mut straddling) = (Vec3::ZERO, 0f32);
         for sh in &shooters {
             let gift = received(sh, x, nx);
             if gift == Vec3::ZERO {
@@ -165,26 +181,36 @@ fn the_item_buffer_sees_what_shadow_rays_see() {
             let h = to.normalize();
             let uv = (Vec2::new(h.dot(tb), h.dot(bb)) * 0.5 + 0.5) * n;
             let texel = uv.floor().min(Vec2::splat(n - 1.0));
-            for corner in [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE] {
-                let xy = (texel + corner) / n * 2.0 - 1.0;
-                let z = (1.0 - xy.length_squared()).max(0.0).sqrt();
-                let d = (xy.x * tb + xy.y * bb + z * sh.normal).normalize();
-                straddles |= patch_seen(&s, &e.patch_of, sh.position, d) != own;
+            let straddles = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE]
+                .iter()
+                .any(|&corner| {
+                    let xy = (texel + corner) / n * 2.0 - 1.0;
+                    let z = (1.0 - xy.length_squared()).max(0.0).sqrt();
+                    let d = (xy.x * tb + xy.y * bb + z * sh.normal).normalize();
+                    patch_seen(&s, &e.patch_of, sh.position, d) != own
+                });
+            if straddles {
+                straddling += (rho * gift).x;
             }
         }
         elements += 1;
         lit += usize::from(cpu.max_element() > 0.0);
         let gpu = Vec3::from_slice(&direct[t][..3]);
-        if (gpu - cpu).abs().max_element() > 1e-3 * cpu.max_element().max(1e-3) {
+        let off = (gpu.x - cpu.x).abs();
+        if off > 1e-3 * cpu.x.max(1e-3) {
             apart += 1;
-            unexplained += usize::from(!straddles);
-            if !straddles {
-                println!("unexplained {x} n {nx}: gpu {} cpu {}", gpu.x, cpu.x);
+            // Only the straddling shooters may be decided otherwise.
+            if off > straddling * 1.001 + 1e-3 * cpu.x.max(1e-3) {
+                unexplained += 1;
+                println!(
+                    "unexplained {x} n {nx}: gpu {} cpu {} straddling {straddling}",
+                    gpu.x, cpu.x
+                );
             }
         }
     }
     println!(
-        "{elements} elements, {lit} lit: {apart} apart from shadow-ray visibility, {unexplained} of them where the item buffer's texel sees one patch"
+        "{elements} elements, {lit} lit: {apart} apart from shadow-ray visibility, {unexplained} of them by more than the shooters whose texel straddles an edge give"
     );
     assert!(lit > elements / 4, "the light reaches the room");
     assert_eq!(unexplained, 0);
@@ -244,12 +270,15 @@ intensity = [1.0, 1.0, 1.0]
         residual[t] = [0.5; 4];
     }
     for _ in 0..report.shots {
-        let shooters = sub_shooters(
-            &e.position,
-            &e.normal,
-            &residual,
-            e.width,
-            (inside, e.res, e.tile_columns, o.substructure),
+        let shooters = on_surface(
+            sub_shooters(
+                &e.position,
+                &e.normal,
+                &residual,
+                e.width,
+                (inside, e.res, e.tile_columns, o.substructure),
+            ),
+            &s,
         );
         for &t in &mine {
             residual[t] = [0.0; 4];
@@ -301,4 +330,34 @@ intensity = [1.0, 1.0, 1.0]
     // Visibility misses only where a rim texel straddles the horizon (the
     // item buffer test): 1% a priori.
     assert!(gpu >= cpu * 0.99, "{gpu} against the twin's {cpu}");
+}
+
+/// A closed diffuse ball over a lit floor: its outside shoots outward, so no
+/// light ever reaches its inside (a shooter inside the surface would shoot
+/// the outside's power into it), and the floor under it gets the ball's
+/// bounce light.
+#[test]
+fn no_light_reaches_the_inside_of_a_closed_ball() {
+    let text = light_over_floor(1.5).replace(
+        "[[light]]",
+        "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.6, 0.0]\nradius = 0.4\nmaterial = \"floor\"\n[[light]]",
+    );
+    let s = scene(&text);
+    let out = solve(&s, RadiosityOptions::default());
+    let r = out.state.radiosity.as_ref().unwrap();
+    let e = &r.elements;
+    let b = common::texels(&r.radiosity);
+    let ball = 1; // the second shape
+    let inside = e.patch_of[2 * ball + 1];
+    let outside = e.patch_of[2 * ball];
+    let sum = |patch: i32| -> f64 {
+        (0..b.len())
+            .filter(|&t| e.position[t][3] > 0.0 && e.normal[t][3] as i32 == patch)
+            .map(|t| f64::from(b[t][0]))
+            .sum()
+    };
+    let (inner, outer) = (sum(inside), sum(outside));
+    println!("ball: outside {outer:.4}, inside {inner:.6}");
+    assert!(outer > 0.0, "the light reaches the ball");
+    assert_eq!(inner, 0.0, "nothing reaches a closed ball's inside");
 }

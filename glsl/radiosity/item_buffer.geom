@@ -10,11 +10,18 @@
 // rim; its two ends are pushed out radially by 1 / cos(half the arc), so the
 // straight edge between them passes outside the rim and the polygon covers
 // the whole arc (nothing outside the unit disc is ever looked up).
+// The side a facet shows the shooter is decided once per facet, from the
+// facet's own plane (turned to agree with the primitive's outward normal),
+// not per fragment from the curved surface's normal, which near a
+// silhouette would name the far side.
+#include "common/scene.glsl"
+
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 4) out;
 
 uniform float u_far;
 uniform float u_near;
+uniform vec3 u_origin;
 
 in vec3 g_local[];
 in vec3 g_world[];
@@ -22,6 +29,9 @@ flat in int g_primitive[];
 
 out vec3 v_world;
 flat out int v_primitive;
+flat out int v_side;
+
+int side;
 
 void emit(vec3 local, vec3 world, float push) {
     float len = length(local);
@@ -29,10 +39,15 @@ void emit(vec3 local, vec3 world, float push) {
     gl_Position = vec4(xy, 2.0 * len / u_far - 1.0, 1.0);
     v_world = world;
     v_primitive = g_primitive[0];
+    v_side = side;
     EmitVertex();
 }
 
 void main() {
+    vec3 centre = (g_world[0] + g_world[1] + g_world[2]) / 3.0;
+    vec3 facet = cross(g_world[1] - g_world[0], g_world[2] - g_world[0]);
+    if (dot(facet, geometric_normal(g_primitive[0], centre)) < 0.0) facet = -facet;
+    side = dot(facet, u_origin - centre) >= 0.0 ? 0 : 1;
     // Sutherland-Hodgman against z >= u_near: at most four vertices.
     vec3 local[4], world[4];
     bool cut[4] = bool[4](false, false, false, false);
@@ -61,7 +76,7 @@ void main() {
     vec2 ends[2];
     int cuts = 0;
     for (int i = 0; i < n; ++i) {
-        if (cut[i] && cuts < 2) ends[cuts++] = normalize(local[i].xy);
+        if (cut[i] && cuts < 2 && dot(local[i].xy, local[i].xy) > 0.0) ends[cuts++] = normalize(local[i].xy);
     }
     if (cuts == 2) push = 1.0 / max(cos(0.5 * acos(clamp(dot(ends[0], ends[1]), -1.0, 1.0))), 0.25);
     float p[4];

@@ -37,6 +37,9 @@ void main() {
     int pid = texelFetch(u_patch_of, ivec2(k % u_patch_of_width, k / u_patch_of_width), 0).x;
     if (pid < 0) return;
     vec2 uv = patch_uv(prim, x.xyz) * float(u_res) - 0.5;
+    // Longitude wraps around a sphere and a cylinder.
+    int kind = int(primitive_texel(prim, 0).x);
+    bool wraps = kind == PRIM_SPHERE || kind == PRIM_CYLINDER;
     ivec2 base = ivec2(pid % u_tile_columns, pid / u_tile_columns) * u_res;
     ivec2 i0 = ivec2(floor(uv));
     vec2 f = uv - vec2(i0);
@@ -44,7 +47,9 @@ void main() {
     float wsum = 0.0;
     for (int j = 0; j < 2; ++j) {
         for (int i = 0; i < 2; ++i) {
-            ivec2 e = clamp(i0 + ivec2(i, j), ivec2(0), ivec2(u_res - 1));
+            ivec2 e = i0 + ivec2(i, j);
+            e.x = wraps ? (e.x + u_res) % u_res : e.x;
+            e = clamp(e, ivec2(0), ivec2(u_res - 1));
             ivec2 t = base + e;
             if (texelFetch(u_element_position, t, 0).w <= 0.0) continue;
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);

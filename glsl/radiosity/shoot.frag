@@ -26,6 +26,14 @@ uniform int u_lights;                 // 1: these shooters are lights (direct li
 
 layout(location = 0) out vec4 o_radiosity;
 
+// The signed axis nearest direction d, as 1 + index (x, y, z), negative for
+// the negative axis; ties go to the earlier axis.
+int nearest_axis(vec3 d) {
+    vec3 a = abs(d);
+    int i = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+    return d[i] >= 0.0 ? i + 1 : -(i + 1);
+}
+
 // The texel of a shooter's item buffer holding hemisphere point xy.
 ivec2 item_texel(vec2 xy) {
     vec2 uv = xy * 0.5 + 0.5;
@@ -56,8 +64,7 @@ void main() {
         float cos_r = dot(en.xyz, r);
         float cos_s = -dot(s1.xyz, r);
         if (cos_r <= 0.0 || cos_s <= 0.0) continue;
-        vec3 a = abs(r);
-        if (s0.w != 0.0 && cos_s < max(a.x, max(a.y, a.z))) continue; // another axis is nearer
+        if (s0.w != 0.0 && nearest_axis(-r) != nearest_axis(s1.xyz)) continue; // another hemisphere's
         // Visibility: the item buffer in the receiver's direction from k.
         vec3 t, b;
         basis_around(s1.xyz, t, b);
@@ -65,10 +72,10 @@ void main() {
         vec2 xy = vec2(dot(h, t), dot(h, b));
         ivec2 tile = ivec2(k % u_item_columns, k / u_item_columns) * u_item_size;
         float id = texelFetch(u_item_buffers, tile + item_texel(xy), 0).x;
-        // No fragment at all: a rim texel, whose centre lies outside the
-        // projected disc though the receiver's direction is inside. The
-        // texel one step in towards the centre holds what is there.
-        if (id < 0.0 && dot(xy, xy) > 0.0) {
+        // No fragment at all (-2, not a blocker's -1): a rim texel, whose
+        // centre lies outside the projected disc though the receiver's
+        // direction is inside. The texel one step in holds what is there.
+        if (id < -1.5 && dot(xy, xy) > 0.0) {
             id = texelFetch(u_item_buffers, tile + item_texel(xy - normalize(xy) * 2.0 / float(u_item_size)), 0).x;
         }
         if (int(id) != int(en.w)) continue;

@@ -192,7 +192,7 @@ impl RenderOutput {
                 0,
                 true,
                 format!(
-                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; the photon map above, if any, is a caustic map",
+                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; the photon map above, if any, is a caustic map. Light that leaves a mirror or glass onto a diffuse surface is in that map but never bounces on, and light from a diffuse surface through a mirror or glass onto another is in neither",
                     r.patches,
                     r.elements,
                     r.element_resolution,

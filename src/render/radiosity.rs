@@ -113,6 +113,10 @@ impl RadiosityOptions {
     }
 }
 
+/// Texels an element atlas may hold (each of its seven textures is RGBA32F:
+/// 256 MiB apiece at this size).
+pub const MAX_ATLAS_TEXELS: u64 = 1 << 24;
+
 /// One side of a primitive, with its tile of elements.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Patch {
@@ -179,6 +183,43 @@ pub fn element_point(g: &Geometry, u: f32, v: f32) -> (Vec3, Vec3) {
     }
 }
 
+/// Element (i, j)'s parameters: its cell's centre, or on a triangle's
+/// diagonal the centroid of the half cell inside it (u + v < 1).
+fn element_uv(g: &Geometry, i: u32, j: u32, res: u32) -> (f32, f32) {
+    let n = res as f32;
+    let third = matches!(g, Geometry::Triangle { .. }) && i + j + 1 == res;
+    let c = if third { 1.0 / 3.0 } else { 0.5 };
+    ((i as f32 + c) / n, (j as f32 + c) / n)
+}
+
+/// Segments around a sphere or cylinder in the item buffers' tessellation
+/// (a sphere has half as many rows).
+pub const CURVED_SEGMENTS: u32 = 32;
+
+/// Where a sub-element shooter of a curved patch stands: its block's
+/// centroid lies inside a sphere or cylinder, and would see the primitive's
+/// inside, so it goes onto the surface and then, along its own normal n
+/// (out for the outside patch, in for the inside one), twice the
+/// tessellation's sagitta further, so that the facets nearest it are on the
+/// side it shoots from. Planar shooters stay at their centroid.
+pub fn onto_surface(g: &Geometry, p: Vec3, n: Vec3) -> Vec3 {
+    let sagitta =
+        |radius: f32| 2.0 * radius * (1.0 - (std::f32::consts::PI / CURVED_SEGMENTS as f32).cos());
+    match *g {
+        Geometry::Sphere { center, radius } => {
+            center + radius * (p - center).normalize() + sagitta(radius) * n
+        }
+        Geometry::Cylinder {
+            base, axis, radius, ..
+        } => {
+            let r = p - base;
+            let along = r.dot(axis) * axis;
+            base + along + radius * (r - along).normalize() + sagitta(radius) * n
+        }
+        _ => p,
+    }
+}
+
 /// Element (i, j)'s area on a tile of res x res, 0 where it holds none.
 fn element_area(g: &Geometry, i: u32, j: u32, res: u32) -> f32 {
     use std::f32::consts::PI;
@@ -189,11 +230,13 @@ fn element_area(g: &Geometry, i: u32, j: u32, res: u32) -> f32 {
             radius * radius * (t0.cos() - t1.cos()) * 2.0 * PI / n
         }
         Geometry::Triangle { .. } => {
-            // Elements whose centre lies in the triangle share its area.
-            if i + j < res {
-                crate::scene::triangle_area(g) / (res * (res + 1) / 2) as f32
-            } else {
-                0.0
+            // Whole cells of the (u, v) grid inside u + v <= 1, and the half
+            // cells along the diagonal: the triangle's area exactly.
+            let whole = 2.0 * crate::scene::triangle_area(g) / (n * n);
+            match (i + j + 1).cmp(&res) {
+                std::cmp::Ordering::Less => whole,
+                std::cmp::Ordering::Equal => 0.5 * whole,
+                std::cmp::Ordering::Greater => 0.0,
             }
         }
         _ => crate::scene::surface_area(g) / (n * n),
@@ -201,7 +244,30 @@ fn element_area(g: &Geometry, i: u32, j: u32, res: u32) -> f32 {
 }
 
 impl Elements {
-    pub fn new(scene: &Scene, res: u32) -> Self {
+    /// The atlas of `scene` at `res` elements a side, or why it cannot be
+    /// made: the driver's texture size, or MAX_ATLAS_TEXELS.
+    pub fn new(scene: &Scene, res: u32, max_side: u32) -> Result<Self> {
+        let patches = scene
+            .shapes
+            .iter()
+            .map(|s| match scene.materials[s.material] {
+                Material::Diffuse { .. } => 2u64,
+                Material::Emitter { .. } => 1,
+                _ => 0,
+            })
+            .sum::<u64>()
+            .max(1);
+        let columns = (patches as f64).sqrt().ceil() as u64;
+        let (w, h) = (columns * res as u64, patches.div_ceil(columns) * res as u64);
+        if w > max_side as u64 || h > max_side as u64 || w * h > MAX_ATLAS_TEXELS {
+            return Err(Error::TooLarge(format!(
+                "{patches} patches of {res} x {res} elements need an atlas of {w} x {h} texels; the limit is {max_side} a side and {MAX_ATLAS_TEXELS} in all: lower --elements (radiosity gives every side of every diffuse primitive its own tile, so large meshes do not fit)"
+            )));
+        }
+        Ok(Self::layout(scene, res))
+    }
+
+    fn layout(scene: &Scene, res: u32) -> Self {
         let mut patches = Vec::new();
         let mut patch_of = vec![-1i32; 2 * scene.shapes.len()];
         for (prim, shape) in scene.shapes.iter().enumerate() {
@@ -265,7 +331,7 @@ impl Elements {
                     if area <= 0.0 {
                         continue;
                     }
-                    let (u, v) = ((i as f32 + 0.5) / res as f32, (j as f32 + 0.5) / res as f32);
+                    let (u, v) = element_uv(&shape.geometry, i, j, res);
                     let (point, normal) = element_point(&shape.geometry, u, v);
                     let t = ((base.1 + j) * width + base.0 + i) as usize;
                     e.position[t] = point.extend(area).to_array();
@@ -289,8 +355,8 @@ pub fn tessellate(scene: &Scene) -> Vec<f32> {
     for (prim, shape) in scene.shapes.iter().enumerate() {
         let g = &shape.geometry;
         let (nu, nv) = match g {
-            Geometry::Sphere { .. } => (32, 16),
-            Geometry::Cylinder { .. } => (32, 4),
+            Geometry::Sphere { .. } => (CURVED_SEGMENTS, CURVED_SEGMENTS / 2),
+            Geometry::Cylinder { .. } => (CURVED_SEGMENTS, 4),
             Geometry::Parallelogram { .. } => (16, 16),
             Geometry::Triangle { .. } => {
                 if fine {
@@ -414,7 +480,7 @@ impl Radiosity {
         options: &RadiosityOptions,
     ) -> Result<Self> {
         options.check()?;
-        let elements = Elements::new(scene, options.resolution);
+        let elements = Elements::new(scene, options.resolution, gpu.max_texture_size())?;
         if elements.patches.is_empty() {
             return Err(Error::InvalidOption(format!(
                 "{} has no diffuse surface: radiosity has nothing to solve",
@@ -574,7 +640,7 @@ impl Radiosity {
                 report.converged = true;
                 break;
             };
-            let shooters = self.sub_shooters(patch)?;
+            let shooters = self.sub_shooters(scene, patch)?;
             let light = self.elements.patches[patch].emitter;
             // Zeroed before the shot: a curved patch (the inside of a
             // sphere) receives some of its own light.
@@ -657,8 +723,9 @@ impl Radiosity {
     }
 
     /// The patch's S x S sub-elements as shooters (read back: their frames
-    /// set the item buffers' uniforms).
-    fn sub_shooters(&self, patch: usize) -> Result<Vec<Shooter>> {
+    /// set the item buffers' uniforms), each moved onto the surface.
+    fn sub_shooters(&self, scene: &Scene, patch: usize) -> Result<Vec<Shooter>> {
+        let g = &scene.shapes[self.elements.patches[patch].primitive].geometry;
         self.gpu.texture_barrier();
         self.programs
             .shooters
@@ -676,7 +743,7 @@ impl Radiosity {
             .chunks(12)
             .filter(|r| r[7] > 0.0)
             .map(|r| Shooter {
-                position: Vec3::new(r[0], r[1], r[2]),
+                position: onto_surface(g, Vec3::new(r[0], r[1], r[2]), Vec3::new(r[4], r[5], r[6])),
                 point: false,
                 normal: Vec3::new(r[4], r[5], r[6]),
                 area: r[7],
@@ -691,7 +758,8 @@ impl Radiosity {
         let n = self.options.item_buffer;
         let columns = self.options.substructure.max(3);
         debug_assert!(shooters.len() as u32 <= columns * columns);
-        self.items_target.clear([-1.0, 0.0, 0.0, 1.0]);
+        // -2: no fragment (a rim texel); -1: a blocker that is no patch.
+        self.items_target.clear([-2.0, 0.0, 0.0, 1.0]);
         self.items_target.clear_depth_stencil(1.0, 0);
         let state = DrawState {
             depth: DepthTest::On {
