@@ -1326,26 +1326,17 @@ fn bench_meshes_reports_every_size_with_rates_renders_and_a_plot() {
 #[test]
 fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
     let d = tmp("final-gather");
-    let png = d.join("fg.png");
-    let out = photonmap()
-        .args([
-            "render", "--quiet", "--json", "--width", "40", "--height", "36",
-        ])
-        .args([
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
             "--final-gather",
             "3",
             "--adaptive",
             "--set",
             "photon_map.photons_stored=4000",
-        ])
-        .arg(scene("cornell_box"))
-        .arg("-o")
-        .arg(&png)
-        .output()
-        .unwrap();
-    assert_ok(&out);
-    assert!(png.exists());
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        ],
+    );
     assert_eq!(json["method"], "final-gather");
     assert_eq!(json["final_gather"]["rays"], 3);
     assert_eq!(json["gathers"][0]["rays_per_pixel"], 3);
@@ -1356,11 +1347,10 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
         .as_u64()
         .unwrap();
     assert!(0 < computed && computed < all, "{computed} of {all}");
-    let out = photonmap()
-        .args([
-            "render", "--quiet", "--json", "--width", "40", "--height", "36",
-        ])
-        .args([
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
             "--method",
             "sppm",
             "--adaptive",
@@ -1368,14 +1358,8 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
             "4",
             "--photons-per-iteration",
             "4096",
-        ])
-        .arg(scene("cornell_box"))
-        .arg("-o")
-        .arg(&png)
-        .output()
-        .unwrap();
-    assert_ok(&out);
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        ],
+    );
     assert_eq!(
         json["adaptive_pilot"], 1,
         "an eighth of 4 iterations, at least 1"
@@ -1434,12 +1418,10 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
 #[test]
 fn igi_runs_and_refuses_what_it_cannot_do() {
     let d = tmp("igi");
-    let png = d.join("igi.png");
-    let out = photonmap()
-        .args([
-            "render", "--quiet", "--json", "--width", "40", "--height", "36",
-        ])
-        .args([
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
             "--method",
             "igi",
             "--vpl-paths",
@@ -1451,15 +1433,8 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
             "--imperfect-visibility",
             "--set",
             "photon_map.photons_stored=4000",
-        ])
-        .arg(scene("cornell_box"))
-        .arg("-o")
-        .arg(&png)
-        .output()
-        .unwrap();
-    assert_ok(&out);
-    assert!(png.exists());
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        ],
+    );
     assert_eq!(json["method"], "igi");
     assert_eq!(json["vpls"]["paths"], 32);
     let vpls = json["vpls"]["vpls"].as_u64().unwrap();
@@ -1529,27 +1504,18 @@ fn bench_igi_splits_each_version_by_component() {
 #[test]
 fn differentials_run_and_refuse_what_they_cannot_do() {
     let d = tmp("differentials");
-    let png = d.join("pd.png");
-    let out = photonmap()
-        .args([
-            "render", "--quiet", "--json", "--width", "40", "--height", "36",
-        ])
-        .args([
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
             "--method",
             "differentials",
             "--kernel",
             "epanechnikov",
             "--set",
             "photon_map.photons_stored=4000",
-        ])
-        .arg(scene("cornell_box"))
-        .arg("-o")
-        .arg(&png)
-        .output()
-        .unwrap();
-    assert_ok(&out);
-    assert!(png.exists());
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        ],
+    );
     assert_eq!(json["method"], "differentials");
     let map = &json["differentials"];
     assert!(map["footprints"].as_u64().unwrap() >= 4000, "{map}");
@@ -1605,12 +1571,10 @@ fn differentials_run_and_refuse_what_they_cannot_do() {
 #[test]
 fn radiosity_runs_and_refuses_what_it_cannot_do() {
     let d = tmp("radiosity");
-    let png = d.join("rad.png");
-    let out = photonmap()
-        .args([
-            "render", "--quiet", "--json", "--width", "32", "--height", "32",
-        ])
-        .args([
+    let json = render_cornell_box_json(
+        &d,
+        ["32", "32"],
+        &[
             "--method",
             "radiosity",
             "--elements",
@@ -1621,15 +1585,8 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
             "64",
             "--set",
             "photon_map.photons_stored=2000",
-        ])
-        .arg(scene("cornell_box"))
-        .arg("-o")
-        .arg(&png)
-        .output()
-        .unwrap();
-    assert_ok(&out);
-    assert!(png.exists());
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        ],
+    );
     assert_eq!(json["method"], "radiosity");
     let r = &json["radiosity"];
     assert_eq!(r["element_resolution"], 8);
@@ -1710,6 +1667,27 @@ fn bench_differentials_compares_methods_leaf_sizes_and_k() {
         assert!(r["rmse"].as_f64().unwrap() > 0.0, "{r}");
     }
     assert!(d.join("differentials.json").is_file());
+}
+
+/// `render` of CORNELL BOX at the given size with `args` and `--json` into
+/// `dir/out.png`: it succeeds, writes the image, and prints this JSON.
+fn render_cornell_box_json(
+    dir: &std::path::Path,
+    [w, h]: [&str; 2],
+    args: &[&str],
+) -> serde_json::Value {
+    let png = dir.join("out.png");
+    let out = photonmap()
+        .args(["render", "--quiet", "--json", "--width", w, "--height", h])
+        .args(args)
+        .arg(scene("cornell_box"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_ok(&out);
+    assert!(png.exists());
+    serde_json::from_slice(&out.stdout).unwrap()
 }
 
 /// `render` of the named scene at 16 x 16 with `args` into `dir/bad.png`

@@ -1,7 +1,6 @@
 #version 450 core
-// Radiosity at each eye path's first diffuse hit: the primitive under the hit
-// (a short ray back into the surface along its normal), the hit's (u, v) on
-// that primitive's patch for the side the eye sees, and the elements around
+// Radiosity at each eye path's first diffuse hit: the primitive the hit
+// records (diffuse_throughput.w), the hit's (u, v) on that primitive's patch for the side the eye sees, and the elements around
 // it bilinearly (only elements that exist). The image takes the indirect
 // part, L = throughput x (B - B_direct) / pi: direct light is the ray
 // tracer's shadow rays.
@@ -11,7 +10,7 @@
 
 uniform sampler2D u_diffuse_position;   // w > 0 where a first diffuse hit
 uniform sampler2D u_diffuse_normal;     // facing the eye
-uniform sampler2D u_diffuse_throughput;
+uniform sampler2D u_diffuse_throughput; // w = the primitive hit
 uniform sampler2D u_radiosity;
 uniform sampler2D u_direct;
 uniform sampler2D u_element_position;   // w = area
@@ -28,10 +27,8 @@ void main() {
     vec4 x = texelFetch(u_diffuse_position, px, 0);
     if (x.w <= 0.0) return;
     vec3 nf = texelFetch(u_diffuse_normal, px, 0).xyz;
-    float back = 4.0 * offset_scale(x.xyz);
-    vec4 hit;
-    int prim = closest_hit(x.xyz + back * nf, -nf, hit);
-    if (prim < 0) return;
+    vec4 throughput = texelFetch(u_diffuse_throughput, px, 0);
+    int prim = int(throughput.w);
     int side = dot(geometric_normal(prim, x.xyz), nf) >= 0.0 ? 0 : 1;
     int k = 2 * prim + side;
     int pid = texelFetch(u_patch_of, ivec2(k % u_patch_of_width, k / u_patch_of_width), 0).x;
@@ -58,5 +55,5 @@ void main() {
         }
     }
     if (wsum > 0.0) b /= wsum;
-    o_radiance = vec4(texelFetch(u_diffuse_throughput, px, 0).rgb * max(b, vec3(0.0)) / PI, 0.0);
+    o_radiance = vec4(throughput.rgb * max(b, vec3(0.0)) / PI, 0.0);
 }

@@ -24,7 +24,7 @@ uniform int u_light_sampling; // 0: no shadow rays (direct light comes from phot
 layout(location = 0) out vec4 o_radiance;
 layout(location = 1) out vec4 o_diffuse_position;   // xyz, w = 1 where recorded
 layout(location = 2) out vec4 o_diffuse_normal;     // facing the viewer, w = material + 1
-layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the hit
+layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the hit, w = primitive
 
 
 // Where shadow sample s of area light l lands: the point q, the light's
@@ -128,6 +128,6 @@ void main() {
     if (first_batch) {
         o_diffuse_position = vec4(p, 1.0);
         o_diffuse_normal = vec4(nf, float(mat + 1));
-        o_diffuse_throughput = vec4(ht.rgb, 0.0);
+        o_diffuse_throughput = vec4(ht.rgb, float(prim));
     }
 }

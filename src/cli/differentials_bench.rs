@@ -112,6 +112,16 @@ impl Bench<'_> {
         reference_options(self.scene, self.scale, 7)
     }
 
+    /// The bench's options with photon differentials `d`.
+    fn with_differentials(&self, d: DifferentialsOptions) -> RenderOptions {
+        let mut o = self.options();
+        o.global
+            .as_mut()
+            .expect("global illumination")
+            .differentials = Some(d);
+        o
+    }
+
     fn row(&mut self, label: &str, o: &RenderOptions) -> Result<(Row, RenderOutput)> {
         self.row_on(self.scene, label, o)
     }
@@ -221,19 +231,11 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
                 .collect(),
         );
     }
-    let with_pd = |d: DifferentialsOptions, b: &Bench| {
-        let mut o = b.options();
-        o.global
-            .as_mut()
-            .expect("global illumination")
-            .differentials = Some(d);
-        o
-    };
     let mut methods = Vec::new();
     methods.push(bench.row("kNN-grid", &bench.options())?.0);
     let (pd, out) = bench.row(
         "differentials",
-        &with_pd(DifferentialsOptions::default(), &bench),
+        &bench.with_differentials(DifferentialsOptions::default()),
     )?;
     let auto = out
         .differentials
@@ -274,14 +276,6 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
 /// Their Table 1: the map at s fixed to the automatic run's, with each leaf
 /// size, then the automatic one.
 fn leaf_rows(bench: &mut Bench<'_>, auto: &DifferentialsReport, quick: bool) -> Result<Vec<Row>> {
-    let with_pd = |d: DifferentialsOptions, b: &Bench| {
-        let mut o = b.options();
-        o.global
-            .as_mut()
-            .expect("global illumination")
-            .differentials = Some(d);
-        o
-    };
     let sizes: Vec<u32> = if quick {
         vec![4, 16, 64, 256]
     } else {
@@ -293,16 +287,13 @@ fn leaf_rows(bench: &mut Bench<'_>, auto: &DifferentialsReport, quick: bool) -> 
         ..DifferentialsOptions::default()
     };
     for t in sizes {
-        let o = with_pd(
-            DifferentialsOptions {
-                leaf_size: Some(t),
-                ..fixed.clone()
-            },
-            bench,
-        );
+        let o = bench.with_differentials(DifferentialsOptions {
+            leaf_size: Some(t),
+            ..fixed.clone()
+        });
         leaf_sizes.push(bench.row(&format!("leaf size {t}"), &o)?.0);
     }
-    let o = with_pd(fixed.clone(), bench);
+    let o = bench.with_differentials(fixed.clone());
     leaf_sizes.push(
         bench
             .row(&format!("leaf size auto ({})", auto.auto_leaf_size), &o)?
@@ -319,14 +310,6 @@ fn k_rows(
     auto: &DifferentialsReport,
     quick: bool,
 ) -> Result<Vec<Row>> {
-    let with_pd = |d: DifferentialsOptions, b: &Bench| {
-        let mut o = b.options();
-        o.global
-            .as_mut()
-            .expect("global illumination")
-            .differentials = Some(d);
-        o
-    };
     let scales: &[f32] = if quick {
         &[0.5, 1.0]
     } else {
@@ -339,14 +322,11 @@ fn k_rows(
     };
     let mut k_pairs = Vec::new();
     for &m in scales {
-        let o = with_pd(
-            DifferentialsOptions {
-                smoothing: Some(auto.smoothing * m),
-                caustic_smoothing: auto.caustic_smoothing * m,
-                ..DifferentialsOptions::default()
-            },
-            bench,
-        );
+        let o = bench.with_differentials(DifferentialsOptions {
+            smoothing: Some(auto.smoothing * m),
+            caustic_smoothing: auto.caustic_smoothing * m,
+            ..DifferentialsOptions::default()
+        });
         let (row, _) = bench.row(&format!("footprints x {m:.2}"), &o)?;
         let k = (row.k.round() as u32).max(1);
         k_pairs.push(row);

@@ -21,7 +21,7 @@ use glam::Vec3;
 
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
-use crate::scene::pack::{PackedScene, SceneTextures};
+use crate::scene::pack::{light_probabilities, SceneTextures};
 use crate::scene::{Light, Scene};
 use crate::timing::Timings;
 
@@ -51,7 +51,7 @@ pub struct DifferentialFrames {
 /// the light per photon (A / (n p)), as a point light's is pi times the area
 /// per photon at any distance; 0 for a point light.
 pub fn light_measures(scene: &Scene, frames: &PhotonFrames) -> Vec<[f32; 2]> {
-    let packed = PackedScene::new(scene);
+    let picks = light_probabilities(scene);
     let texels = frames.projection.as_ref().map(|p| p.texels(scene));
     scene
         .lights
@@ -60,10 +60,7 @@ pub fn light_measures(scene: &Scene, frames: &PhotonFrames) -> Vec<[f32; 2]> {
         .map(|(l, light)| {
             let (probability, kept) = match &texels {
                 Some(t) => (t.texel(l, 0).y, t.texel(l, 0).z),
-                None => (
-                    packed.lights[l * crate::layout::LIGHT_TEXELS as usize + 5][1],
-                    1.0,
-                ),
+                None => (picks[l], 1.0),
             };
             if probability <= 0.0 {
                 return [0.0, 0.0];

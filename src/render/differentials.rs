@@ -282,18 +282,18 @@ impl FootprintEstimate {
             stats.passes as usize + 2,
         );
         gpu.check("footprint estimate")?;
-        self.summarise(direct, &mut stats);
+        self.summarise(&mut stats);
         Ok(stats)
     }
 
-    /// Means over the first hits, from a read-back of the state (not timed).
-    fn summarise(&self, direct: &DirectLight, stats: &mut FootprintStats) {
+    /// Means over the first hits, from a read-back of the state (not timed):
+    /// a pixel with a hit visited at least the root.
+    fn summarise(&self, stats: &mut FootprintStats) {
         let sum = self.sum.read_f32();
         let walk = self.walk.read_i32();
-        let hit = direct.diffuse_position.read_f32();
         let (mut n, mut k, mut kd, mut nodes, mut examined) = (0u64, 0f64, 0f64, 0f64, 0f64);
         for i in 0..(self.width * self.height) as usize {
-            if hit[4 * i + 3] > 0.0 {
+            if walk[4 * i + 1] > 0 {
                 n += 1;
                 k += f64::from(sum[4 * i + 3]);
                 nodes += f64::from(walk[4 * i + 1]);

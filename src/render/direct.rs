@@ -13,7 +13,7 @@ pub struct DirectLight {
     pub diffuse_position: Texture,
     /// Normal facing the viewer, w = material index + 1.
     pub diffuse_normal: Texture,
-    /// Path throughput up to that hit.
+    /// Path throughput up to that hit, w = the primitive hit.
     pub diffuse_throughput: Texture,
     pub(crate) target: Target,
     program: Program,

@@ -527,7 +527,10 @@ impl Radiosity {
         let items = Texture::new(gpu, items_side, items_side, TexFormat::Rgba32F)?;
         let items_target = Target::with_stencil(gpu, &[&items])?;
         let sub = options.substructure;
-        let shooters = Texture::new(gpu, 3, sub * sub, TexFormat::Rgba32F)?;
+        // A shot's shooter records, 3 texels a row: drawn by `shooters`, read
+        // back, moved onto the surface and uploaded again for `shoot`; as
+        // many rows as item buffers (point lights use 6).
+        let shooters = Texture::new(gpu, 3, sub.max(3).pow(2), TexFormat::Rgba32F)?;
         let shooters_target = Target::new(gpu, &[&shooters])?;
         let vertices = VertexBuffer::from_f32(gpu, &tessellate(scene), &[3, 1])?;
         let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
@@ -737,9 +740,14 @@ impl Radiosity {
             .int("u_res", self.elements.res as i32)
             .int("u_tile_columns", self.elements.tile_columns as i32)
             .int("u_sub", self.options.substructure as i32)
-            .draw_fullscreen(&self.shooters_target, &DrawState::PLAIN)?;
+            .draw_region(
+                &self.shooters_target,
+                &DrawState::PLAIN,
+                [0, 0, 3, (self.options.substructure.pow(2)) as i32],
+            )?;
         let data = self.shooters.read_f32();
-        Ok(data
+        let rows = self.options.substructure.pow(2) as usize;
+        Ok(data[..12 * rows]
             .chunks(12)
             .filter(|r| r[7] > 0.0)
             .map(|r| Shooter {
@@ -789,7 +797,7 @@ impl Radiosity {
                 .float("u_near", self.far * 1e-6)
                 .draw_triangles(&self.items_target, &state, viewport, &self.vertices)?;
         }
-        let mut data = vec![0f32; shooters.len().max(1) * 12];
+        let mut data = vec![0f32; 12 * (columns * columns) as usize];
         for (k, s) in shooters.iter().enumerate() {
             data[12 * k..12 * k + 12].copy_from_slice(&[
                 s.position.x,
@@ -806,20 +814,14 @@ impl Radiosity {
                 0.0,
             ]);
         }
-        let records = Texture::from_f32(
-            gpu,
-            3,
-            shooters.len().max(1) as u32,
-            TexFormat::Rgba32F,
-            &data,
-        )?;
+        self.shooters.upload_f32(&data)?;
         self.programs
             .shoot
             .bind()
             .texture("u_element_position", &self.position)
             .texture("u_element_normal", &self.normal)
             .texture("u_element_albedo", &self.albedo)
-            .texture("u_shooters", &records)
+            .texture("u_shooters", &self.shooters)
             .int("u_shooter_count", shooters.len() as i32)
             .texture("u_item_buffers", &self.items)
             .int("u_item_size", n as i32)

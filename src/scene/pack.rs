@@ -64,6 +64,27 @@ pub fn geometry_kind(g: &Geometry) -> f32 {
     }
 }
 
+/// The probability photon emission picks each light with: in proportion to
+/// its power (sum of channels), or uniform when no light has any.
+pub fn light_probabilities(scene: &Scene) -> Vec<f32> {
+    let weights: Vec<f32> = scene
+        .lights
+        .iter()
+        .map(|l| l.power(&scene.shapes).element_sum())
+        .collect();
+    let total: f32 = weights.iter().sum();
+    weights
+        .iter()
+        .map(|w| {
+            if total > 0.0 {
+                w / total
+            } else {
+                1.0 / scene.lights.len() as f32
+            }
+        })
+        .collect()
+}
+
 impl PackedScene {
     pub fn new(scene: &Scene) -> Self {
         let mut primitives = Vec::new();
@@ -80,13 +101,7 @@ impl PackedScene {
             primitives.extend(pack_geometry(&s.geometry));
         }
         let materials = scene.materials.iter().flat_map(pack_material).collect();
-        // Photon emission picks a light in proportion to its power (sum of channels).
-        let weights: Vec<f32> = scene
-            .lights
-            .iter()
-            .map(|l| l.power(&scene.shapes).element_sum())
-            .collect();
-        let total: f32 = weights.iter().sum();
+        let probabilities = light_probabilities(scene);
         let mut cdf = 0.0;
         // Area light k is the k-th emitter shape (the loader appends them in order).
         let mut emitter_shapes = scene
@@ -108,13 +123,8 @@ impl PackedScene {
             .map(|(i, _)| i as f32);
         let mut lights = Vec::new();
         let mut light_triangles = Vec::new();
-        for (l, w) in scene.lights.iter().zip(&weights) {
+        for (l, &probability) in scene.lights.iter().zip(&probabilities) {
             let v = |a: glam::Vec3| [a.x, a.y, a.z, 0.0];
-            let probability = if total > 0.0 {
-                w / total
-            } else {
-                1.0 / scene.lights.len() as f32
-            };
             cdf += probability;
             let primitive = match *l {
                 Light::Area {
