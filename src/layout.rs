@@ -95,9 +95,19 @@ pub const FOOTPRINT_THICKNESS: f32 = 0.1;
 /// pixel at most (bounds work per pass).
 pub const FOOTPRINT_BUDGET: u32 = 256;
 
-/// Progressive radiosity's patch power texture: patch p at texel
-/// (p mod PATCH_ROW, p / PATCH_ROW).
-pub const PATCH_ROW: u32 = 1024;
+/// Vertices of a radiosity shooter's outline at most (glsl/radiosity/
+/// form_factor.glsl): a curved block's four edges in CURVED_OUTLINE_SEGMENTS
+/// each; a triangle's block of cells cut by its diagonal has 5.
+pub const SHOOTER_OUTLINE: u32 = 4 * CURVED_OUTLINE_SEGMENTS;
+/// Segments along each edge of a curved shooter's outline (it follows the
+/// surface, so its form factor is the curved block's).
+pub const CURVED_OUTLINE_SEGMENTS: u32 = 4;
+/// Texels of a shooter record: position, normal, energy, then the outline.
+pub const SHOOTER_TEXELS: u32 = 3 + SHOOTER_OUTLINE;
+
+/// Progressive radiosity's per-tile and per-node textures (tile powers,
+/// quadtree nodes): record r at texel (r mod TILE_ROW, r / TILE_ROW).
+pub const TILE_ROW: u32 = 1024;
 
 /// Rec. 709 luminance weights of linear RGB.
 pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
@@ -138,7 +148,9 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PI", PI_GLSL.into()),
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
         ("FOOTPRINT_THICKNESS", format!("{FOOTPRINT_THICKNESS:?}")),
-        ("PATCH_ROW", u(PATCH_ROW)),
+        ("TILE_ROW", u(TILE_ROW)),
+        ("SHOOTER_OUTLINE", u(SHOOTER_OUTLINE)),
+        ("SHOOTER_TEXELS", u(SHOOTER_TEXELS)),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
         ("PRIMITIVE_BOX_ROW", u(PRIMITIVE_BOX_ROW)),

@@ -30,8 +30,10 @@ flat in int g_primitive[];
 out vec3 v_world;
 flat out int v_primitive;
 flat out int v_side;
+flat out vec3 v_facing;          // the shown side's facet normal
 
 int side;
+vec3 facing;
 
 void emit(vec3 local, vec3 world, float push) {
     float len = length(local);
@@ -40,6 +42,7 @@ void emit(vec3 local, vec3 world, float push) {
     v_world = world;
     v_primitive = g_primitive[0];
     v_side = side;
+    v_facing = facing;
     EmitVertex();
 }
 
@@ -48,6 +51,7 @@ void main() {
     vec3 facet = cross(g_world[1] - g_world[0], g_world[2] - g_world[0]);
     if (dot(facet, geometric_normal(g_primitive[0], centre)) < 0.0) facet = -facet;
     side = dot(facet, u_origin - centre) >= 0.0 ? 0 : 1;
+    facing = normalize(side == 0 ? facet : -facet);
     // Sutherland-Hodgman against z >= u_near: at most four vertices.
     vec3 local[4], world[4];
     bool cut[4] = bool[4](false, false, false, false);

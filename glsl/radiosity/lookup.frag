@@ -1,7 +1,9 @@
 #version 450 core
 // Radiosity at each eye path's first diffuse hit: the primitive the hit
-// records (diffuse_throughput.w), the hit's (u, v) on that primitive's patch for the side the eye sees, and the elements around
-// it bilinearly (only elements that exist). The image takes the indirect
+// records (diffuse_throughput.w), the patch of the side the eye sees, the
+// leaf of its quadtree holding the hit's (u, v), and that tile's elements
+// around it bilinearly (only elements that exist; clamped at the tile's
+// edge). The image takes the indirect
 // part, L = throughput x (B - B_direct) / pi: direct light is the ray
 // tracer's shadow rays.
 #include "common/scene.glsl"
@@ -16,6 +18,7 @@ uniform sampler2D u_direct;
 uniform sampler2D u_element_position;   // w = area
 uniform isampler2D u_patch_of;
 uniform int u_patch_of_width;
+uniform isampler2D u_nodes;  // node n at (n mod TILE_ROW, n / TILE_ROW): tile t >= 0, -1 empty, -(first child + 2)
 uniform int u_res;
 uniform int u_tile_columns;
 
@@ -33,11 +36,26 @@ void main() {
     int k = 2 * prim + side;
     int pid = texelFetch(u_patch_of, ivec2(k % u_patch_of_width, k / u_patch_of_width), 0).x;
     if (pid < 0) return;
-    vec2 uv = patch_uv(prim, x.xyz) * float(u_res) - 0.5;
-    // Longitude wraps around a sphere and a cylinder.
+    vec2 uv = patch_uv(prim, x.xyz);
+    // Down the quadtree: children in the order (0, 0), (1, 0), (0, 1), (1, 1).
+    int node = pid, tile = -1, depth = 0;
+    for (; depth < 16; ++depth) {
+        int v = texelFetch(u_nodes, ivec2(node % TILE_ROW, node / TILE_ROW), 0).x;
+        if (v == -1) return;
+        if (v >= 0) {
+            tile = v;
+            break;
+        }
+        ivec2 q = ivec2(greaterThanEqual(uv, vec2(0.5)));
+        node = -v - 2 + q.x + 2 * q.y;
+        uv = 2.0 * uv - vec2(q);
+    }
+    if (tile < 0) return;
+    uv = uv * float(u_res) - 0.5;
+    // Longitude wraps around a sphere and a cylinder (a whole patch's tile).
     int kind = int(primitive_texel(prim, 0).x);
-    bool wraps = kind == PRIM_SPHERE || kind == PRIM_CYLINDER;
-    ivec2 base = ivec2(pid % u_tile_columns, pid / u_tile_columns) * u_res;
+    bool wraps = depth == 0 && (kind == PRIM_SPHERE || kind == PRIM_CYLINDER);
+    ivec2 base = ivec2(tile % u_tile_columns, tile / u_tile_columns) * u_res;
     ivec2 i0 = ivec2(floor(uv));
     vec2 f = uv - vec2(i0);
     vec3 b = vec3(0.0);

@@ -3,28 +3,39 @@
 // a pass over the element atlas (the chapter draws each receiving polygon
 // orthographically at its texture's resolution; here each texel's position,
 // normal and area come from textures made once). For shooter k (a sub-element
-// of the chosen patch, or one hemisphere of a point light):
+// of the chosen tile, or one hemisphere of a point light):
+//   dB = rho * B_k * F(x -> outline_k) * V
+// (`--form-factor polygon`: Lambert's exact point-to-polygon form factor to
+// the sub-element's outline, which on a curved surface follows its edges
+// along the surface; the disc's for the block's own elements, which a curved
+// block lights), or
 //   dB = rho * B_k * A_k * max(cos_r cos_k, 0) / (pi d^2 + A_k) * V
-// (the oriented-disc form factor), or for a point light of intensity I,
+// (`disc`: the chapter's oriented-disc form factor), or for a point light of
+// intensity I,
 //   dB = rho * I * max(cos_r, 0) / d^2 * V,
 // from the one of its six axis hemispheres whose axis is nearest the
 // receiver's direction.
 // V: the receiver's patch is what shooter k's item buffer holds in its
-// direction. dB is added (blending) to the radiosity and the residual, and,
-// when the shooters are lights, to the direct part too.
+// direction, or a surface continuing the receiver's (`sees`), or, where
+// nothing is there, a texel beside it does. dB is the shot's alone (accumulate.frag adds it, once the
+// tiles it makes uneven are split and shot again at their children).
 #include "common/sampling.glsl"
+#include "radiosity/form_factor.glsl"
 
 uniform sampler2D u_element_position; // xyz, w = area (0: no element)
 uniform sampler2D u_element_normal;   // xyz, w = patch
 uniform sampler2D u_element_albedo;   // rgb reflectance
-uniform sampler2D u_shooters;         // 3 texels a shooter: (pos, kind), (normal, area), (B or I, 0)
+uniform sampler2D u_shooters;         // a row a shooter: (pos, kind), (normal, area), (B or I, outline vertices),
+                                      // then the outline's vertices (w of the first two:
+                                      // the block's first texel in the atlas)
 uniform int u_shooter_count;
 uniform sampler2D u_item_buffers;     // shooter k's at tile (k % u_item_columns, k / u_item_columns)
 uniform int u_item_size;
 uniform int u_item_columns;
-uniform int u_lights;                 // 1: these shooters are lights (direct light)
+uniform int u_polygon;                // 1: the polygon form factor; 0: the disc's
+uniform int u_block;                  // elements a shooter a side
 
-layout(location = 0) out vec4 o_radiosity;
+layout(location = 0) out vec4 o_shot;
 
 // The signed axis nearest direction d, as 1 + index (x, y, z), negative for
 // the negative axis; ties go to the earlier axis.
@@ -34,20 +45,35 @@ int nearest_axis(vec3 d) {
     return d[i] >= 0.0 ? i + 1 : -(i + 1);
 }
 
+// The facet normal item_buffer.frag packs into (z, w).
+vec3 item_normal(vec2 zw) {
+    float s = zw.y >= 0.0 ? 1.0 : -1.0;
+    float y = zw.y - 4.0 * s;
+    return vec3(zw.x, y, s * sqrt(max(0.0, 1.0 - zw.x * zw.x - y * y)));
+}
+
+// Whether an item-buffer texel lets a receiver (patch, normal n) be seen:
+// it holds the receiver's own patch, or a surface facing the way the
+// receiver does no nearer than `nearest` (the receiver's distance less its
+// own size and two texels' width): an edge it shares (a mesh's next
+// triangle), where the chapter's IDs alone lose every element along the
+// edge. The facing test keeps a closed surface's near side blocking its far
+// side's inside at the silhouette, where the two are as near.
+bool sees(vec4 item, int patch_id, vec3 n, float nearest) {
+    return int(item.x) == patch_id
+        || (item.x > -1.5 && item.y >= nearest && dot(item_normal(item.zw), n) > 0.9);
+}
+
 // The texel of a shooter's item buffer holding hemisphere point xy.
 ivec2 item_texel(vec2 xy) {
     vec2 uv = xy * 0.5 + 0.5;
     return clamp(ivec2(uv * float(u_item_size)), ivec2(0), ivec2(u_item_size - 1));
 }
-layout(location = 1) out vec4 o_residual;
-layout(location = 2) out vec4 o_direct;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 e = texelFetch(u_element_position, px, 0);
-    o_radiosity = vec4(0.0);
-    o_residual = vec4(0.0);
-    o_direct = vec4(0.0);
+    o_shot = vec4(0.0);
     if (e.w <= 0.0) return;
     vec4 en = texelFetch(u_element_normal, px, 0);
     vec3 rho = texelFetch(u_element_albedo, px, 0).rgb;
@@ -56,7 +82,8 @@ void main() {
     for (int k = 0; k < u_shooter_count; ++k) {
         vec4 s0 = texelFetch(u_shooters, ivec2(0, k), 0);
         vec4 s1 = texelFetch(u_shooters, ivec2(1, k), 0);
-        vec3 energy = texelFetch(u_shooters, ivec2(2, k), 0).rgb;
+        vec4 s2 = texelFetch(u_shooters, ivec2(2, k), 0);
+        vec3 energy = s2.rgb;
         vec3 r = s0.xyz - e.xyz;
         float d2 = dot(r, r);
         if (!(d2 > 0.0)) continue;
@@ -71,20 +98,46 @@ void main() {
         vec3 h = -r;
         vec2 xy = vec2(dot(h, t), dot(h, b));
         ivec2 tile = ivec2(k % u_item_columns, k / u_item_columns) * u_item_size;
-        float id = texelFetch(u_item_buffers, tile + item_texel(xy), 0).x;
-        // No fragment at all (-2, not a blocker's -1): a rim texel, whose
-        // centre lies outside the projected disc though the receiver's
-        // direction is inside. The texel one step in holds what is there.
-        if (id < -1.5 && dot(xy, xy) > 0.0) {
-            id = texelFetch(u_item_buffers, tile + item_texel(xy - normalize(xy) * 2.0 / float(u_item_size)), 0).x;
+        ivec2 at = tile + item_texel(xy);
+        float d = sqrt(d2);
+        float slack = sqrt(e.w) + 4.0 * d / float(u_item_size);
+        bool visible = sees(texelFetch(u_item_buffers, at, 0), int(en.w), en.xyz, d - slack);
+        // Nothing at all there (-2, the clear value): the receiver is at its
+        // own surface's silhouette (a disc's rim) or the texel at the
+        // projection's rim, its centre outside the projected disc. A texel
+        // beside it that holds the receiver's surface decides (at no
+        // depth); a closed surface's near side there still blocks its far
+        // side's inside.
+        if (!visible && texelFetch(u_item_buffers, at, 0).x < -1.5) {
+            for (int n = 0; n < 4 && !visible; ++n) {
+                ivec2 step = n < 2 ? ivec2(2 * n - 1, 0) : ivec2(0, 2 * n - 5);
+                ivec2 q = clamp(at + step, tile, tile + ivec2(u_item_size - 1));
+                vec4 beside = texelFetch(u_item_buffers, q, 0);
+                visible = beside.x > -1.5 && sees(beside, int(en.w), en.xyz, -1e30);
+            }
         }
-        if (int(id) != int(en.w)) continue;
-        float f = s0.w == 0.0 ? cos_r * cos_s * s1.w / (PI * d2 + s1.w)
-                              : cos_r / d2;
+        if (!visible) continue;
+        float f;
+        if (s0.w != 0.0) {
+            f = cos_r / d2;
+        } else {
+            f = cos_r * cos_s * s1.w / (PI * d2 + s1.w);
+            if (u_polygon != 0 && s2.w >= 3.0) {
+                vec3 outline[SHOOTER_OUTLINE];
+                int count = min(int(s2.w), SHOOTER_OUTLINE);
+                for (int v = 0; v < SHOOTER_OUTLINE; ++v) {
+                    outline[v] = texelFetch(u_shooters, ivec2(3 + v, k), 0).xyz;
+                }
+                // A curved block's own elements lie on the surface its
+                // outline bounds: for them the disc stands.
+                ivec2 own = ivec2(texelFetch(u_shooters, ivec2(3, k), 0).w,
+                                  texelFetch(u_shooters, ivec2(4, k), 0).w);
+                if (any(lessThan(px, own)) || any(greaterThanEqual(px, own + u_block))) {
+                    f = polygon_form_factor(e.xyz, en.xyz, outline, count);
+                }
+            }
+        }
         sum += energy * f;
     }
-    vec3 db = rho * sum;
-    o_radiosity = vec4(db, 0.0);
-    o_residual = vec4(db, 0.0);
-    o_direct = u_lights != 0 ? vec4(db, 0.0) : vec4(0.0);
+    o_shot = vec4(rho * sum, 0.0);
 }

@@ -1,12 +1,12 @@
 #version 450 core
-// The chosen patch's sub-elements as shooters (substructuring, 39.4): the
-// patch's res x res tile in u_sub x u_sub blocks, each one shooter at its
+// The chosen tile's sub-elements as shooters (substructuring, 39.4): its
+// res x res elements in u_sub x u_sub blocks, each one shooter at its
 // elements' area-weighted centre, normal and residual radiosity, with their
 // total area. Row k of the output: (pos, 0), (normal, area), (B, 0).
 uniform sampler2D u_residual;
 uniform sampler2D u_element_position;
 uniform sampler2D u_element_normal;
-uniform int u_patch;
+uniform int u_tile;
 uniform int u_res;
 uniform int u_tile_columns;
 uniform int u_sub;
@@ -17,7 +17,7 @@ void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     int k = px.y;
     int block = u_res / u_sub;
-    ivec2 base = ivec2(u_patch % u_tile_columns, u_patch / u_tile_columns) * u_res
+    ivec2 base = ivec2(u_tile % u_tile_columns, u_tile / u_tile_columns) * u_res
                + ivec2(k % u_sub, k / u_sub) * block;
     vec3 pos = vec3(0.0), normal = vec3(0.0), energy = vec3(0.0);
     float area = 0.0;

@@ -6,6 +6,7 @@ use clap::Args;
 use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
+use photonmap::render::radiosity::FormFactor;
 use photonmap::render::sppm::{DirectLighting, SppmOptions};
 use photonmap::render::{
     DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel, RadiosityOptions,
@@ -306,11 +307,11 @@ pub struct DifferentialsArgs {
 /// Progressive radiosity's switches (`--method radiosity`).
 #[derive(Args, Clone, Debug)]
 pub struct RadiosityArgs {
-    /// Radiosity: elements per side of each patch (each side of a diffuse
-    /// primitive) (2..=256).
+    /// Radiosity: elements per side of each tile, a leaf of a patch's
+    /// quadtree (a patch is a side of a diffuse primitive) (2..=256).
     #[arg(long, value_name = "N", default_value_t = 16, value_parser = in_range(2, 256))]
     pub elements: u32,
-    /// Radiosity: shooters per side of a shooting patch, its elements merged
+    /// Radiosity: shooters per side of a shooting tile, its elements merged
     /// S x S (substructuring; a divisor of --elements, 1..=8).
     #[arg(long, value_name = "S", default_value_t = 4, value_parser = in_range(1, 8))]
     pub substructure: u32,
@@ -320,10 +321,22 @@ pub struct RadiosityArgs {
     /// Radiosity: shots at most (1..=1000000).
     #[arg(long, default_value_t = 10_000, value_parser = in_range(1, 1_000_000))]
     pub max_shots: u32,
-    /// Radiosity: converged once no patch holds this fraction of the emitted
+    /// Radiosity: converged once no tile holds this fraction of the emitted
     /// power unshot (0 < F < 1).
     #[arg(long, value_name = "F", default_value_t = 1e-4, value_parser = open_fraction)]
     pub convergence: f32,
+    /// Radiosity: adaptive subdivision's quadtree depth at most (0: one
+    /// uniform tile a patch; 0..=6).
+    #[arg(long, value_name = "D", default_value_t = RadiosityOptions::default().subdivide, value_parser = in_range(0, photonmap::render::radiosity::MAX_SUBDIVIDE))]
+    pub subdivide: u32,
+    /// Radiosity: a tile splits where the radiosity's second difference
+    /// exceeds this fraction of the local radiosity (> 0).
+    #[arg(long, value_name = "G", default_value_t = RadiosityOptions::default().gradient, value_parser = positive_f32)]
+    pub gradient: f32,
+    /// Radiosity: a shooter's form factor to an element: Lambert's exact
+    /// point-to-polygon one, or the chapter's oriented disc.
+    #[arg(long, value_enum, default_value_t = FormFactor::Polygon)]
+    pub form_factor: FormFactor,
 }
 
 fn open_fraction(s: &str) -> Result<f32, String> {
@@ -341,6 +354,9 @@ impl RadiosityArgs {
             || self.item_buffer != d.item_buffer
             || self.max_shots != d.max_shots
             || self.convergence != d.convergence
+            || self.subdivide != d.subdivide
+            || self.gradient != d.gradient
+            || self.form_factor != d.form_factor
     }
 }
 
@@ -352,6 +368,9 @@ impl From<&RadiosityArgs> for RadiosityOptions {
             item_buffer: a.item_buffer,
             max_shots: a.max_shots,
             convergence: a.convergence,
+            subdivide: a.subdivide,
+            gradient: a.gradient,
+            form_factor: a.form_factor,
         }
     }
 }

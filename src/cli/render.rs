@@ -389,7 +389,7 @@ fn check_method_switches(args: &RenderArgs) -> Result<()> {
         bail!("--method differentials replaces the kNN estimate with footprints: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
     }
     if args.method != Method::Radiosity && args.radiosity.any_given() {
-        bail!("--elements, --substructure, --item-buffer, --max-shots and --convergence are radiosity's: add --method radiosity");
+        bail!("--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient and --form-factor are radiosity's: add --method radiosity");
     }
     if args.method == Method::Radiosity
         && (args.final_gather.is_some()
@@ -442,7 +442,7 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         || args.differentials.any_given()
         || args.radiosity.any_given()
     {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence)");
+        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor)");
     }
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
@@ -605,11 +605,14 @@ fn print_summary(
     }
     if let Some(r) = &out.radiosity {
         eprintln!(
-            "radiosity: {} patches, {} elements ({} x {} a patch); {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}",
+            "radiosity: {} patches in {} tiles of {} x {} ({} splits{}), {} elements; {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}",
             r.patches,
+            r.tiles,
+            r.element_resolution,
+            r.element_resolution,
+            r.splits,
+            if r.atlas_full { ", the atlas full" } else { "" },
             r.elements,
-            r.element_resolution,
-            r.element_resolution,
             r.shots,
             r.seconds,
             if r.converged { "converged" } else { "stopped at --max-shots" },

@@ -224,6 +224,40 @@ impl Texture {
         self.upload(data)
     }
 
+    /// Replaces the `[x, y, width, height]` region of level 0 with `data`.
+    pub fn upload_region<T: Texel>(&self, region: [u32; 4], data: &[T]) -> Result<()> {
+        assert_eq!(T::INTEGER, self.is_integer(), "texel type against format");
+        let [x, y, w, h] = region;
+        assert!(
+            x + w <= self.width && y + h <= self.height,
+            "region inside the texture"
+        );
+        assert_eq!(
+            data.len(),
+            (w * h) as usize * self.format.channels(),
+            "region data size"
+        );
+        let (_, fmt, ty) = self.format.gl();
+        // SAFETY: gpu module doc; `data` holds exactly the region's texels.
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
+            gl.tex_sub_image_2d(
+                glow::TEXTURE_2D,
+                0,
+                x as i32,
+                y as i32,
+                w as i32,
+                h as i32,
+                fmt,
+                ty,
+                glow::PixelUnpackData::Slice(Some(bytes_of(data))),
+            );
+        }
+        self.gpu.check("uploading a texture region")
+    }
+
     /// Restricts which mip levels samplers see (texelFetch's lod counts from `base`).
     pub fn set_level_range(&self, base: u32, max: u32) {
         // SAFETY: gpu module doc.

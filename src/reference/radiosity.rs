@@ -1,34 +1,40 @@
-//! Twins of progressive radiosity's shooting (glsl/radiosity/shooters.frag
-//! and shoot.frag): a patch's sub-element shooters from the element atlas,
-//! and the oriented-disc form factor, with visibility given by the caller
-//! (shadow rays here, the item buffer on the GPU).
+//! Twins of progressive radiosity's passes (glsl/radiosity/): a tile's
+//! sub-element shooters from the element atlas (shooters.frag), the energy an
+//! element receives by the polygon or the oriented-disc form factor
+//! (shoot.frag, form_factor.glsl), with visibility given by the caller
+//! (shadow rays here, the item buffer on the GPU), and adaptive
+//! subdivision's split test (discontinuity.frag).
 
 use glam::Vec3;
 
-/// A shooter: position, normal, area and residual radiosity.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A shooter: position, normal, area, residual radiosity and outline.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Shooter {
     pub position: Vec3,
     pub normal: Vec3,
     pub area: f32,
     pub energy: Vec3,
+    /// The sub-element's outline on the surface (empty: a disc only).
+    pub outline: Vec<Vec3>,
 }
 
-/// Patch `patch`'s sub x sub shooters, from the atlas's element positions
-/// (w = area), normals and residuals (each `width` texels a row).
+/// Tile `tile`'s sub x sub shooters, from the atlas's element positions
+/// (w = area), normals and residuals (each `width` texels a row); block k's
+/// outline from `outline(k)`.
 pub fn sub_shooters(
     position: &[[f32; 4]],
     normal: &[[f32; 4]],
     residual: &[[f32; 4]],
     width: u32,
-    (patch, res, tile_columns, sub): (u32, u32, u32, u32),
+    (tile, res, tile_columns, sub): (u32, u32, u32, u32),
+    outline: &dyn Fn(u32) -> Vec<Vec3>,
 ) -> Vec<Shooter> {
     let block = res / sub;
     let mut out = Vec::new();
     for k in 0..sub * sub {
         let base = (
-            (patch % tile_columns) * res + (k % sub) * block,
-            (patch / tile_columns) * res + (k / sub) * block,
+            (tile % tile_columns) * res + (k % sub) * block,
+            (tile / tile_columns) * res + (k / sub) * block,
         );
         let (mut p, mut n, mut e, mut area) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0.0);
         for j in 0..block {
@@ -50,15 +56,51 @@ pub fn sub_shooters(
                 normal: n.normalize(),
                 area,
                 energy: e / area,
+                outline: outline(k),
             });
         }
     }
     out
 }
 
+/// Lambert's form factor from point x (unit normal n) to a polygon (or a
+/// non-planar loop: the surface it bounds), clipped to x's upper half-space.
+pub fn polygon_form_factor(x: Vec3, n: Vec3, outline: &[Vec3]) -> f32 {
+    let mut clipped = Vec::with_capacity(outline.len() + 1);
+    for k in 0..outline.len() {
+        let a = outline[k] - x;
+        let b = outline[(k + 1) % outline.len()] - x;
+        let (da, db) = (a.dot(n), b.dot(n));
+        if da > 0.0 {
+            clipped.push(a);
+        }
+        if (da > 0.0) != (db > 0.0) {
+            clipped.push(a + (da / (da - db)) * (b - a));
+        }
+    }
+    if clipped.len() < 3 {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for k in 0..clipped.len() {
+        let a = clipped[k].normalize();
+        let b = clipped[(k + 1) % clipped.len()].normalize();
+        let axb = a.cross(b);
+        let s = axb.length();
+        if s > 0.0 {
+            sum += s.atan2(a.dot(b)) * n.dot(axb) / s;
+        }
+    }
+    sum.abs() / (2.0 * std::f32::consts::PI)
+}
+
 /// The radiosity element (x, normal nx) receives from shooter s, per unit
-/// reflectance, if visible: B_s A_s max(cos_r cos_s, 0) / (pi d^2 + A_s).
-pub fn received(s: &Shooter, x: Vec3, nx: Vec3) -> Vec3 {
+/// reflectance, if visible: B_s F, F the polygon form factor (`polygon`,
+/// when it has an outline; the caller passes false for the shooter's own
+/// elements, as the GPU does) or the oriented disc's
+/// A_s cos_r cos_s / (pi d^2 + A_s). Nothing unless the element and
+/// the shooter face each other (centre to centre).
+pub fn received(s: &Shooter, x: Vec3, nx: Vec3, polygon: bool) -> Vec3 {
     let r = s.position - x;
     let d2 = r.dot(r);
     if d2 <= 0.0 {
@@ -69,5 +111,42 @@ pub fn received(s: &Shooter, x: Vec3, nx: Vec3) -> Vec3 {
     if cos_r <= 0.0 || cos_s <= 0.0 {
         return Vec3::ZERO;
     }
+    if polygon && s.outline.len() >= 3 {
+        return s.energy * polygon_form_factor(x, nx, &s.outline);
+    }
     s.energy * (cos_r * cos_s * s.area / (std::f32::consts::PI * d2 + s.area))
+}
+
+/// The split test's count over a res x res tile of radiosity luminances
+/// (None: no element): elements whose second difference along u or v
+/// exceeds gradient x the three's mean + floor. Also how many elements lie
+/// within 1e-4 (relative) of deciding otherwise, where f32 rounding on the
+/// GPU may decide the other way.
+pub fn discontinuities(values: &[Option<f32>], res: u32, gradient: f32, floor: f32) -> (u64, u64) {
+    let at = |i: u32, j: u32| values[(j * res + i) as usize];
+    let (mut count, mut close) = (0, 0);
+    for j in 0..res {
+        for i in 0..res {
+            let Some(b) = at(i, j) else { continue };
+            let mut uneven = false;
+            let mut marginal = false;
+            let mut test = |a: Option<f32>, c: Option<f32>| {
+                if let (Some(a), Some(c)) = (a, c) {
+                    let d = (a - 2.0 * b + c).abs();
+                    let limit = gradient * (a + b + c) / 3.0 + floor;
+                    uneven |= d > limit;
+                    marginal |= (d - limit).abs() <= 1e-4 * limit.max(d);
+                }
+            };
+            if i >= 1 && i + 1 < res {
+                test(at(i - 1, j), at(i + 1, j));
+            }
+            if j >= 1 && j + 1 < res {
+                test(at(i, j - 1), at(i, j + 1));
+            }
+            count += u64::from(uneven);
+            close += u64::from(marginal);
+        }
+    }
+    (count, close)
 }

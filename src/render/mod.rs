@@ -812,7 +812,7 @@ fn radiosity_run(
                     "radiosity computes the diffuse interreflection itself: drop --adaptive, --final-gather and the other methods' options".into(),
                 ));
                 }
-                let r = Radiosity::new(gpu, scene, w, h, o)?;
+                let mut r = Radiosity::new(gpu, scene, w, h, o)?;
                 let report = r.solve(scene, textures, timings, &mut |shot, unshot| {
                     observer.progress(&Progress::stage(
                         "radiosity",

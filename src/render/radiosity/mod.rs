@@ -1,0 +1,943 @@
+//! Progressive refinement radiosity (Coombe and Harris, GPU Gems 2, chapter
+//! 39) as a fourth method beside photon mapping, IGI and photon
+//! differentials (`--method radiosity`). It rasterises rather than ray traces:
+//!
+//! 1. **Elements as texels.** Every diffuse primitive has two patches (its
+//!    sides), each the root of a quadtree of res x res tiles of an element
+//!    atlas (`elements`), laid out by the primitive's parameterisation
+//!    (`element_point`; glsl/radiosity/parameterisation.glsl inverts it).
+//!    Each element's position, normal, area and reflectance are textures;
+//!    radiosity, residual and the direct part are atlas textures. Emitters
+//!    are patches on their emitting side, with residual pi L_e; mirror and
+//!    glass are not patches but still block.
+//! 2. **The shooter** is the tile of most residual power (`tile_power`, a
+//!    loop over its elements in place of the chapter's mipmap), chosen by
+//!    the chapter's z-buffer sort: one point a tile into a 1 x 1 target at
+//!    depth threshold / power (`select`). No fragment means converged: the
+//!    far plane is the convergence threshold.
+//! 3. **Shooting**, batched: the tile in S x S sub-elements (substructuring;
+//!    `shooters`), each with its item buffer, the scene drawn through the
+//!    hemispherical projection (`item_buffer.vert`) as patch IDs into one
+//!    tile of a shared texture; then one pass over the atlas (`shoot`) puts
+//!    every sub-element's oriented-disc form factor times visibility into a
+//!    shot texture. Point lights shoot once, first, as six hemispheres about
+//!    the axes, each receiver taking the one whose axis is nearest its
+//!    direction (so none is seen near a hemisphere's rim, where the
+//!    projection is coarsest).
+//! 4. **Adaptive subdivision** (39.3, `--subdivide D`): after each shot,
+//!    every live tile above depth D is tested for gradient discontinuities
+//!    (`discontinuity`, counted by an occlusion query a tile); a tile with
+//!    more than res / 2 of them splits into four children, which inherit its
+//!    radiosity and residual (`inherit`) and take the shot again at their
+//!    own elements, then are tested in turn. Then the shot is added
+//!    (`accumulate`).
+//! 5. **The image**: direct light and specular paths from the ray tracer, the
+//!    radiosity less its direct part at each first diffuse hit (`lookup`,
+//!    down the quadtree to the leaf), and caustics from a caustic photon
+//!    map: radiosity has none, and light from a diffuse surface through
+//!    glass or a mirror is in neither.
+
+mod elements;
+
+pub use elements::{
+    block_outline, element_point, full_tree, onto_surface, tessellate, Elements, Node, Patch, Tile,
+    CURVED_SEGMENTS, MAX_ATLAS_TEXELS,
+};
+
+use glam::Vec3;
+
+use crate::error::Error;
+use crate::gpu::{
+    Compare, DepthTest, DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture,
+    VertexBuffer,
+};
+use crate::layout::{SHOOTER_OUTLINE, SHOOTER_TEXELS, TILE_ROW};
+use crate::scene::pack::SceneTextures;
+use crate::scene::{Light, Scene};
+
+use super::{DirectLight, Image, Timings};
+
+/// How the radiosity solution runs.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RadiosityOptions {
+    /// Elements per side of each tile.
+    pub resolution: u32,
+    /// Shooters per side of a shooting tile (substructuring; divides `resolution`).
+    pub substructure: u32,
+    /// Texels per side of each item buffer.
+    pub item_buffer: u32,
+    /// Shots at most.
+    pub max_shots: u32,
+    /// Converged once no tile holds this fraction of the emitted power unshot.
+    pub convergence: f32,
+    /// Quadtree depth at most (0: one uniform tile a patch).
+    pub subdivide: u32,
+    /// The split test's relative second difference (`discontinuity.frag`).
+    pub gradient: f32,
+    /// How a sub-element shooter's form factor is computed.
+    pub form_factor: FormFactor,
+}
+
+/// A shooter's form factor to a receiving element's centre.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum FormFactor {
+    /// Lambert's exact point-to-polygon form factor to the sub-element's
+    /// outline (a curved one's chord polygon: the same boundary, so the same
+    /// form factor from wherever all of it is seen).
+    Polygon,
+    /// The chapter's oriented disc, A cos cos / (pi d^2 + A): exact on the
+    /// disc's axis, short of the true value near the shooter.
+    Disc,
+}
+
+impl Default for RadiosityOptions {
+    /// 16 x 16 elements a tile (the chapter's leaf tiles), 4 x 4 shooters a
+    /// tile, 256^2 item buffers, and a tile shoots while it holds 0.01% of
+    /// the emitted power (a priori; the unshot total is reported). Tiles
+    /// split to depth 2 where the second difference exceeds a quarter of the
+    /// local radiosity.
+    fn default() -> Self {
+        Self {
+            resolution: 16,
+            substructure: 4,
+            item_buffer: 256,
+            max_shots: 10_000,
+            convergence: 1e-4,
+            subdivide: 2,
+            gradient: 0.25,
+            form_factor: FormFactor::Polygon,
+        }
+    }
+}
+
+impl RadiosityOptions {
+    pub fn check(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::InvalidOption(what));
+        if !(2..=256).contains(&self.resolution) {
+            return bad(format!(
+                "--elements {}: the allowed range is 2..=256",
+                self.resolution
+            ));
+        }
+        if self.substructure == 0 || !self.resolution.is_multiple_of(self.substructure) {
+            return bad(format!(
+                "--substructure {}: give a divisor of --elements ({})",
+                self.substructure, self.resolution
+            ));
+        }
+        if self.substructure > 8 {
+            return bad(format!(
+                "--substructure {}: at most 8 (64 item buffers a shot)",
+                self.substructure
+            ));
+        }
+        if !(16..=2048).contains(&self.item_buffer) {
+            return bad(format!(
+                "--item-buffer {}: the allowed range is 16..=2048",
+                self.item_buffer
+            ));
+        }
+        if !(self.convergence > 0.0 && self.convergence < 1.0) {
+            return bad(format!(
+                "--convergence {}: the allowed range is (0, 1)",
+                self.convergence
+            ));
+        }
+        if self.subdivide > MAX_SUBDIVIDE {
+            return bad(format!(
+                "--subdivide {}: the allowed range is 0..={MAX_SUBDIVIDE}",
+                self.subdivide
+            ));
+        }
+        if !(self.gradient > 0.0 && self.gradient.is_finite()) {
+            return bad(format!(
+                "--gradient {}: give a positive number",
+                self.gradient
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Quadtree depth at most (a tile at depth 6 is 1/64 of its patch a side).
+pub const MAX_SUBDIVIDE: u32 = 6;
+
+/// The split test's absolute floor, as a fraction of the scene's mean
+/// irradiance (emitted power over receiving area): dim corners do not split
+/// on differences far below what the image shows.
+pub const SPLIT_FLOOR: f32 = 1e-2;
+
+/// The convergence of a solution: after each recorded shot, the unshot
+/// power as a fraction of all emitted.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct ConvergencePoint {
+    pub shot: u32,
+    pub seconds: f64,
+    pub unshot_fraction: f64,
+}
+
+/// What a solution did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct RadiosityReport {
+    pub patches: usize,
+    /// Elements of live tiles at the end.
+    pub elements: usize,
+    pub element_resolution: u32,
+    /// Live tiles at the end, and splits made.
+    pub tiles: usize,
+    pub splits: usize,
+    /// Split tests (one occlusion query a tile) and the seconds they and the
+    /// splits' passes took.
+    pub split_tests: usize,
+    pub subdivision_seconds: f64,
+    /// True when a split found the atlas full (MAX_ATLAS_TEXELS).
+    pub atlas_full: bool,
+    /// The split test's absolute floor (SPLIT_FLOOR x the mean irradiance).
+    pub split_floor: f32,
+    pub shots: u32,
+    pub converged: bool,
+    pub unshot_fraction: f64,
+    pub seconds: f64,
+    pub convergence: Vec<ConvergencePoint>,
+}
+
+/// A shooter as the shoot pass reads it.
+#[derive(Clone, Debug)]
+struct Shooter {
+    position: Vec3,
+    point: bool,
+    normal: Vec3,
+    area: f32,
+    energy: Vec3,
+    /// The sub-element's outline (none for a point light).
+    outline: Vec<Vec3>,
+    /// The block's first texel in the atlas (its own elements).
+    block_base: [u32; 2],
+}
+
+/// The radiosity solution's textures and passes.
+pub struct Radiosity {
+    gpu: Gpu,
+    options: RadiosityOptions,
+    pub elements: Elements,
+    pub position: Texture,
+    pub normal: Texture,
+    albedo: Texture,
+    pub radiosity: Texture,
+    pub residual: Texture,
+    pub direct: Texture,
+    atlas_target: Target,
+    residual_target: Target,
+    /// The last shot's energy at each element (before `accumulate`).
+    pub shot: Texture,
+    shot_target: Target,
+    nodes: Texture,
+    patch_of: Texture,
+    patch_of_width: u32,
+    power: Texture,
+    power_target: Target,
+    pick: Texture,
+    pick_target: Target,
+    pub items: Texture,
+    items_target: Target,
+    shooters: Texture,
+    shooters_target: Target,
+    vertices: VertexBuffer,
+    far: f32,
+    queries: Vec<Query>,
+    programs: Programs,
+    pub indirect: Texture,
+    indirect_target: Target,
+    width: u32,
+    height: u32,
+}
+
+struct Programs {
+    power: Program,
+    select: Program,
+    shooters: Program,
+    items: Program,
+    shoot: Program,
+    accumulate: Program,
+    discontinuity: Program,
+    inherit: Program,
+    zero: Program,
+    lookup: Program,
+}
+
+/// A texture of `count` records of one i32 or RGBA32F, TILE_ROW a row.
+fn record_texture(gpu: &Gpu, count: usize, format: TexFormat) -> Result<Texture> {
+    let count = count.max(1) as u32;
+    Texture::new(gpu, count.min(TILE_ROW), count.div_ceil(TILE_ROW), format)
+}
+
+impl Radiosity {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        options: &RadiosityOptions,
+    ) -> Result<Self> {
+        options.check()?;
+        let max = gpu.max_texture_size();
+        let elements = Elements::new(scene, options.resolution, options.subdivide, max)?;
+        if elements.patches.is_empty() {
+            return Err(Error::InvalidOption(format!(
+                "{} has no diffuse surface: radiosity has nothing to solve",
+                scene.name
+            )));
+        }
+        // At least 3 x 3 item buffers: a point light shoots as six hemispheres.
+        let items_side = options.substructure.max(3) * options.item_buffer;
+        if items_side > max {
+            return Err(Error::TooLarge(format!(
+                "item buffers of {items_side} texels a side: this driver allows {max}; lower --item-buffer"
+            )));
+        }
+        let (w, h) = (elements.width, elements.height);
+        let flat = |v: &[[f32; 4]]| v.iter().flatten().copied().collect::<Vec<f32>>();
+        let upload = |v: &[[f32; 4]]| Texture::from_f32(gpu, w, h, TexFormat::Rgba32F, &flat(v));
+        let position = upload(&elements.position)?;
+        let normal = upload(&elements.normal)?;
+        let albedo = upload(&elements.albedo)?;
+        let radiosity = upload(&elements.emission)?;
+        let residual = upload(&elements.emission)?;
+        let direct = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
+        let atlas_target = Target::new(gpu, &[&radiosity, &residual, &direct])?;
+        atlas_target.clear([0.0; 4]);
+        // The clear above zeroed all three; radiosity and residual start at the emission.
+        radiosity.upload_f32(&flat(&elements.emission))?;
+        residual.upload_f32(&flat(&elements.emission))?;
+        let residual_target = Target::new(gpu, &[&residual])?;
+        let shot = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
+        let shot_target = Target::new(gpu, &[&shot])?;
+        shot_target.clear([0.0; 4]);
+        let nodes = record_texture(gpu, elements.node_capacity(), TexFormat::R32I)?;
+        let patch_of_width = (elements.patch_of.len() as u32).clamp(1, 4096);
+        let rows = (elements.patch_of.len() as u32)
+            .div_ceil(patch_of_width)
+            .max(1);
+        let mut ids = elements.patch_of.clone();
+        ids.resize((patch_of_width * rows) as usize, -1);
+        let patch_of = Texture::from_i32_format(gpu, patch_of_width, rows, TexFormat::R32I, &ids)?;
+        let power = record_texture(gpu, elements.capacity as usize, TexFormat::Rgba32F)?;
+        let power_target = Target::new(gpu, &[&power])?;
+        let pick = Texture::new(gpu, 1, 1, TexFormat::Rgba32F)?;
+        let pick_target = Target::with_stencil(gpu, &[&pick])?;
+        let items = Texture::new(gpu, items_side, items_side, TexFormat::Rgba32F)?;
+        let items_target = Target::with_stencil(gpu, &[&items])?;
+        let sub = options.substructure;
+        // A shot's shooter records, a row each: the first 3 texels drawn by
+        // `shooters`, read back, moved onto the surface and uploaded again
+        // with their outlines for `shoot`; as many rows as item buffers
+        // (point lights use 6).
+        let shooters = Texture::new(gpu, SHOOTER_TEXELS, sub.max(3).pow(2), TexFormat::Rgba32F)?;
+        let shooters_target = Target::new(gpu, &[&shooters])?;
+        let vertices = VertexBuffer::from_f32(gpu, &tessellate(scene), &[3, 1])?;
+        let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let p = |name: &str| Program::fullscreen(gpu, name);
+        let r = Self {
+            gpu: gpu.clone(),
+            options: options.clone(),
+            position,
+            normal,
+            albedo,
+            radiosity,
+            residual,
+            direct,
+            atlas_target,
+            residual_target,
+            shot,
+            shot_target,
+            nodes,
+            patch_of,
+            patch_of_width,
+            power,
+            power_target,
+            pick,
+            pick_target,
+            items,
+            items_target,
+            shooters,
+            shooters_target,
+            vertices,
+            far: 4.0 * scene.size(),
+            queries: Vec::new(),
+            programs: Programs {
+                power: p("radiosity/tile_power.frag")?,
+                select: Program::new(gpu, "radiosity/select.vert", "radiosity/select.frag", &[])?,
+                shooters: p("radiosity/shooters.frag")?,
+                items: Program::with_geometry(
+                    gpu,
+                    "radiosity/item_buffer.vert",
+                    "radiosity/item_buffer.geom",
+                    "radiosity/item_buffer.frag",
+                    &[],
+                )?,
+                shoot: p("radiosity/shoot.frag")?,
+                accumulate: p("radiosity/accumulate.frag")?,
+                discontinuity: p("radiosity/discontinuity.frag")?,
+                inherit: p("radiosity/inherit.frag")?,
+                zero: p("radiosity/zero.frag")?,
+                lookup: p("radiosity/lookup.frag")?,
+            },
+            indirect_target: Target::new(gpu, &[&indirect])?,
+            indirect,
+            elements,
+            width,
+            height,
+        };
+        r.upload_nodes()?;
+        Ok(r)
+    }
+
+    fn upload_nodes(&self) -> Result<()> {
+        let mut data = self.elements.encoded_nodes();
+        data.resize(self.nodes.texel_count(), -1);
+        self.nodes.upload(&data)
+    }
+
+    /// Solves to convergence or the shot limit, recording the unshot power
+    /// after each shot. Adds "radiosity solve" to `timings`.
+    pub fn solve(
+        &mut self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        timings: &mut Timings,
+        on_shot: &mut dyn FnMut(u32, f64),
+    ) -> Result<RadiosityReport> {
+        self.gpu.finish();
+        let t0 = std::time::Instant::now();
+        let mut report = RadiosityReport {
+            patches: self.elements.patches.len(),
+            element_resolution: self.options.resolution,
+            ..Default::default()
+        };
+        let point_power = point_light_power(scene);
+        let emitted = self
+            .tile_powers()?
+            .iter()
+            .map(|&p| f64::from(p))
+            .sum::<f64>();
+        let total = emitted + point_power;
+        if total <= 0.0 {
+            return Err(Error::InvalidOption(format!(
+                "{}: no light reaches a patch; radiosity has nothing to shoot",
+                scene.name
+            )));
+        }
+        let floor = SPLIT_FLOOR * (total / self.receiving_area()) as f32;
+        report.split_floor = floor;
+        // Point lights first, each as six hemispheres about the axes.
+        for light in &scene.lights {
+            if let Light::Point {
+                position,
+                intensity,
+            } = *light
+            {
+                let hemisphere = |normal: Vec3| Shooter {
+                    position,
+                    point: true,
+                    normal,
+                    area: 0.0,
+                    energy: intensity,
+                    outline: Vec::new(),
+                    block_base: [0; 2],
+                };
+                let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+                self.shoot(
+                    scene,
+                    textures,
+                    &axes.map(hemisphere),
+                    true,
+                    floor,
+                    &mut report,
+                )?;
+            }
+        }
+        let threshold = (f64::from(self.options.convergence) * total) as f32;
+        let occlusion = Query::occlusion(&self.gpu)?;
+        let mut unshot = self
+            .tile_powers()?
+            .iter()
+            .map(|&p| f64::from(p))
+            .sum::<f64>();
+        report.convergence.push(ConvergencePoint {
+            shot: 0,
+            seconds: t0.elapsed().as_secs_f64(),
+            unshot_fraction: unshot / total,
+        });
+        while report.shots < self.options.max_shots {
+            crate::interrupt::check()?;
+            let Some(tile) = self.select(threshold, &occlusion)? else {
+                report.converged = true;
+                break;
+            };
+            let shooters = self.sub_shooters(scene, tile)?;
+            let light = self.elements.patches[self.elements.tiles[tile].patch as usize].emitter;
+            // Zeroed before the shot: a curved patch (the inside of a
+            // sphere) receives some of its own light.
+            self.zero_region(&self.residual_target, tile)?;
+            self.shoot(scene, textures, &shooters, light, floor, &mut report)?;
+            report.shots += 1;
+            unshot = self.tile_powers()?.iter().map(|&p| f64::from(p)).sum();
+            self.gpu.finish();
+            report.convergence.push(ConvergencePoint {
+                shot: report.shots,
+                seconds: t0.elapsed().as_secs_f64(),
+                unshot_fraction: unshot / total,
+            });
+            on_shot(report.shots, unshot / total);
+        }
+        self.gpu.finish();
+        self.gpu.check("radiosity solve")?;
+        report.unshot_fraction = unshot / total;
+        report.seconds = t0.elapsed().as_secs_f64();
+        report.elements = self.elements.elements;
+        report.tiles = self.elements.tiles.iter().filter(|t| t.alive).count();
+        timings.add_both(
+            "radiosity solve",
+            0.0,
+            report.seconds,
+            report.shots as usize * 5,
+        );
+        Ok(report)
+    }
+
+    /// The area of every live receiving element (diffuse, either side).
+    fn receiving_area(&self) -> f64 {
+        let e = &self.elements;
+        e.position
+            .iter()
+            .zip(&e.albedo)
+            .filter(|(p, a)| p[3] > 0.0 && a[..3] != [0.0; 3])
+            .map(|(p, _)| f64::from(p[3]))
+            .sum::<f64>()
+            .max(f64::MIN_POSITIVE)
+    }
+
+    /// Each tile's residual power (read back).
+    fn tile_powers(&self) -> Result<Vec<f32>> {
+        self.gpu.texture_barrier();
+        let tiles = self.elements.tiles.len();
+        self.programs
+            .power
+            .bind()
+            .texture("u_residual", &self.residual)
+            .texture("u_element_position", &self.position)
+            .int("u_tiles", tiles as i32)
+            .int("u_res", self.elements.res as i32)
+            .int("u_tile_columns", self.elements.tile_columns as i32)
+            .draw_fullscreen(&self.power_target, &DrawState::PLAIN)?;
+        let all = self.power.read_f32();
+        Ok((0..tiles).map(|p| all[4 * p]).collect())
+    }
+
+    /// The chapter's z-buffer sort over the tile powers last drawn: the
+    /// tile of most power, or None when none reaches `threshold`.
+    fn select(&self, threshold: f32, occlusion: &Query) -> Result<Option<usize>> {
+        self.pick_target.clear([-1.0; 4]);
+        self.pick_target.clear_depth_stencil(1.0, 0);
+        let state = DrawState {
+            depth: DepthTest::On {
+                compare: Compare::Less,
+                write: true,
+            },
+            ..DrawState::PLAIN
+        };
+        occlusion.begin();
+        let drawn = self
+            .programs
+            .select
+            .bind()
+            .texture("u_power", &self.power)
+            .float("u_threshold", threshold)
+            .draw_points(
+                &self.pick_target,
+                &state,
+                0,
+                self.elements.tiles.len() as i32,
+            );
+        occlusion.end();
+        drawn?;
+        if occlusion.count() == 0 {
+            return Ok(None);
+        }
+        let id = self.pick.read_f32()[0];
+        Ok((id >= 0.0).then_some(id as usize))
+    }
+
+    /// The tile's S x S sub-elements as shooters (read back: their frames
+    /// set the item buffers' uniforms), each moved onto the surface, with
+    /// its outline.
+    fn sub_shooters(&self, scene: &Scene, tile: usize) -> Result<Vec<Shooter>> {
+        let t = self.elements.tiles[tile];
+        let g = &scene.shapes[self.elements.patches[t.patch as usize].primitive].geometry;
+        let (res, sub) = (self.elements.res, self.options.substructure);
+        let block = res / sub;
+        let base = self.elements.tile_base(tile);
+        self.gpu.texture_barrier();
+        self.programs
+            .shooters
+            .bind()
+            .texture("u_residual", &self.residual)
+            .texture("u_element_position", &self.position)
+            .texture("u_element_normal", &self.normal)
+            .int("u_tile", tile as i32)
+            .int("u_res", self.elements.res as i32)
+            .int("u_tile_columns", self.elements.tile_columns as i32)
+            .int("u_sub", self.options.substructure as i32)
+            .draw_region(
+                &self.shooters_target,
+                &DrawState::PLAIN,
+                [0, 0, 3, (self.options.substructure.pow(2)) as i32],
+            )?;
+        let data = self.shooters.read_f32();
+        let rows = self.options.substructure.pow(2) as usize;
+        let stride = 4 * SHOOTER_TEXELS as usize;
+        Ok(data[..stride * rows]
+            .chunks(stride)
+            .enumerate()
+            .filter(|(_, r)| r[7] > 0.0)
+            .map(|(k, r)| {
+                let (i0, j0) = (
+                    t.origin[0] + (k as u32 % sub) * block,
+                    t.origin[1] + (k as u32 / sub) * block,
+                );
+                Shooter {
+                    position: onto_surface(
+                        g,
+                        Vec3::new(r[0], r[1], r[2]),
+                        Vec3::new(r[4], r[5], r[6]),
+                    ),
+                    point: false,
+                    normal: Vec3::new(r[4], r[5], r[6]),
+                    area: r[7],
+                    energy: Vec3::new(r[8], r[9], r[10]),
+                    outline: block_outline(g, [i0, j0, i0 + block, j0 + block], res << t.depth),
+                    block_base: [
+                        base.0 + (k as u32 % sub) * block,
+                        base.1 + (k as u32 / sub) * block,
+                    ],
+                }
+            })
+            .collect())
+    }
+
+    /// One shot: the shooters' item buffers, their energy at every element
+    /// (into `shot`), the tiles it makes uneven split and shot again, then
+    /// the shot added into radiosity, residual (and direct, from lights).
+    fn shoot(
+        &mut self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        shooters: &[Shooter],
+        lights: bool,
+        floor: f32,
+        report: &mut RadiosityReport,
+    ) -> Result<()> {
+        self.item_buffers(textures, shooters)?;
+        let e = &self.elements;
+        self.shot_pass(shooters.len(), [0, 0, e.width as i32, e.rows_used() as i32])?;
+        if self.options.subdivide > 0 {
+            let t0 = std::time::Instant::now();
+            self.refine(scene, shooters.len(), floor, report)?;
+            self.gpu.finish();
+            report.subdivision_seconds += t0.elapsed().as_secs_f64();
+        }
+        self.gpu.texture_barrier();
+        let e = &self.elements;
+        self.programs
+            .accumulate
+            .bind()
+            .texture("u_shot", &self.shot)
+            .texture("u_element_position", &self.position)
+            .int("u_lights", i32::from(lights))
+            .draw_region(
+                &self.atlas_target,
+                &DrawState::ADDITIVE,
+                [0, 0, e.width as i32, e.rows_used() as i32],
+            )?;
+        // Added: the split test (`discontinuities`) reads radiosity + shot.
+        self.shot_target.clear([0.0; 4]);
+        self.gpu.check("radiosity shot")
+    }
+
+    /// Draws each shooter's item buffer and uploads the shooter records.
+    fn item_buffers(&self, textures: &SceneTextures, shooters: &[Shooter]) -> Result<()> {
+        let n = self.options.item_buffer;
+        let columns = self.options.substructure.max(3);
+        debug_assert!(shooters.len() as u32 <= columns * columns);
+        // -2: no fragment (a rim texel); -1: a blocker that is no patch.
+        self.items_target.clear([-2.0, 0.0, 0.0, 1.0]);
+        self.items_target.clear_depth_stencil(1.0, 0);
+        let state = DrawState {
+            depth: DepthTest::On {
+                compare: Compare::Less,
+                write: true,
+            },
+            ..DrawState::PLAIN
+        };
+        for (k, s) in shooters.iter().enumerate() {
+            let (t, b) = crate::sampling::basis_around(s.normal);
+            let k = k as u32;
+            let viewport = [
+                ((k % columns) * n) as i32,
+                ((k / columns) * n) as i32,
+                n as i32,
+                n as i32,
+            ];
+            let mut bind = self.programs.items.bind();
+            textures.bind(&mut bind);
+            bind.texture("u_patch_of", &self.patch_of)
+                .int("u_patch_of_width", self.patch_of_width as i32)
+                .vec3("u_origin", s.position.to_array())
+                .vec3("u_tangent", t.to_array())
+                .vec3("u_bitangent", b.to_array())
+                .vec3("u_normal", s.normal.to_array())
+                .float("u_far", self.far)
+                .float("u_near", self.far * 1e-6)
+                .draw_triangles(&self.items_target, &state, viewport, &self.vertices)?;
+        }
+        let row = 4 * SHOOTER_TEXELS as usize;
+        let mut data = vec![0f32; row * (columns * columns) as usize];
+        for (k, s) in shooters.iter().enumerate() {
+            data[row * k..row * k + 12].copy_from_slice(&[
+                s.position.x,
+                s.position.y,
+                s.position.z,
+                f32::from(u8::from(s.point)),
+                s.normal.x,
+                s.normal.y,
+                s.normal.z,
+                s.area,
+                s.energy.x,
+                s.energy.y,
+                s.energy.z,
+                s.outline.len() as f32,
+            ]);
+            debug_assert!(s.outline.len() <= SHOOTER_OUTLINE as usize);
+            for (v, p) in s.outline.iter().enumerate() {
+                let at = row * k + 12 + 4 * v;
+                let w = match v {
+                    0 => s.block_base[0] as f32,
+                    1 => s.block_base[1] as f32,
+                    _ => 0.0,
+                };
+                data[at..at + 4].copy_from_slice(&[p.x, p.y, p.z, w]);
+            }
+        }
+        self.shooters.upload_f32(&data)
+    }
+
+    /// The shot of the shooters last uploaded, at the elements of `region`.
+    fn shot_pass(&self, shooters: usize, region: [i32; 4]) -> Result<()> {
+        self.programs
+            .shoot
+            .bind()
+            .texture("u_element_position", &self.position)
+            .texture("u_element_normal", &self.normal)
+            .texture("u_element_albedo", &self.albedo)
+            .texture("u_shooters", &self.shooters)
+            .int("u_shooter_count", shooters as i32)
+            .texture("u_item_buffers", &self.items)
+            .int("u_item_size", self.options.item_buffer as i32)
+            .int("u_item_columns", self.options.substructure.max(3) as i32)
+            .int(
+                "u_polygon",
+                i32::from(self.options.form_factor == FormFactor::Polygon),
+            )
+            .int(
+                "u_block",
+                (self.options.resolution / self.options.substructure) as i32,
+            )
+            .draw_region(&self.shot_target, &DrawState::PLAIN, region)
+    }
+
+    /// Adaptive subdivision after a shot: split test, split, inherit, shoot
+    /// again at the children, and test them in turn.
+    fn refine(
+        &mut self,
+        scene: &Scene,
+        shooters: usize,
+        floor: f32,
+        report: &mut RadiosityReport,
+    ) -> Result<()> {
+        let max_depth = self.options.subdivide;
+        let e = &self.elements;
+        let mut candidates: Vec<usize> = (0..e.tiles.len())
+            .filter(|&t| {
+                let tile = e.tiles[t];
+                tile.alive && tile.depth < max_depth && !e.patches[tile.patch as usize].emitter
+            })
+            .collect();
+        while !candidates.is_empty() && !report.atlas_full {
+            let counts = self.discontinuities(&candidates, floor)?;
+            report.split_tests += candidates.len();
+            let mut split = Vec::new();
+            for (&t, &count) in candidates.iter().zip(&counts) {
+                if count <= u64::from(self.elements.res / 2) {
+                    continue;
+                }
+                match self.elements.split(scene, t) {
+                    Some(children) => split.push((t, children)),
+                    None => {
+                        report.atlas_full = true;
+                        break;
+                    }
+                }
+            }
+            report.splits += split.len();
+            for (parent, children) in &split {
+                self.adopt(*parent, children)?;
+            }
+            self.upload_nodes()?;
+            self.gpu.texture_barrier();
+            candidates = Vec::new();
+            for (_, children) in &split {
+                for &c in children {
+                    self.shot_pass(shooters, self.elements.tile_region(c))?;
+                    if self.elements.tiles[c].depth < max_depth {
+                        candidates.push(c);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The split test's fragment count for each tile (an occlusion query a tile).
+    pub fn discontinuities(&mut self, tiles: &[usize], floor: f32) -> Result<Vec<u64>> {
+        while self.queries.len() < tiles.len() {
+            self.queries.push(Query::occlusion(&self.gpu)?);
+        }
+        self.gpu.texture_barrier();
+        let state = DrawState {
+            color_writes: false,
+            ..DrawState::PLAIN
+        };
+        for (&t, q) in tiles.iter().zip(&self.queries) {
+            let (x, y) = self.elements.tile_base(t);
+            q.begin();
+            let drawn = self
+                .programs
+                .discontinuity
+                .bind()
+                .texture("u_radiosity", &self.radiosity)
+                .texture("u_shot", &self.shot)
+                .texture("u_element_position", &self.position)
+                .ivec2("u_tile_base", [x as i32, y as i32])
+                .int("u_res", self.elements.res as i32)
+                .float("u_gradient", self.options.gradient)
+                .float("u_floor", floor)
+                .draw_region(&self.residual_target, &state, self.elements.tile_region(t));
+            q.end();
+            drawn?;
+        }
+        Ok(self.queries[..tiles.len()]
+            .iter()
+            .map(Query::count)
+            .collect())
+    }
+
+    /// A split's records on the GPU: the children's elements and their
+    /// inherited radiosity, residual and direct part; the parent retired.
+    fn adopt(&self, parent: usize, children: &[usize]) -> Result<()> {
+        let e = &self.elements;
+        let upload = |t: usize| -> Result<()> {
+            let (x, y) = e.tile_base(t);
+            let region = [x, y, e.res, e.res];
+            self.position
+                .upload_region(region, &e.tile_records(t, &e.position))?;
+            self.normal
+                .upload_region(region, &e.tile_records(t, &e.normal))?;
+            self.albedo
+                .upload_region(region, &e.tile_records(t, &e.albedo))
+        };
+        let (px, py) = e.tile_base(parent);
+        let parent_tile = e.tiles[parent];
+        self.gpu.texture_barrier();
+        for &c in children {
+            upload(c)?;
+            let tile = e.tiles[c];
+            let (cx, cy) = e.tile_base(c);
+            let quadrant = [
+                (tile.origin[0] - 2 * parent_tile.origin[0]) / e.res,
+                (tile.origin[1] - 2 * parent_tile.origin[1]) / e.res,
+            ];
+            self.programs
+                .inherit
+                .bind()
+                .texture("u_radiosity", &self.radiosity)
+                .texture("u_residual", &self.residual)
+                .texture("u_direct", &self.direct)
+                .ivec2("u_child_base", [cx as i32, cy as i32])
+                .ivec2("u_parent_base", [px as i32, py as i32])
+                .ivec2("u_quadrant", [quadrant[0] as i32, quadrant[1] as i32])
+                .int("u_res", e.res as i32)
+                .draw_region(&self.atlas_target, &DrawState::PLAIN, e.tile_region(c))?;
+        }
+        self.gpu.texture_barrier();
+        self.zero_region(&self.atlas_target, parent)?;
+        upload(parent)
+    }
+
+    /// Zero over tile t's region of `target`'s textures.
+    fn zero_region(&self, target: &Target, tile: usize) -> Result<()> {
+        self.programs.zero.bind().draw_region(
+            target,
+            &DrawState::PLAIN,
+            self.elements.tile_region(tile),
+        )
+    }
+
+    /// The indirect light at `direct`'s first hits, left in `indirect`.
+    pub fn run(
+        &self,
+        textures: &SceneTextures,
+        direct: &DirectLight,
+        timings: &mut Timings,
+    ) -> Result<()> {
+        self.gpu.finish();
+        let t0 = std::time::Instant::now();
+        let mut b = self.programs.lookup.bind();
+        textures.bind(&mut b);
+        b.texture("u_diffuse_position", &direct.diffuse_position)
+            .texture("u_diffuse_normal", &direct.diffuse_normal)
+            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
+            .texture("u_radiosity", &self.radiosity)
+            .texture("u_direct", &self.direct)
+            .texture("u_element_position", &self.position)
+            .texture("u_patch_of", &self.patch_of)
+            .int("u_patch_of_width", self.patch_of_width as i32)
+            .texture("u_nodes", &self.nodes)
+            .int("u_res", self.elements.res as i32)
+            .int("u_tile_columns", self.elements.tile_columns as i32)
+            .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
+        drop(b);
+        self.gpu.finish();
+        timings.add_both("radiosity lookup", 0.0, t0.elapsed().as_secs_f64(), 1);
+        self.gpu.check("radiosity lookup")
+    }
+
+    pub fn read_indirect(&self) -> Image {
+        Image::from_gl_rgba(self.width, self.height, &self.indirect.read_f32())
+    }
+}
+
+/// The power of the scene's point lights, 4 pi I (luminance).
+fn point_light_power(scene: &Scene) -> f64 {
+    scene
+        .lights
+        .iter()
+        .map(|l| match *l {
+            Light::Point { intensity, .. } => {
+                4.0 * std::f64::consts::PI
+                    * f64::from(intensity.dot(Vec3::from(crate::layout::LUMINANCE)))
+            }
+            _ => 0.0,
+        })
+        .sum()
+}
