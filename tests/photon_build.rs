@@ -7,7 +7,9 @@ mod common;
 use common::Rng;
 
 use photonmap::gpu::{Gpu, TexFormat, Texture};
-use photonmap::photon::bitonic::{pass_count, sort_texture_size, BitonicBuild, INVALID_KEY};
+use photonmap::photon::bitonic::{
+    fused_plan, pass_count, sort_texture_size, BitonicBuild, INVALID_KEY,
+};
 use photonmap::photon::{Grid, GridStorage, StencilRouting, VertexFeed};
 use photonmap::reference::photon::route;
 use photonmap::render::Timings;
@@ -39,10 +41,13 @@ fn sort_on_gpu(
     )
 }
 
+/// Both sorts, the faithful passes (one a step) and the fused ones (two
+/// long steps a pass, the short ones in registers), give the CPU's order.
 #[test]
 fn bitonic_sort_equals_a_cpu_sort_for_every_power_of_two_to_2_pow_16() {
     let gpu = common::gpu();
-    let build = BitonicBuild::new(&gpu).unwrap();
+    let faithful = BitonicBuild::new(&gpu).unwrap().fusing(false);
+    let fused = BitonicBuild::new(&gpu).unwrap().fusing(true);
     let mut rng = Rng(0xC0FFEE);
     for k in 1..=16u32 {
         let n = 1usize << k;
@@ -75,17 +80,24 @@ fn bitonic_sort_equals_a_cpu_sort_for_every_power_of_two_to_2_pow_16() {
             } else {
                 TexFormat::Rgba32I
             };
-            let (gpu_sorted, passes) = sort_on_gpu(&gpu, &build, &keys, format);
             let mut cpu: Vec<(i32, i32)> = keys
                 .iter()
                 .enumerate()
                 .map(|(i, &k)| (k, i as i32))
                 .collect();
             cpu.sort();
+            let (gpu_sorted, passes) = sort_on_gpu(&gpu, &faithful, &keys, format);
             assert_eq!(passes, pass_count(n as u64), "n = {n}");
             assert_eq!(
                 gpu_sorted, cpu,
                 "n = {n}, {name}: GPU order differs from the CPU sort"
+            );
+            let (fused_sorted, fused_passes) = sort_on_gpu(&gpu, &fused, &keys, format);
+            let width = sort_texture_size(n as u64).0;
+            assert_eq!(fused_passes as usize, fused_plan(n as u64, width).len());
+            assert_eq!(
+                fused_sorted, cpu,
+                "n = {n}, {name}: the fused sort's order differs from the CPU sort"
             );
         }
     }
@@ -94,6 +106,10 @@ fn bitonic_sort_equals_a_cpu_sort_for_every_power_of_two_to_2_pow_16() {
         210,
         "the paper's 210 passes for 1024 x 1024"
     );
+    // One local pass (blocks of SORT_BLOCK = 2), then for stages 4..2^20
+    // the long steps two a pass and one local pass each:
+    // 1 + sum over s = 2..20 of ceil((s - 1) / 2) + 1.
+    assert_eq!(fused_plan(1 << 20, 1024).len(), 120);
 }
 
 #[test]

@@ -258,4 +258,21 @@ pub fn print_build_bench(b: &BuildBench) {
             r.stencil_readback_seconds * 1e3
         );
     }
+    println!("fused sort (two long steps a pass, short steps in registers; the same order):");
+    println!(
+        "{:>9} {:>6} {:>10} {:>9} {:>6} {:>14} {:>12}",
+        "photons", "passes", "sort ms", "pass ms", "ratio", "copy passes", "/ faithful"
+    );
+    for r in &b.rows {
+        println!(
+            "{:>9} {:>6} {:>10.2} {:>9.3} {:>6.2} {:>14.1} {:>12.2}",
+            r.photons,
+            r.fused_passes,
+            r.fused_sort_seconds * 1e3,
+            r.fused_seconds_per_pass * 1e3,
+            r.fused_pass_to_copy_ratio,
+            r.fused_sort_in_copy_passes,
+            r.fused_to_faithful
+        );
+    }
 }

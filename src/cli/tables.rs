@@ -25,9 +25,19 @@ pub struct TablesArgs {
     /// A reduced run for CI: quarter resolution, one run, fewer sizes and modes.
     #[arg(long)]
     pub quick: bool,
-    /// The paper's 2003 constraints (random-number texture, read-back, no compaction).
+    /// The paper's 2003 constraints: a random-number texture, read-back
+    /// before routing, float addressing, no compaction, the faithful sort
+    /// passes, no projection maps, and stencil routing's m = 16.
     #[arg(long)]
     pub faithful: bool,
+    /// Stencil routing's m, each cell holding m x m photons (1..=16; default
+    /// 4, or 16 with --faithful).
+    #[arg(long, value_name = "M", value_parser = super::args::in_range(1, 16))]
+    pub stencil_m: Option<u32>,
+    /// Table 1 and figure 7 only (no section 3.3, pass counts, figure 8 or
+    /// Table 2).
+    #[arg(long)]
+    pub table1_only: bool,
     /// Runs per Table 1 cell, median and spread quoted (1..=20).
     #[arg(long, default_value_t = 3, value_parser = super::args::in_range(1, 20))]
     pub runs: u32,
@@ -123,6 +133,8 @@ pub struct TablesReport {
     pub cores: usize,
     pub quick: bool,
     pub faithful: bool,
+    pub stencil_m: u32,
+    pub table1_only: bool,
     pub image_scale: String,
     pub runs: u32,
     pub command: String,
@@ -131,7 +143,7 @@ pub struct TablesReport {
     pub convergence: Vec<ConvergenceRow>,
     pub passes: Vec<BuildBenchRow>,
     pub figure7: String,
-    pub figure8: Figure8,
+    pub figure8: Option<Figure8>,
     pub table2: Result<Vec<KernelCount>, String>,
 }
 
@@ -169,7 +181,7 @@ fn options(
     scene: &Scene,
     scale: u32,
     build: BuildMethod,
-    faithful: bool,
+    (faithful, stencil_m): (bool, u32),
     mode: EstimateMode,
 ) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
@@ -179,6 +191,9 @@ fn options(
         photons: PhotonConfig {
             build,
             faithful,
+            stencil_block: stencil_m,
+            // The paper aims no photons: it emits them all from the light.
+            projection_maps: !faithful,
             ..PhotonConfig::default()
         },
         ..GlobalIllumination::default()
@@ -486,16 +501,29 @@ pub fn run_tables(
         .out
         .clone()
         .unwrap_or_else(|| default_out(&caps.gl_renderer));
-    for dir in ["figure7", "figure8"] {
+    if o.table1_only && o.out.is_none() {
+        anyhow::bail!(
+            "--table1-only needs --out: Table 1 alone would replace the full run's tables.md in {}",
+            out.display()
+        );
+    }
+    let dirs: &[&str] = if o.table1_only {
+        &["figure7"]
+    } else {
+        &["figure7", "figure8"]
+    };
+    for dir in dirs {
         std::fs::create_dir_all(out.join(dir))
             .with_context(|| format!("creating {}", out.display()))?;
     }
+    let stencil_m = o.stencil_m.unwrap_or(if o.faithful { 16 } else { 4 });
     let run = TablesRun {
         gpu,
         scale: if o.quick { 4 } else { 1 },
         runs: if o.quick { 1 } else { o.runs },
         quick: o.quick,
         faithful: o.faithful,
+        stencil_m,
         out: &out,
         progress,
         staged: Staged::default(),
@@ -503,20 +531,24 @@ pub fn run_tables(
     let (table1, totals, figure7_rows) = run.table1()?;
     run.staged
         .png(out.join("figure7.png"), &montage(&figure7_rows))?;
-    let convergence = run.section_3_3()?;
-    let mut passes = Vec::new();
-    for k in 10..=(if o.quick { 12 } else { 20 }) {
-        progress(&format!("Passes: n = 2^{k}"));
-        passes.push(bench_size(gpu, 1 << k, &paper_grid(), 4)?);
+    let (mut convergence, mut passes, mut figure8) = (Vec::new(), Vec::new(), None);
+    if !o.table1_only {
+        convergence = run.section_3_3()?;
+        for k in 10..=(if o.quick { 12 } else { 20 }) {
+            progress(&format!("Passes: n = 2^{k}"));
+            passes.push(bench_size(gpu, 1 << k, &paper_grid(), stencil_m)?);
+        }
+        figure8 = Some(run.figure8()?);
+        progress("Table 2: SPIR-V instruction counts");
     }
-    let figure8 = run.figure8()?;
-    progress("Table 2: SPIR-V instruction counts");
     let report = TablesReport {
         renderer: caps.gl_renderer,
         gl_version: caps.gl_version,
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
         quick: o.quick,
         faithful: o.faithful,
+        stencil_m,
+        table1_only: o.table1_only,
         image_scale: if o.quick {
             "1/4 of the paper's resolution".into()
         } else {
@@ -524,9 +556,12 @@ pub fn run_tables(
         },
         runs: run.runs,
         command: format!(
-            "photonmap tables{}{}",
+            "photonmap tables{}{}{}{}",
             if o.quick { " --quick" } else { "" },
-            if o.faithful { " --faithful" } else { "" }
+            if o.faithful { " --faithful" } else { "" },
+            o.stencil_m
+                .map_or(String::new(), |m| format!(" --stencil-m {m}")),
+            if o.table1_only { " --table1-only" } else { "" }
         ),
         table1,
         totals,
@@ -534,7 +569,11 @@ pub fn run_tables(
         passes,
         figure7: "figure7.png".into(),
         figure8,
-        table2: table2(),
+        table2: if o.table1_only {
+            Err("not run (--table1-only)".into())
+        } else {
+            table2()
+        },
     };
     let staged = run.staged;
     staged.add(
@@ -554,6 +593,7 @@ struct TablesRun<'a> {
     runs: u32,
     quick: bool,
     faithful: bool,
+    stencil_m: u32,
     out: &'a Path,
     progress: &'a dyn Fn(&str),
     staged: Staged,
@@ -563,7 +603,13 @@ type Table1 = (Vec<Table1Cell>, Vec<Table1Total>, Vec<Vec<Image>>);
 
 impl TablesRun<'_> {
     fn options(&self, scene: &Scene, build: BuildMethod, mode: EstimateMode) -> RenderOptions {
-        options(scene, self.scale, build, self.faithful, mode)
+        options(
+            scene,
+            self.scale,
+            build,
+            (self.faithful, self.stencil_m),
+            mode,
+        )
     }
 
     /// Table 1 (and figure 7's images from the first run of each).
@@ -836,6 +882,19 @@ pub fn markdown(r: &TablesReport) -> String {
     }
     s +=
         "\n▲ marks a cell above the paper's figure, or a total above a quarter of the paper's.\n\n";
+    s += &format!(
+        "Stencil routing: m = {}{}.\n\n",
+        r.stencil_m,
+        if r.faithful {
+            "; the paper's 2003 constraints (--faithful): a random-number texture, read-back before routing, float addressing, no compaction, the faithful sort passes, no projection maps"
+        } else {
+            ""
+        }
+    );
+    if r.table1_only {
+        s += "## Figure 7: bitonic, stencil routing, software (kd-tree), per scene\n\n![figure 7](figure7.png)\n";
+        return s;
+    }
     s += "## Section 3.3: full convergence of the radiance estimate by drawing mode (seconds)\n\nPaper: CORNELL BOX 104 s full screen, 52.4 s with 16 x 16 tiles; GLASS BALL 102 s and 14.9 s.\n\n| scene | mode | seconds | passes | tile draws |\n|---|---|---|---|---|\n";
     for c in &r.convergence {
         s += &format!(
@@ -859,12 +918,15 @@ pub fn markdown(r: &TablesReport) -> String {
         );
     }
     s += "\n## Figure 7: bitonic, stencil routing, software (kd-tree), per scene\n\n![figure 7](figure7.png)\n\n";
+    let Some(figure8) = &r.figure8 else {
+        return s;
+    };
     s += &format!(
         "## Figure 8: the GLASS BALL caustic during convergence\n\n![figure 8](figure8.png)\n\nSnapshots at {} s (the last is the final image). Full convergence {:.2} s; visually converged at {:.2} s ({}). Paper: about 4 s of 14.9 s.\n\n",
-        r.figure8.snapshots.iter().map(|s| format!("{:.2}", s.1)).collect::<Vec<_>>().join(", "),
-        r.figure8.full_convergence_seconds,
-        r.figure8.visual_convergence_seconds,
-        r.figure8.criterion
+        figure8.snapshots.iter().map(|s| format!("{:.2}", s.1)).collect::<Vec<_>>().join(", "),
+        figure8.full_convergence_seconds,
+        figure8.visual_convergence_seconds,
+        figure8.criterion
     );
     s += "## Table 2 analogue: instructions per kernel\n\nStatic counts of the whole kernel (a loop body once) in SPIR-V from `glslangValidator -G -Os`, not the driver's own code; *Addr* counts integer and conversion operations; *Pack* is 0 because every output has its own render target. The paper's Cg counts (one iteration) in brackets.\n\n";
     match &r.table2 {

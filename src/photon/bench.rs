@@ -1,5 +1,6 @@
-//! `photonmap bench build`: both photon-map builds on n = 2^k synthetic photons,
-//! beside a plain copy pass over the same texture (the bandwidth bound).
+//! `photonmap bench build`: both photon-map builds on n = 2^k synthetic photons
+//! (the bitonic sort's faithful passes and its fused ones), beside a plain
+//! copy pass over the same texture (the bandwidth bound).
 
 use glam::Vec3;
 
@@ -21,6 +22,15 @@ pub struct BuildBenchRow {
     pub copy_pass_wall_seconds: f64,
     /// bitonic_seconds_per_pass / copy_pass_seconds (target: <= 1.5)
     pub pass_to_copy_ratio: f64,
+    /// The fused sort (`fused_plan`): its passes, GPU seconds, seconds per
+    /// pass, that against a copy pass, its time in copy passes (the faithful
+    /// sort's is passes x ratio), and its time over the faithful sort's.
+    pub fused_passes: u32,
+    pub fused_sort_seconds: f64,
+    pub fused_seconds_per_pass: f64,
+    pub fused_pass_to_copy_ratio: f64,
+    pub fused_sort_in_copy_passes: f64,
+    pub fused_to_faithful: f64,
     pub keys_seconds: f64,
     pub binary_search_seconds: f64,
     pub gather_seconds: f64,
@@ -62,7 +72,8 @@ fn stage(t: &Timings, name: &str) -> f64 {
 /// Benchmarks one size. `grid` is the paper's ~40^3 cells; `block` is m.
 pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBenchRow> {
     let frames = synthetic_frames(gpu, n, 0x5eed)?;
-    let bitonic = BitonicBuild::new(gpu)?;
+    let bitonic = BitonicBuild::new(gpu)?.fusing(false);
+    let fused = BitonicBuild::new(gpu)?.fusing(true);
     let routing = StencilRouting::new(gpu)?;
     // Warm-up: compile, first-touch allocation.
     bitonic.build(&frames, grid, &mut Timings::default())?;
@@ -133,6 +144,15 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     };
     let readback_wall = stage(&readback, "read-back (wall)");
     let per_pass = sort.gpu_seconds / sort.passes.max(1) as f64;
+    fused.build(&frames, grid, &mut Timings::default())?;
+    let mut tf = Timings::default();
+    fused.build(&frames, grid, &mut tf)?;
+    let fused_sort = tf
+        .stages
+        .iter()
+        .find(|s| s.name == "bitonic sort")
+        .cloned()
+        .unwrap_or_default();
     Ok(BuildBenchRow {
         photons: n,
         bitonic_passes: sort.passes as u32,
@@ -142,6 +162,14 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
         bitonic_sort_wall_seconds: sort_wall * sort.passes as f64 / passes.max(1) as f64,
         copy_pass_wall_seconds: copy_wall,
         pass_to_copy_ratio: per_pass / copy_pass,
+        fused_passes: fused_sort.passes as u32,
+        fused_sort_seconds: fused_sort.gpu_seconds,
+        fused_seconds_per_pass: fused_sort.gpu_seconds / fused_sort.passes.max(1) as f64,
+        fused_pass_to_copy_ratio: fused_sort.gpu_seconds
+            / fused_sort.passes.max(1) as f64
+            / copy_pass,
+        fused_sort_in_copy_passes: fused_sort.gpu_seconds / copy_pass,
+        fused_to_faithful: fused_sort.gpu_seconds / sort.gpu_seconds,
         keys_seconds: stage(&t, "keys"),
         binary_search_seconds: stage(&t, "binary search"),
         gather_seconds: stage(&t, "gather"),

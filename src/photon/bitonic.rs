@@ -1,5 +1,6 @@
 //! Build A (section 2.2.1): a (cell, record) key per photon record, bitonic
-//! merge sort as log2(n)(log2(n)+1)/2 fragment passes over a 2D texture, one
+//! merge sort as log2(n)(log2(n)+1)/2 fragment passes over a 2D texture (or
+//! the fused sort's fewer, heavier passes with the same result), one
 //! binary-search pass that writes each grid cell's first photon, and a gather
 //! of the photon records into sorted order.
 
@@ -40,8 +41,68 @@ pub fn pass_count(n: u64) -> u32 {
     k * (k + 1) / 2
 }
 
+/// One pass of the fused sort (`fused_plan`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SortPass {
+    /// One step: stage k, distance j (the faithful pass).
+    Step { stage: u64, distance: u64 },
+    /// Two steps: distances j and j / 2 of stage k (`bitonic_pair.frag`).
+    Pair { stage: u64, distance: u64 },
+    /// Every step below SORT_BLOCK of stages first..=last (`bitonic_local.frag`).
+    Local { first: u64, last: u64 },
+}
+
+/// The fused sort's passes for n = 2^k pairs in a texture `width` wide: one
+/// local pass sorting every block of SORT_BLOCK, then for each later stage
+/// its long steps two a pass (one alone when their count is odd) and one
+/// local pass for its short ones. The faithful passes where the texture is
+/// narrower than a block. Each pass's result is the faithful steps' it
+/// stands for, so the sorted pairs are the same.
+pub fn fused_plan(n: u64, width: u32) -> Vec<SortPass> {
+    let block = u64::from(crate::layout::SORT_BLOCK);
+    let mut plan = Vec::new();
+    if u64::from(width) < block || n < block {
+        let mut stage = 2;
+        while stage <= n {
+            let mut distance = stage / 2;
+            while distance >= 1 {
+                plan.push(SortPass::Step { stage, distance });
+                distance /= 2;
+            }
+            stage *= 2;
+        }
+        return plan;
+    }
+    plan.push(SortPass::Local {
+        first: 2,
+        last: block,
+    });
+    let mut stage = 2 * block;
+    while stage <= n {
+        let mut distance = stage / 2;
+        while distance >= block {
+            if distance / 2 >= block {
+                plan.push(SortPass::Pair { stage, distance });
+                distance /= 4;
+            } else {
+                plan.push(SortPass::Step { stage, distance });
+                distance /= 2;
+            }
+        }
+        plan.push(SortPass::Local {
+            first: stage,
+            last: stage,
+        });
+        stage *= 2;
+    }
+    plan
+}
+
 pub struct BitonicBuild {
     gpu: Gpu,
+    /// The fused sort (`fused_plan`: two long steps a pass, short steps in
+    /// registers) instead of one faithful pass a step; the same result.
+    fused: bool,
     /// Compact stored records on the GPU before sorting (a HistoPyramid); off
     /// for the paper's way, sorting every record of every frame.
     compact: bool,
@@ -52,6 +113,8 @@ pub struct BitonicBuild {
     compact_pass: Program,
     keys: Program,
     bitonic: Program,
+    bitonic_pair: Program,
+    bitonic_local: Program,
     search: Program,
     gather: Program,
 }
@@ -72,6 +135,11 @@ impl BitonicBuild {
         let p = |name: &str| Program::fullscreen_with(gpu, name, &defines);
         Ok(Self {
             gpu: gpu.clone(),
+            // Off: on llvmpipe the fused passes take as long as the faithful
+            // ones (`bench build`; README), so renders keep the paper's.
+            fused: false,
+            bitonic_pair: p("photon/bitonic_pair.frag")?,
+            bitonic_local: p("photon/bitonic_local.frag")?,
             compact: !float_addressing,
             float_addressing,
             pyramid_base: p("photon/pyramid_base.frag")?,
@@ -88,6 +156,12 @@ impl BitonicBuild {
     /// record of every frame, as the paper does).
     pub fn compacting(mut self, compact: bool) -> Self {
         self.compact = compact;
+        self
+    }
+
+    /// The same build with the fused sort or the faithful passes.
+    pub fn fusing(mut self, fused: bool) -> Self {
+        self.fused = fused && !self.float_addressing;
         self
     }
 
@@ -113,32 +187,50 @@ impl BitonicBuild {
             Target::new(&self.gpu, &[&textures[0]])?,
             Target::new(&self.gpu, &[&textures[1]])?,
         ];
+        let plan = if self.fused {
+            fused_plan(n, w)
+        } else {
+            fused_plan(n, 1)
+        };
+        let split = |v: u64| {
+            if v < w as u64 {
+                [v as i32, 0]
+            } else {
+                [0, (v / w as u64) as i32]
+            }
+        };
         let mut current = 0;
-        let mut passes = 0;
-        let mut stage = 2u64;
-        while stage <= n {
-            let mut distance = stage / 2;
-            while distance >= 1 {
-                let split = |v: u64| {
-                    if v < w as u64 {
-                        [v as i32, 0]
-                    } else {
-                        [0, (v / w as u64) as i32]
-                    }
-                };
-                self.bitonic
+        for pass in &plan {
+            let (from, to) = (&textures[current], &targets[1 - current]);
+            match *pass {
+                SortPass::Step { stage, distance } => self
+                    .bitonic
                     .bind()
-                    .texture("u_pairs", &textures[current])
+                    .texture("u_pairs", from)
                     .ivec2("u_stage_xy", split(stage))
                     .ivec2("u_distance_xy", split(distance))
                     .int("u_width", w as i32)
-                    .draw_fullscreen(&targets[1 - current], &DrawState::PLAIN)?;
-                current = 1 - current;
-                passes += 1;
-                distance /= 2;
+                    .draw_fullscreen(to, &DrawState::PLAIN)?,
+                SortPass::Pair { stage, distance } => self
+                    .bitonic_pair
+                    .bind()
+                    .texture("u_pairs", from)
+                    .ivec2("u_stage_xy", split(stage))
+                    .ivec2("u_distance_xy", split(distance))
+                    .ivec2("u_half_xy", split(distance / 2))
+                    .draw_fullscreen(to, &DrawState::PLAIN)?,
+                SortPass::Local { first, last } => self
+                    .bitonic_local
+                    .bind()
+                    .texture("u_pairs", from)
+                    .int("u_width", w as i32)
+                    .int("u_stage_first", first as i32)
+                    .int("u_stage_last", last as i32)
+                    .draw_fullscreen(to, &DrawState::PLAIN)?,
             }
-            stage *= 2;
+            current = 1 - current;
         }
+        let passes = plan.len() as u32;
         self.gpu.check("bitonic sort")?;
         drop(targets);
         let [a, b] = textures;
