@@ -20,6 +20,14 @@ fn assert_ok(out: &std::process::Output) {
     );
 }
 
+/// A command that failed with one line of error naming `says`.
+fn assert_refused(out: &std::process::Output, says: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "accepted; stderr: {stderr}");
+    assert!(stderr.contains(says), "no '{says}' in: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("photonmap-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -1601,8 +1609,12 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
         unshot[0] > 0.9 && *unshot.last().unwrap() < 1e-2,
         "{unshot:?}"
     );
-    let refused: [(&[&str], &str); 5] = [
+    assert!(r["tiles"].as_u64().unwrap() >= r["patches"].as_u64().unwrap());
+    let refused: [(&[&str], &str); 8] = [
         (&["--elements", "8"], "--method radiosity"),
+        (&["--subdivide", "2"], "--method radiosity"),
+        (&["--method", "radiosity", "--subdivide", "7"], "0..=6"),
+        (&["--method", "radiosity", "--gradient", "0"], "positive"),
         (&["--method", "radiosity", "--adaptive"], "--adaptive"),
         (
             &[
@@ -1621,6 +1633,30 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
     for (args, says) in refused {
         assert_render_refused(&d, "cornell_box", args, says);
     }
+}
+
+/// `bench mitsuba` runs Mitsuba through --python, and says before any render
+/// when it cannot; `tables --table1-only` needs --out (it would replace the
+/// full run's tables.md).
+#[test]
+fn bench_mitsuba_and_tables_refuse_what_they_cannot_do() {
+    let out = photonmap()
+        .args([
+            "bench",
+            "mitsuba",
+            "--scene",
+            "glass_ball",
+            "--python",
+            "/nonexistent/python3",
+        ])
+        .output()
+        .unwrap();
+    assert_refused(&out, "/nonexistent/python3");
+    let out = photonmap()
+        .args(["tables", "--table1-only", "--quiet"])
+        .output()
+        .unwrap();
+    assert_refused(&out, "--table1-only needs --out");
 }
 
 /// `bench differentials --quick` on RING: both methods, the leaf sizes with

@@ -29,6 +29,10 @@ pub enum BenchCommand {
     /// Photon differentials against the kNN-grid at the same photons: time
     /// and error, the BVH's leaf size (their Table 1), and k_PM ~ k_PD.
     Differentials(super::differentials_bench::DifferentialsBenchArgs),
+    /// photonmap at a scene's defaults against Mitsuba 3 (path and light
+    /// tracing) at the same wall time, both against the SPPM reference; runs
+    /// Mitsuba through --python (not a dependency).
+    Mitsuba(super::mitsuba_bench::MitsubaBenchArgs),
     /// Whether the stencil test skips fragment work on this driver (the
     /// computation mask): an expensive pass with 0%, 50% and 90% of pixels masked.
     Mask(MaskArgs),
@@ -92,6 +96,7 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
         BenchCommand::Meshes(a) => super::meshes::run(&a, platform),
         BenchCommand::Igi(a) => super::igi_bench::run(&a, platform),
         BenchCommand::Differentials(a) => super::differentials_bench::run(&a, platform),
+        BenchCommand::Mitsuba(a) => super::mitsuba_bench::run(&a, platform),
         BenchCommand::Build(a) => {
             if a.min_log2 > a.max_log2 {
                 bail!(

@@ -10,6 +10,7 @@ pub mod differentials_bench;
 pub mod igi_bench;
 pub mod info;
 pub mod meshes;
+pub mod mitsuba_bench;
 pub mod photons;
 pub mod plot;
 pub mod progress;
