@@ -17,6 +17,7 @@
 mod common;
 
 use glam::{Vec2, Vec3};
+use photonmap::layout::LUMINANCE;
 use photonmap::reference::radiosity::{discontinuities, received, sub_shooters, Shooter};
 use photonmap::reference::ray_trace::closest_hit;
 use photonmap::render::radiosity::{block_outline, onto_surface, FormFactor};
@@ -89,6 +90,22 @@ radiance = [1.0, 1.0, 1.0]
     )
 }
 
+/// The light's one shot over the floor h below it, as one shooter (the
+/// whole light) onto 9 x 9 uniform elements, by `form_factor`.
+fn one_shooter_shot(h: f32, form_factor: FormFactor) -> RenderOutput {
+    solve(
+        &scene(&light_over_floor(h)),
+        RadiosityOptions {
+            resolution: 9,
+            substructure: 1,
+            max_shots: 1,
+            subdivide: 0,
+            form_factor,
+            ..RadiosityOptions::default()
+        },
+    )
+}
+
 #[test]
 fn on_the_axis_the_disc_form_factor_is_the_analytic_point_to_disc_one() {
     // One shooter (substructure 1): the whole light, a disc of its area A to
@@ -96,18 +113,7 @@ fn on_the_axis_the_disc_form_factor_is_the_analytic_point_to_disc_one() {
     // rho B A / (pi h^2 + A): a point's form factor to a disc of radius a,
     // a^2 / (h^2 + a^2), with pi a^2 = A.
     let h = 0.5f32;
-    let s = scene(&light_over_floor(h));
-    let out = solve(
-        &s,
-        RadiosityOptions {
-            resolution: 9,
-            substructure: 1,
-            max_shots: 1,
-            subdivide: 0,
-            form_factor: FormFactor::Disc,
-            ..RadiosityOptions::default()
-        },
-    );
+    let out = one_shooter_shot(h, FormFactor::Disc);
     let r = out.state.radiosity.as_ref().unwrap();
     let e = &r.elements;
     let direct = common::texels(&r.direct);
@@ -437,17 +443,7 @@ fn the_polygon_form_factor_is_the_analytic_point_to_rectangle_one_everywhere() {
     // element, on the axis or far off it, receives rho B F(point ->
     // rectangle) exactly (to f32 rounding): nothing blocks.
     let h = 0.5f32;
-    let s = scene(&light_over_floor(h));
-    let out = solve(
-        &s,
-        RadiosityOptions {
-            resolution: 9,
-            substructure: 1,
-            max_shots: 1,
-            subdivide: 0,
-            ..RadiosityOptions::default()
-        },
-    );
+    let out = one_shooter_shot(h, FormFactor::Polygon);
     let r = out.state.radiosity.as_ref().unwrap();
     let e = &r.elements;
     let direct = common::texels(&r.direct);
@@ -799,7 +795,7 @@ fn adaptive_subdivision_splits_where_its_twin_finds_discontinuities() {
             .map(|k| {
                 let x = e.texel(t, k % e.res, k / e.res);
                 (e.position[x][3] > 0.0)
-                    .then(|| b[x][0] * 0.2126 + b[x][1] * 0.7152 + b[x][2] * 0.0722)
+                    .then(|| Vec3::from_slice(&b[x][..3]).dot(Vec3::from(LUMINANCE)))
             })
             .collect();
         let (cpu, close) = discontinuities(&values, e.res, o.gradient, report.split_floor);

@@ -10,6 +10,7 @@
 // With FLOAT_ADDRESSING (`--faithful`) the partner is found as the paper did:
 // through the 1D index and convert1dto2d in floats.
 #include "common/addressing.glsl"
+#include "photon/bitonic_common.glsl"
 
 uniform isampler2D u_pairs;
 uniform ivec2 u_distance_xy;  // j as (j, 0) or (0, j / width)
@@ -28,7 +29,7 @@ void main() {
 #endif
     ivec4 mine = texelFetch(u_pairs, px, 0);
     ivec4 theirs = texelFetch(u_pairs, partner_px, 0);
-    bool mine_less = mine.x < theirs.x || (mine.x == theirs.x && mine.y < theirs.y);
+    bool mine_less = pair_less(mine, theirs);
     bool ascending = all(equal(px & u_stage_xy, ivec2(0)));
     bool lower = all(equal(px & u_distance_xy, ivec2(0))); // i < partner
     bool keep_smaller = lower == ascending;

@@ -1,4 +1,5 @@
-// Shared by the fast sort's passes (bitonic_pair.frag, bitonic_local.frag):
+// Shared by the sort's passes (bitonic.frag, and the fused sort's
+// bitonic_pair.frag and bitonic_local.frag):
 // the order of (key, record) pairs, ties broken by the record so that the
 // sorted result is the faithful passes' exactly.
 // Without short-circuits, so no branch.

@@ -8,7 +8,7 @@
 //! libLLVM 16 or newer, named by DRJIT_LIBLLVM_PATH where the system's is
 //! older).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{bail, Context, Result};
@@ -174,12 +174,9 @@ pub fn export(scene: &Scene, width: u32, height: u32, max_depth: u32) -> serde_j
     })
 }
 
-pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name, reference, scale) = super::igi_bench::scene_and_reference(&a.scene)?;
-    let Some((reference_path, reference)) = reference else {
-        bail!("bench mitsuba compares against an SPPM reference: give --reference (`photonmap reference` makes one)");
-    };
-    // Before any render: Mitsuba must import, with the variant asked for.
+/// Fails, before any render, unless `--python` imports Mitsuba with the
+/// variant asked for.
+fn check_mitsuba(a: &MitsubaBenchArgs) -> Result<()> {
     let check = Command::new(&a.python)
         .args([
             "-c",
@@ -189,12 +186,93 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
         .with_context(|| format!("running {} (--python)", a.python))?;
     if !check.status.success() {
         bail!(
-            "{} cannot run Mitsuba's {} variant: {}\n(pip install mitsuba; its LLVM back end needs libLLVM 16 or newer, named by DRJIT_LIBLLVM_PATH)",
+            "{} cannot run Mitsuba's {} variant: {}\n{INSTALL}",
             a.python,
             a.variant,
-            String::from_utf8_lossy(&check.stderr).lines().last().unwrap_or("")
+            String::from_utf8_lossy(&check.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
         );
     }
+    Ok(())
+}
+
+const INSTALL: &str = "(pip install mitsuba; its LLVM back end needs libLLVM 16 or newer, named by DRJIT_LIBLLVM_PATH)";
+
+/// Renders the export with Mitsuba's `integrator` for `seconds` of wall
+/// time: its image and (seconds taken, samples per pixel).
+fn render_mitsuba(
+    a: &MitsubaBenchArgs,
+    dir: &Path,
+    integrator: &str,
+    seconds: f64,
+) -> Result<(Image, f64, u32)> {
+    let exr = dir.join(format!("mitsuba_{integrator}.exr"));
+    let run = Command::new(&a.python)
+        .arg(dir.join(SCRIPT_FILE))
+        .arg(dir.join(EXPORT_FILE))
+        .arg(format!("{seconds}"))
+        .arg(&exr)
+        .arg(integrator)
+        .arg(&a.variant)
+        .output()
+        .with_context(|| format!("running {}", a.python))?;
+    if !run.status.success() {
+        let err = String::from_utf8_lossy(&run.stderr);
+        let tail: Vec<&str> = err.lines().rev().take(6).collect();
+        bail!(
+            "Mitsuba failed ({}): {}\n{INSTALL}",
+            run.status,
+            tail.into_iter().rev().collect::<Vec<_>>().join("\n")
+        );
+    }
+    let report: serde_json::Value = serde_json::from_slice(
+        run.stdout
+            .split(|&b| b == b'\n')
+            .rfind(|l| l.starts_with(b"{"))
+            .unwrap_or_default(),
+    )
+    .context("Mitsuba's report line")?;
+    let image = Image::read_exr(&exr)?;
+    let _ = std::fs::remove_file(&exr);
+    Ok((
+        image,
+        report["seconds"].as_f64().unwrap_or(f64::NAN),
+        report["spp"].as_u64().unwrap_or(0) as u32,
+    ))
+}
+
+const EXPORT_FILE: &str = "export.json";
+const SCRIPT_FILE: &str = "mitsuba_render.py";
+
+/// A row: `image` compared with the reference and written as `file`.
+fn row(
+    (dir, reference): (&Path, &Image),
+    renderer: String,
+    (seconds, spp): (f64, u32),
+    image: &Image,
+    file: String,
+) -> Result<Row> {
+    let m = compare(image, reference, None)?;
+    write_atomically(&dir.join(&file), &image.png_bytes()?)?;
+    Ok(Row {
+        renderer,
+        seconds,
+        spp,
+        rmse: m.rmse,
+        rel_mse: m.rel_mse,
+        rel_rmse: m.rel_mse.sqrt(),
+        image: file,
+    })
+}
+
+pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
+    let (scene, name, reference, scale) = super::igi_bench::scene_and_reference(&a.scene)?;
+    let Some((reference_path, reference)) = reference else {
+        bail!("bench mitsuba compares against an SPPM reference: give --reference (`photonmap reference` makes one)");
+    };
+    check_mitsuba(a)?;
     let dir = a
         .out
         .clone()
@@ -202,29 +280,14 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
     std::fs::create_dir_all(&dir)?;
     let progress = super::progress_lines(a.quiet);
     let (width, height) = (reference.width, reference.height);
-    let export_path = dir.join("export.json");
     write_atomically(
-        &export_path,
+        &dir.join(EXPORT_FILE),
         serde_json::to_string(&export(&scene, width, height, a.max_depth))?.as_bytes(),
     )?;
-    let script = dir.join("mitsuba_render.py");
-    write_atomically(&script, SCRIPT.as_bytes())?;
+    write_atomically(&dir.join(SCRIPT_FILE), SCRIPT.as_bytes())?;
     let gpu = super::gpu(platform)?;
+    let at = (dir.as_path(), &reference);
     let mut rows = Vec::new();
-    let row =
-        |renderer: String, seconds: f64, spp: u32, image: &Image, file: &str| -> Result<Row> {
-            let m = compare(image, &reference, None)?;
-            write_atomically(&dir.join(file), &image.png_bytes()?)?;
-            Ok(Row {
-                renderer,
-                seconds,
-                spp,
-                rmse: m.rmse,
-                rel_mse: m.rel_mse,
-                rel_rmse: m.rel_mse.sqrt(),
-                image: file.into(),
-            })
-        };
     for &spp in &a.spp {
         progress(&format!("photonmap, {spp} spp"));
         let mut o = reference_options(&scene, scale, 7);
@@ -232,12 +295,13 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
         let t = std::time::Instant::now();
         let out = render(&gpu, &scene, &o, &mut ())?;
         let seconds = t.elapsed().as_secs_f64();
+        let file = format!("photonmap_{spp}spp.png");
         rows.push(row(
+            at,
             "photonmap".into(),
-            seconds,
-            spp,
+            (seconds, spp),
             &out.image,
-            &format!("photonmap_{spp}spp.png"),
+            file,
         )?);
         // photonmap's own converging method, SPPM, stopped at the same time.
         progress(&format!("photonmap SPPM, {seconds:.1} s"));
@@ -247,57 +311,17 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
             ..SppmOptions::default()
         };
         let t = std::time::Instant::now();
-        let s = render_sppm(
-            &gpu,
-            &scene,
-            &reference_options(&scene, scale, 7),
-            &sppm,
-            &mut (),
-        )?;
-        rows.push(row(
-            "photonmap SPPM".into(),
-            t.elapsed().as_secs_f64(),
-            s.iterations,
-            &s.image,
-            &format!("photonmap_sppm_{spp}.png"),
-        )?);
+        let o = reference_options(&scene, scale, 7);
+        let s = render_sppm(&gpu, &scene, &o, &sppm, &mut ())?;
+        let taken = (t.elapsed().as_secs_f64(), s.iterations);
+        let file = format!("photonmap_sppm_{spp}.png");
+        rows.push(row(at, "photonmap SPPM".into(), taken, &s.image, file)?);
         for integrator in &a.integrators {
             progress(&format!("Mitsuba {integrator}, {seconds:.1} s"));
-            let exr = dir.join(format!("mitsuba_{integrator}_{spp}.exr"));
-            let run = Command::new(&a.python)
-                .arg(&script)
-                .arg(&export_path)
-                .arg(format!("{seconds}"))
-                .arg(&exr)
-                .arg(integrator)
-                .arg(&a.variant)
-                .output()
-                .with_context(|| format!("running {}", a.python))?;
-            if !run.status.success() {
-                let err = String::from_utf8_lossy(&run.stderr);
-                let tail: Vec<&str> = err.lines().rev().take(6).collect();
-                bail!(
-                    "Mitsuba failed ({}): {}\n(pip install mitsuba; its LLVM back end needs libLLVM 16 or newer, named by DRJIT_LIBLLVM_PATH)",
-                    run.status,
-                    tail.into_iter().rev().collect::<Vec<_>>().join("\n")
-                );
-            }
-            let report: serde_json::Value = serde_json::from_slice(
-                run.stdout
-                    .split(|&b| b == b'\n')
-                    .rfind(|l| l.starts_with(b"{"))
-                    .unwrap_or_default(),
-            )
-            .context("Mitsuba's report line")?;
-            let image = Image::read_exr(&exr)?;
-            let _ = std::fs::remove_file(&exr);
-            rows.push(row(
-                format!("Mitsuba {integrator}"),
-                report["seconds"].as_f64().unwrap_or(f64::NAN),
-                report["spp"].as_u64().unwrap_or(0) as u32,
-                &image,
-                &format!("mitsuba_{integrator}_{spp}.png"),
-            )?);
+            let (image, taken, samples) = render_mitsuba(a, &dir, integrator, seconds)?;
+            let file = format!("mitsuba_{integrator}_{spp}.png");
+            let label = format!("Mitsuba {integrator}");
+            rows.push(row(at, label, (taken, samples), &image, file)?);
         }
     }
     let bench = MitsubaBench {
@@ -315,22 +339,26 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
         serde_json::to_string_pretty(&bench)?.as_bytes(),
     )?;
     if a.json {
-        super::print_json(&bench)?;
+        super::print_json(&bench)
     } else {
-        println!(
-            "{} ({} x {}) against {}",
-            bench.scene, bench.width, bench.height, bench.reference
-        );
-        println!(
-            "{:<18} {:>8} {:>6} {:>8} {:>10}",
-            "renderer", "seconds", "spp/it", "RMSE", "rel. RMSE"
-        );
-        for r in &bench.rows {
-            println!(
-                "{:<18} {:>8.2} {:>6} {:>8.4} {:>10.4}",
-                r.renderer, r.seconds, r.spp, r.rmse, r.rel_rmse
-            );
-        }
+        print_table(&bench);
+        Ok(())
     }
-    Ok(())
+}
+
+fn print_table(bench: &MitsubaBench) {
+    println!(
+        "{} ({} x {}) against {}",
+        bench.scene, bench.width, bench.height, bench.reference
+    );
+    println!(
+        "{:<18} {:>8} {:>6} {:>8} {:>10}",
+        "renderer", "seconds", "spp/it", "RMSE", "rel. RMSE"
+    );
+    for r in &bench.rows {
+        println!(
+            "{:<18} {:>8.2} {:>6} {:>8.4} {:>10.4}",
+            r.renderer, r.seconds, r.spp, r.rmse, r.rel_rmse
+        );
+    }
 }

@@ -364,41 +364,40 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
 
 /// Refuses each method's switches without it, and what it cannot combine with.
 fn check_method_switches(args: &RenderArgs) -> Result<()> {
-    if args.method != Method::Igi && args.igi.any_given() {
-        bail!("--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi");
-    }
-    if args.method == Method::Igi
-        && (args.final_gather.is_some()
-            || args.adaptive
-            || args.reference_software.is_some()
-            || args.snapshots.is_some()
-            || args.direct_only)
-    {
-        bail!("--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
-    }
-    if args.method != Method::Differentials && args.differentials.any_given() {
-        bail!("--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials");
-    }
-    if args.method == Method::Differentials
-        && (args.final_gather.is_some()
-            || args.adaptive
-            || args.reference_software.is_some()
-            || args.snapshots.is_some()
-            || args.direct_only)
-    {
-        bail!("--method differentials replaces the kNN estimate with footprints: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
-    }
-    if args.method != Method::Radiosity && args.radiosity.any_given() {
-        bail!("--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient and --form-factor are radiosity's: add --method radiosity");
-    }
-    if args.method == Method::Radiosity
-        && (args.final_gather.is_some()
-            || args.adaptive
-            || args.reference_software.is_some()
-            || args.snapshots.is_some()
-            || args.direct_only)
-    {
-        bail!("--method radiosity computes the diffuse interreflection itself: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+    // Each method's own switches, and what its image (no one-map estimate)
+    // cannot take.
+    let one_map_only = args.final_gather.is_some()
+        || args.adaptive
+        || args.reference_software.is_some()
+        || args.snapshots.is_some()
+        || args.direct_only;
+    let methods = [
+        (
+            Method::Igi,
+            args.igi.any_given(),
+            "--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi",
+            "--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate",
+        ),
+        (
+            Method::Differentials,
+            args.differentials.any_given(),
+            "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials",
+            "--method differentials replaces the kNN estimate with footprints",
+        ),
+        (
+            Method::Radiosity,
+            args.radiosity.any_given(),
+            "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient and --form-factor are radiosity's: add --method radiosity",
+            "--method radiosity computes the diffuse interreflection itself",
+        ),
+    ];
+    for (method, given, theirs, cannot) in methods {
+        if args.method != method && given {
+            bail!("{theirs}");
+        }
+        if args.method == method && one_map_only {
+            bail!("{cannot}: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+        }
     }
     if args.method == Method::Differentials {
         if let Some(s) = args

@@ -193,31 +193,7 @@ impl Texture {
 
     /// Replaces level 0 with `data` (row 0 first, `channels` values a texel).
     pub fn upload<T: Texel>(&self, data: &[T]) -> Result<()> {
-        assert_eq!(T::INTEGER, self.is_integer(), "texel type against format");
-        assert_eq!(
-            data.len(),
-            self.texel_count() * self.format.channels(),
-            "texture data size"
-        );
-        let (_, fmt, ty) = self.format.gl();
-        // SAFETY: gpu module doc; `data` holds exactly the texels of level 0.
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
-            gl.tex_sub_image_2d(
-                glow::TEXTURE_2D,
-                0,
-                0,
-                0,
-                self.width as i32,
-                self.height as i32,
-                fmt,
-                ty,
-                glow::PixelUnpackData::Slice(Some(bytes_of(data))),
-            );
-        }
-        self.gpu.check("uploading a texture")
+        self.upload_region([0, 0, self.width, self.height], data)
     }
 
     pub fn upload_f32(&self, data: &[f32]) -> Result<()> {

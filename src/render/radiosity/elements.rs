@@ -63,10 +63,9 @@ impl Node {
 pub struct Elements {
     pub patches: Vec<Patch>,
     pub tiles: Vec<Tile>,
-    /// Patch p's root is node p.
+    /// Node t stands where tile t does (patch p's root is node p; a split
+    /// appends four nodes as it appends four tiles).
     pub nodes: Vec<Node>,
-    /// The node holding each tile.
-    node_of_tile: Vec<usize>,
     pub res: u32,
     /// Tiles the atlas has room for.
     pub capacity: u32,
@@ -317,7 +316,6 @@ impl Elements {
         let mut e = Elements {
             tiles: Vec::new(),
             nodes: Vec::new(),
-            node_of_tile: Vec::new(),
             patches,
             res,
             capacity,
@@ -333,7 +331,6 @@ impl Elements {
         };
         for p in 0..e.patches.len() {
             e.nodes.push(Node::Leaf(p));
-            e.node_of_tile.push(p);
             e.tiles.push(Tile {
                 patch: p as u32,
                 depth: 0,
@@ -416,8 +413,7 @@ impl Elements {
             return None;
         }
         let first = self.nodes.len();
-        let node = self.node_of_tile[t];
-        self.nodes[node] = Node::Split(first);
+        self.nodes[t] = Node::Split(first);
         let mut made = Vec::new();
         for q in 0..4u32 {
             let origin = [
@@ -431,7 +427,6 @@ impl Elements {
                 origin,
                 alive: true,
             });
-            self.node_of_tile.push(first + q as usize);
             if self.fill(scene, child) > 0 {
                 self.nodes.push(Node::Leaf(child));
                 made.push(child);
@@ -469,9 +464,9 @@ impl Elements {
         self.nodes.iter().map(|n| n.encode()).collect()
     }
 
-    /// Nodes the atlas's capacity can need: every root, and four a split.
+    /// Nodes the atlas's capacity can need: one a tile.
     pub fn node_capacity(&self) -> usize {
-        self.patches.len() + 4 * (self.capacity as usize).saturating_sub(self.patches.len()) / 4 + 4
+        self.capacity as usize
     }
 }
 

@@ -314,11 +314,8 @@ impl Radiosity {
         let radiosity = upload(&elements.emission)?;
         let residual = upload(&elements.emission)?;
         let direct = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
+        Target::new(gpu, &[&direct])?.clear([0.0; 4]);
         let atlas_target = Target::new(gpu, &[&radiosity, &residual, &direct])?;
-        atlas_target.clear([0.0; 4]);
-        // The clear above zeroed all three; radiosity and residual start at the emission.
-        radiosity.upload_f32(&flat(&elements.emission))?;
-        residual.upload_f32(&flat(&elements.emission))?;
         let residual_target = Target::new(gpu, &[&residual])?;
         let shot = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
         let shot_target = Target::new(gpu, &[&shot])?;
@@ -425,11 +422,7 @@ impl Radiosity {
             ..Default::default()
         };
         let point_power = point_light_power(scene);
-        let emitted = self
-            .tile_powers()?
-            .iter()
-            .map(|&p| f64::from(p))
-            .sum::<f64>();
+        let emitted = self.unshot()?;
         let total = emitted + point_power;
         if total <= 0.0 {
             return Err(Error::InvalidOption(format!(
@@ -468,11 +461,7 @@ impl Radiosity {
         }
         let threshold = (f64::from(self.options.convergence) * total) as f32;
         let occlusion = Query::occlusion(&self.gpu)?;
-        let mut unshot = self
-            .tile_powers()?
-            .iter()
-            .map(|&p| f64::from(p))
-            .sum::<f64>();
+        let mut unshot = self.unshot()?;
         report.convergence.push(ConvergencePoint {
             shot: 0,
             seconds: t0.elapsed().as_secs_f64(),
@@ -491,7 +480,7 @@ impl Radiosity {
             self.zero_region(&self.residual_target, tile)?;
             self.shoot(scene, textures, &shooters, light, floor, &mut report)?;
             report.shots += 1;
-            unshot = self.tile_powers()?.iter().map(|&p| f64::from(p)).sum();
+            unshot = self.unshot()?;
             self.gpu.finish();
             report.convergence.push(ConvergencePoint {
                 shot: report.shots,
@@ -527,26 +516,31 @@ impl Radiosity {
             .max(f64::MIN_POSITIVE)
     }
 
-    /// Each tile's residual power (read back).
-    fn tile_powers(&self) -> Result<Vec<f32>> {
-        self.tile_powers_of(&self.residual)
-    }
-
-    /// Each tile's power in `texture` (residual, radiosity or a shot's), read back.
-    fn tile_powers_of(&self, texture: &Texture) -> Result<Vec<f32>> {
+    /// Each tile's power (read back): of its residual, its radiosity and
+    /// the last shot.
+    fn tile_powers(&self) -> Result<Vec<[f32; 3]>> {
         self.gpu.texture_barrier();
         let tiles = self.elements.tiles.len();
         self.programs
             .power
             .bind()
-            .texture("u_residual", texture)
+            .texture("u_residual", &self.residual)
+            .texture("u_radiosity", &self.radiosity)
+            .texture("u_shot", &self.shot)
             .texture("u_element_position", &self.position)
             .int("u_tiles", tiles as i32)
             .int("u_res", self.elements.res as i32)
             .int("u_tile_columns", self.elements.tile_columns as i32)
             .draw_fullscreen(&self.power_target, &DrawState::PLAIN)?;
         let all = self.power.read_f32();
-        Ok((0..tiles).map(|p| all[4 * p]).collect())
+        Ok((0..tiles)
+            .map(|p| [all[4 * p], all[4 * p + 1], all[4 * p + 2]])
+            .collect())
+    }
+
+    /// The unshot power: the sum of the tiles' residual power.
+    fn unshot(&self) -> Result<f64> {
+        Ok(self.tile_powers()?.iter().map(|p| f64::from(p[0])).sum())
     }
 
     /// The chapter's z-buffer sort over the tile powers last drawn: the
@@ -782,8 +776,7 @@ impl Radiosity {
         let max_depth = self.options.subdivide;
         // Only tiles this shot changes by SPLIT_SHARE of their radiosity
         // power or more: later shots add little to what is already there.
-        let shot = self.tile_powers_of(&self.shot)?;
-        let before = self.tile_powers_of(&self.radiosity)?;
+        let powers = self.tile_powers()?;
         let e = &self.elements;
         let mut candidates: Vec<usize> = (0..e.tiles.len())
             .filter(|&t| {
@@ -791,8 +784,8 @@ impl Radiosity {
                 tile.alive
                     && tile.depth < max_depth
                     && !e.patches[tile.patch as usize].emitter
-                    && shot[t] > 0.0
-                    && shot[t] >= SPLIT_SHARE * (before[t] + shot[t])
+                    && powers[t][2] > 0.0
+                    && powers[t][2] >= SPLIT_SHARE * (powers[t][1] + powers[t][2])
             })
             .collect();
         while !candidates.is_empty() && !report.atlas_full {
@@ -954,12 +947,12 @@ fn point_light_power(scene: &Scene) -> f64 {
     scene
         .lights
         .iter()
-        .map(|l| match *l {
-            Light::Point { intensity, .. } => {
-                4.0 * std::f64::consts::PI
-                    * f64::from(intensity.dot(Vec3::from(crate::layout::LUMINANCE)))
-            }
-            _ => 0.0,
+        .filter(|l| matches!(l, Light::Point { .. }))
+        .map(|l| {
+            f64::from(
+                l.power(&scene.shapes)
+                    .dot(Vec3::from(crate::layout::LUMINANCE)),
+            )
         })
         .sum()
 }
