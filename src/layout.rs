@@ -57,6 +57,11 @@ pub const RANDOM_PER_PHOTON_FRAME: usize = 8;
 /// fraction of the maximum radius from the query's tangent plane are not its own.
 pub const DISC_THICKNESS: f32 = 0.1;
 
+/// The kNN search skips a grid cell whose box, shrunk by this fraction of a
+/// cell on every side, lies beyond its reach (glsl/render/knn_search.frag):
+/// a photon is in its cell's box up to f32 rounding, far below this slack.
+pub const CULL_SLACK: f32 = 1e-3;
+
 /// The random stream of final-gather ray g of a pixel is GATHER_STREAM | g
 /// (glsl/render/gather_rays.frag; the eye side's other streams use other top bits).
 pub const GATHER_STREAM: u32 = 0x5000_0000;
@@ -153,6 +158,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ),
         ("PI", PI_GLSL.into()),
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
+        ("CULL_SLACK", format!("{CULL_SLACK:?}")),
         ("FOOTPRINT_THICKNESS", format!("{FOOTPRINT_THICKNESS:?}")),
         ("TILE_ROW", u(TILE_ROW)),
         ("LOCAL_BLOCK", u(SORT_BLOCK)),

@@ -435,3 +435,107 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
         }
     }
 }
+
+/// The search's ways of visiting cells (skipping cells beyond the reach,
+/// reading a face row's cells as one range) leave the result bit for bit the
+/// paper search's, on both builds; the paper search examines exactly the
+/// photons its CPU twin does, and the others examine fewer.
+#[test]
+fn culled_searches_end_in_the_paper_search_s_state_bit_for_bit() {
+    use photonmap::reference::knn::knn_grid_counted;
+    for (name, w, h) in [
+        ("glass_ball", 64, 48),
+        ("cornell_box", 48, 48),
+        ("ring", 64, 48),
+    ] {
+        let scene = common::paper_scene(name);
+        for build in [BuildMethod::Bitonic, BuildMethod::Stencil] {
+            let mut states = Vec::new();
+            for (cull, runs) in [(false, false), (true, false), (true, true)] {
+                let gpu = common::gpu();
+                let mut o = RenderOptions::for_scene(&scene);
+                (o.width, o.height, o.seed) = (w, h, 3);
+                let mut gi = GlobalIllumination {
+                    photons: PhotonConfig {
+                        build,
+                        ..PhotonConfig::default()
+                    },
+                    ..GlobalIllumination::default()
+                };
+                gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
+                (gi.estimate.cull, gi.estimate.runs) = (cull, runs);
+                o.global = Some(gi);
+                let out = render(&gpu, &scene, &o, &mut ()).unwrap();
+                // Read now: the next render makes its own context current.
+                let est = out.state.estimate.as_ref().unwrap();
+                let twin = (cull, runs) == (false, false);
+                let cpu_map = twin.then(|| CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap()));
+                let pos = out.state.direct.diffuse_position.read_f32();
+                states.push((
+                    est.flux.read_f32(),
+                    est.cursor.read_i32(),
+                    est.done.read_i32(),
+                    out.estimate.unwrap().work,
+                ));
+                let Some(cpu_map) = cpu_map else { continue };
+                let done = &states.last().unwrap().2;
+                let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
+                let mut checked = 0;
+                for i in (0..pos.len() / 4).filter(|&i| pos[4 * i + 3] > 0.0) {
+                    let x = Vec3::from_slice(&pos[4 * i..]);
+                    let (_, examined) = knn_grid_counted(&cpu_map, x, k, max_r, &|_| true);
+                    assert_eq!(
+                        done[4 * i + 1] as u64,
+                        examined,
+                        "{name} {build:?} pixel {i}: photons examined against the twin's"
+                    );
+                    checked += 1;
+                }
+                assert!(checked > (w * h / 3) as usize, "{name}: {checked} queries");
+            }
+            let (flux0, cursor0, done0, work0) = &states[0];
+            for (v, (flux, cursor, done, work)) in states.iter().enumerate().skip(1) {
+                assert!(
+                    flux.iter()
+                        .zip(flux0)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "{name} {build:?} variant {v}: flux or radius differs"
+                );
+                for i in 0..cursor.len() / 4 {
+                    assert_eq!(
+                        cursor[4 * i],
+                        cursor0[4 * i],
+                        "{name} {build:?} variant {v} pixel {i}: accepted"
+                    );
+                    assert_eq!(
+                        done[4 * i],
+                        done0[4 * i],
+                        "{name} {build:?} variant {v} pixel {i}: done"
+                    );
+                    assert!(
+                        done[4 * i + 1] <= done0[4 * i + 1] && done[4 * i + 1] >= cursor[4 * i],
+                        "{name} {build:?} variant {v} pixel {i}: examined {} against the paper's {} and {} accepted",
+                        done[4 * i + 1],
+                        done0[4 * i + 1],
+                        cursor[4 * i]
+                    );
+                }
+                assert!(
+                    work.steps < work0.steps,
+                    "{name} {build:?} variant {v}: {} steps against the paper's {}",
+                    work.steps,
+                    work0.steps
+                );
+            }
+            eprintln!(
+                "{name} {build:?}: steps {} / {} / {}, photons examined {} / {} / {}",
+                states[0].3.steps,
+                states[1].3.steps,
+                states[2].3.steps,
+                states[0].3.photons_examined,
+                states[1].3.photons_examined,
+                states[2].3.photons_examined
+            );
+        }
+    }
+}

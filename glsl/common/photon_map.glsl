@@ -34,6 +34,19 @@ int cell_photon_count(int cell, out int base) {
 #endif
 }
 
+// Photons stored in the `run` cells from `cell` along x (a run of one is the
+// cell's slot); a longer run only in a sorted uniform grid, whose slots are
+// the cells, their photons one after another.
+int run_photon_count(int cell, int run, out int base) {
+#ifndef ROUTED
+    if (run > 1) {
+        base = texelFetch(u_grid_first, texel_of_index(cell, u_grid_width), 0).x;
+        return texelFetch(u_grid_first, texel_of_index(cell + run, u_grid_width), 0).x - base;
+    }
+#endif
+    return cell_photon_count(cell, base);
+}
+
 // Whether the photon at p belongs to `cell`: always in a uniform grid; in a
 // hash grid only if its own cell is `cell` (the same grid_cell that keyed it).
 bool photon_in_cell(vec3 p, int cell) {

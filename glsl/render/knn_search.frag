@@ -16,6 +16,12 @@
 // (Elias; faces on the grid's boundary do not count): the search ends when k
 // are accepted and the radius is within d_min(r), when d_min(r) reaches the
 // maximum radius, or when the box covers the grid.
+// Cells that can hold no candidate (outside the grid, inside the shell, and,
+// unless NO_CULL, beyond the reach: the maximum radius, or the radius once k
+// are in, which only shrinks) are skipped; NO_CULL (the paper's search) spends
+// a step on each skip and opens every other cell, while the default skips
+// within the step, up to SKIPS_PER_STEP at a time. The candidates and their
+// order are the same either way, so the result is bit for bit the same.
 // VISIBILITY_TEST accepts only photons nothing blocks from the query point (a
 // thin wall does not leak light), DISC_TEST only photons near its tangent
 // plane; the k nearest are then the k nearest that pass.
@@ -30,10 +36,13 @@ uniform sampler2D u_query_normal;    // facing the eye, w = material + 1
 #endif
 uniform sampler2D u_state_flux;      // rgb sum of accepted power, w = radius^2
 uniform isampler2D u_state_cursor;   // accepted, ring, cube cursor, photon cursor
-uniform isampler2D u_state_done;     // done, photons examined
+uniform isampler2D u_state_done;     // done, photons examined, steps, cells opened
 uniform int u_k;
 uniform float u_max_radius;
 uniform int u_budget;
+#ifndef ROUTED
+uniform int u_cell_runs;             // 1: read a face row's cells as one range
+#endif
 
 #ifdef TILED
 flat in ivec4 v_tile; // render/tile.vert: this draw's tile; a cut tile's point covers more
@@ -42,6 +51,46 @@ flat in ivec4 v_tile; // render/tile.vert: this draw's tile; a cut tile's point 
 layout(location = 0) out vec4 o_flux;
 layout(location = 1) out ivec4 o_cursor;
 layout(location = 2) out ivec4 o_done;
+
+const int SKIPS_PER_STEP = 64;
+
+// Moves cursor j of shell `ring` past cells that can hold no candidate;
+// returns whether it moved (false: the cell at j is to be opened). One call
+// skips one run: a plane, a row, or cells of a row.
+bool skip_empty(inout int j, int ring, ivec3 c0, vec3 x, vec3 cell_size, float reach2) {
+    int side = 2 * ring + 1;
+    int plane = side * side;
+    ivec3 d = ivec3(j % side, (j / side) % side, j / plane) - ring;
+    ivec3 cell = c0 + d;
+    // Cells outside the grid hold nothing: jump over whole planes, rows and
+    // runs of them (what makes thin grids such as 250 x 1 x 250 cheap).
+    if (cell.z < 0) { j = (-c0.z + ring) * plane; return true; }
+    if (cell.z >= u_grid_resolution.z) { j = plane * side; return true; }
+    if (cell.y < 0) { j = (d.z + ring) * plane + (-c0.y + ring) * side; return true; }
+    if (cell.y >= u_grid_resolution.y) { j = (d.z + ring + 1) * plane; return true; }
+    if (abs(d.y) < ring && abs(d.z) < ring && abs(d.x) < ring) { j += ring - d.x; return true; } // interior: jump to the far face
+    if (cell.x < 0) { j += -cell.x; return true; }
+    if (cell.x >= u_grid_resolution.x) { j = (j / side + 1) * side; return true; }
+#ifndef NO_CULL
+    // Beyond the reach: the cell's box (less a slack for rounding) farther
+    // than it, and with it the whole plane or row when those are, or the
+    // cells of the row before the first within it.
+    vec3 lo = u_grid_min + vec3(cell) * cell_size;
+    vec3 gap = max(max(lo - x, x - lo - cell_size) - CULL_SLACK * cell_size, 0.0);
+    float gap_yz2 = gap.y * gap.y + gap.z * gap.z;
+    if (gap.z * gap.z > reach2) { j = (d.z + ring + 1) * plane; return true; }
+    if (gap_yz2 > reach2) { j = (j / side + 1) * side; return true; }
+    if (gap.x * gap.x > reach2 - gap_yz2) {
+        int row_end = (j / side + 1) * side;
+        if (d.x > 0) { j = row_end; return true; }
+        float reach_x = sqrt(reach2 - gap_yz2);
+        int first = int(floor((x.x - reach_x - u_grid_min.x) / cell_size.x)) - 1;
+        j = min(j + max(1, first - cell.x), row_end);
+        return true;
+    }
+#endif
+    return false;
+}
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -57,7 +106,7 @@ void main() {
     vec3 nf = texelFetch(u_query_normal, px, 0).xyz;
 #endif
     int accepted = cursor.x, ring = cursor.y, j = cursor.z, p = cursor.w;
-    int examined = done.y;
+    int examined = done.y, steps = done.z, opened = done.w;
     float r2 = flux.w;
     float max_r2 = u_max_radius * u_max_radius;
     vec3 cell_size = (u_grid_max - u_grid_min) / vec3(u_grid_resolution);
@@ -65,11 +114,24 @@ void main() {
     bool finished = false;
 
     for (int step = 0; step < u_budget; ++step) {
+        steps += 1;
         int side = 2 * ring + 1;
         int plane = side * side;
+        float reach2 = accepted < u_k ? max_r2 : r2;
+        if (p == 0 && j < plane * side) {
+#ifdef NO_CULL
+            if (skip_empty(j, ring, c0, x, cell_size, reach2)) continue;
+#else
+            bool moved = true;
+            for (int s = 0; s < SKIPS_PER_STEP && moved && j < plane * side; ++s) {
+                moved = skip_empty(j, ring, c0, x, cell_size, reach2);
+            }
+            if (moved && j < plane * side) continue;
+#endif
+        }
         if (j >= plane * side) {
             // Ring done: every photon nearer than the examined box's faces is seen.
-                        // A face on the grid's boundary bounds nothing: no photon lies beyond.
+            // A face on the grid's boundary bounds nothing: no photon lies beyond.
             vec3 lo = u_grid_min + vec3(c0 - ring) * cell_size;
             vec3 hi = u_grid_min + vec3(c0 + ring + 1) * cell_size;
             const float FAR = 3.0e38;
@@ -89,42 +151,67 @@ void main() {
         }
         ivec3 d = ivec3(j % side, (j / side) % side, j / plane) - ring;
         ivec3 cell = c0 + d;
-        // Cells outside the grid hold nothing: jump over whole planes, rows and
-        // runs of them (what makes thin grids such as 250 x 1 x 250 cheap).
-        if (cell.z < 0) { j = (-c0.z + ring) * plane; p = 0; continue; }
-        if (cell.z >= u_grid_resolution.z) { j = plane * side; p = 0; continue; }
-        if (cell.y < 0) { j = (d.z + ring) * plane + (-c0.y + ring) * side; p = 0; continue; }
-        if (cell.y >= u_grid_resolution.y) { j = (d.z + ring + 1) * plane; p = 0; continue; }
-        if (abs(d.y) < ring && abs(d.z) < ring && abs(d.x) < ring) { j += ring - d.x; p = 0; continue; } // interior: jump to the far face
-        if (cell.x < 0) { j += -cell.x; p = 0; continue; }
-        if (cell.x >= u_grid_resolution.x) { j = (j / side + 1) * side; p = 0; continue; }
+        // Along x, the last cell that this step's range spans: the cell itself,
+        // or, in a sorted uniform grid, the end of a face row's run (below).
+        int last = cell.x;
+#ifndef ROUTED
+        // A sorted uniform grid stores a row's cells one after another, so a
+        // face row's cells (all of them on the shell) read as one range of
+        // photons, in the same order as cell by cell: one step opens them all.
+        if (u_cell_runs != 0 && u_hash_buckets == 0 && (abs(d.y) == ring || abs(d.z) == ring)) {
+            last = min(c0.x + ring, u_grid_resolution.x - 1);
+#ifndef NO_CULL
+            vec3 lo = u_grid_min + vec3(cell) * cell_size;
+            vec2 gap_yz = max(max(lo.yz - x.yz, x.yz - lo.yz - cell_size.yz) - CULL_SLACK * cell_size.yz, 0.0);
+            float reach_x = sqrt(max(reach2 - dot(gap_yz, gap_yz), 0.0));
+            last = min(last, int(floor((x.x + reach_x - u_grid_min.x) / cell_size.x)) + 1);
+#endif
+            last = max(last, cell.x);
+        }
+#endif
         int cell_index = cell.x + u_grid_resolution.x * (cell.y + u_grid_resolution.y * cell.z);
         int base;
-        int count = cell_photon_count(cell_index, base);
-        if (p >= count) { j += 1; p = 0; continue; }
-        ivec2 t = photon_texel(base, p);
-        vec3 photon = texelFetch(u_map_position, t, 0).xyz;
-        vec3 offset = photon - x;
-        float dist2 = dot(offset, offset);
-        // A hash bucket's photons of other cells are examined and rejected.
-        bool candidate = dist2 <= max_r2 && (accepted < u_k || dist2 <= r2) && photon_in_cell(photon, cell_index);
+        int count = run_photon_count(cell_index, last - cell.x + 1, base);
+        if (p == 0) opened += 1;
+        if (p >= count) { j += last - cell.x + 1; p = 0; continue; }
+        // The range's photons, one a step; by default in a loop of their own,
+        // so the lanes of a SIMD group run this tight body, not the whole step.
+        while (true) {
+            ivec2 t = photon_texel(base, p);
+            vec3 photon = texelFetch(u_map_position, t, 0).xyz;
+            vec3 offset = photon - x;
+            float dist2 = dot(offset, offset);
+            // A hash bucket's photons of other cells are examined and rejected.
+            bool candidate = dist2 <= max_r2 && (accepted < u_k || dist2 <= r2) && photon_in_cell(photon, cell_index);
 #ifdef DISC_TEST
-        // A disc, not a sphere: photons off the query's tangent plane (another
-        // wall at a corner) are not its photons.
-        candidate = candidate && abs(dot(offset, nf)) <= DISC_THICKNESS * u_max_radius;
+            // A disc, not a sphere: photons off the query's tangent plane
+            // (another wall at a corner) are not its photons.
+            candidate = candidate && abs(dot(offset, nf)) <= DISC_THICKNESS * u_max_radius;
 #endif
 #ifdef VISIBILITY_TEST
-        candidate = candidate && photon_visible(x, nf, x + offset);
+            candidate = candidate && photon_visible(x, nf, x + offset);
 #endif
-        if (candidate) {
-            flux.rgb += texelFetch(u_map_power, t, 0).rgb;
-            if (accepted < u_k) r2 = max(r2, dist2);
-            accepted += 1;
+            if (candidate) {
+                flux.rgb += texelFetch(u_map_power, t, 0).rgb;
+                if (accepted < u_k) r2 = max(r2, dist2);
+                accepted += 1;
+            }
+            p += 1;
+            examined += 1;
+#ifdef NO_CULL
+            break;
+#else
+            if (p >= count || step + 1 >= u_budget) break;
+            step += 1;
+            steps += 1;
+#endif
         }
-        p += 1;
-        examined += 1;
+#ifndef NO_CULL
+        // The range's last photon moves on in the same step.
+        if (p >= count) { j += last - cell.x + 1; p = 0; }
+#endif
     }
     o_flux = vec4(flux.rgb, r2);
     o_cursor = ivec4(accepted, ring, j, p);
-    o_done = ivec4(finished ? 1 : 0, examined, 0, 0);
+    o_done = ivec4(finished ? 1 : 0, examined, steps, opened);
 }

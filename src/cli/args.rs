@@ -112,6 +112,11 @@ pub struct EstimateArgs {
     /// default), or both.
     #[arg(long, value_enum, default_value_t = LeakTest::Visibility)]
     pub leak_test: LeakTest,
+    /// Search as the paper does, opening every cell of each ring one by one,
+    /// instead of skipping cells beyond the search radius and reading a row's
+    /// cells as one range (the same image, bit for bit; only slower).
+    #[arg(long)]
+    pub paper_search: bool,
 }
 
 impl EstimateArgs {
@@ -122,6 +127,7 @@ impl EstimateArgs {
             (self.mask.is_some(), "--mask"),
             (self.budget != 64, "--budget"),
             (self.leak_test != LeakTest::Visibility, "--leak-test"),
+            (self.paper_search, "--paper-search"),
         ]
         .into_iter()
         .find_map(|(given, name)| given.then_some(name))
@@ -138,6 +144,8 @@ impl From<&EstimateArgs> for EstimateOptions {
             },
             budget: a.budget,
             leak: a.leak_test,
+            cull: !a.paper_search,
+            runs: !a.paper_search,
             ..EstimateOptions::default()
         }
     }

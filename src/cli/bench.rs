@@ -40,6 +40,10 @@ pub enum BenchCommand {
     /// time per pass against a copy pass, binary search, stencil routing with and
     /// without read-back.
     Build(BuildArgs),
+    /// Where the kNN-grid radiance estimate's time goes (steps, photons
+    /// examined, cells opened, passes, lane use) for each variant of the
+    /// search, each checked to give the paper search's image bit for bit.
+    Estimate(super::estimate_bench::EstimateBenchArgs),
 }
 
 #[derive(Args)]
@@ -97,6 +101,7 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
         BenchCommand::Igi(a) => super::igi_bench::run(&a, platform),
         BenchCommand::Differentials(a) => super::differentials_bench::run(&a, platform),
         BenchCommand::Mitsuba(a) => super::mitsuba_bench::run(&a, platform),
+        BenchCommand::Estimate(a) => super::estimate_bench::run(&a, platform),
         BenchCommand::Build(a) => {
             if a.min_log2 > a.max_log2 {
                 bail!(

@@ -7,6 +7,7 @@ pub mod bench;
 pub mod compare;
 pub mod convert;
 pub mod differentials_bench;
+pub mod estimate_bench;
 pub mod igi_bench;
 pub mod info;
 pub mod meshes;

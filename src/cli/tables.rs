@@ -177,7 +177,7 @@ pub fn default_out(renderer: &str) -> PathBuf {
     })
 }
 
-fn options(
+pub(crate) fn table1_options(
     scene: &Scene,
     scale: u32,
     build: BuildMethod,
@@ -602,8 +602,13 @@ struct TablesRun<'a> {
 type Table1 = (Vec<Table1Cell>, Vec<Table1Total>, Vec<Vec<Image>>);
 
 impl TablesRun<'_> {
-    fn options(&self, scene: &Scene, build: BuildMethod, mode: EstimateMode) -> RenderOptions {
-        options(
+    fn table1_options(
+        &self,
+        scene: &Scene,
+        build: BuildMethod,
+        mode: EstimateMode,
+    ) -> RenderOptions {
+        table1_options(
             scene,
             self.scale,
             build,
@@ -648,7 +653,7 @@ impl TablesRun<'_> {
         let mut run_totals = Vec::new();
         for run in 0..runs {
             (self.progress)(&format!("Table 1: {name} {build:?} run {}/{runs}", run + 1));
-            let opts = self.options(scene, build, EstimateMode::Tiled { tile: 16 });
+            let opts = self.table1_options(scene, build, EstimateMode::Tiled { tile: 16 });
             let r = render(self.gpu, scene, &opts, &mut ())?;
             let mut total = 0.0;
             for (i, stage) in STAGES.iter().enumerate() {
@@ -724,7 +729,7 @@ impl TablesRun<'_> {
             let scene = embedded::load(name)?;
             for (label, mode) in &modes {
                 (self.progress)(&format!("Section 3.3: {name} {label}"));
-                let opts = self.options(&scene, BuildMethod::Bitonic, *mode);
+                let opts = self.table1_options(&scene, BuildMethod::Bitonic, *mode);
                 let r = render(self.gpu, &scene, &opts, &mut ())?;
                 let e = r.estimate.unwrap_or_default();
                 convergence.push(ConvergenceRow {
@@ -746,7 +751,7 @@ impl TablesRun<'_> {
         let temporary = tempfile::tempdir()?;
         let snap_dir = temporary.path().to_path_buf();
         let scene = embedded::load("glass_ball")?;
-        let opts = self.options(
+        let opts = self.table1_options(
             &scene,
             BuildMethod::Bitonic,
             EstimateMode::Tiled { tile: 16 },

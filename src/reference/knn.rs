@@ -34,6 +34,20 @@ pub fn knn_grid_filtered(
     max_radius: f32,
     accept: &dyn Fn(Vec3) -> bool,
 ) -> KnnResult {
+    knn_grid_counted(map, x, k, max_radius, accept).0
+}
+
+/// The search and the photons it examined: every photon of every in-grid
+/// cell on the shells it visits, the count the paper's search (the GPU's
+/// `--paper-search`) keeps in its state.
+pub fn knn_grid_counted(
+    map: &CpuPhotonMap,
+    x: Vec3,
+    k: u32,
+    max_radius: f32,
+    accept: &dyn Fn(Vec3) -> bool,
+) -> (KnnResult, u64) {
+    let mut examined = 0u64;
     let g = &map.grid;
     let res = [
         g.resolution[0] as i32,
@@ -69,6 +83,7 @@ pub fn knn_grid_filtered(
                     }
                     let cell = (xi + res[0] * (y + res[1] * z)) as u32;
                     for (_, _, (p, power)) in map.cell_photons(cell) {
+                        examined += 1;
                         let o = *p - x;
                         let d2 = o.dot(o);
                         if d2 <= max_r2 && (accepted < k || d2 <= r2) && accept(*p) {
@@ -113,11 +128,12 @@ pub fn knn_grid_filtered(
         let d_min = lo_gap.min(hi_gap).min_element();
         let covers = (0..3).all(|a| c0[a] - ring <= 0 && c0[a] + ring >= res[a] - 1);
         if covers || d_min >= max_radius || (accepted >= k && d_min >= 0.0 && r2 <= d_min * d_min) {
-            return KnnResult {
+            let result = KnnResult {
                 flux,
                 radius2: r2,
                 accepted,
             };
+            return (result, examined);
         }
         ring += 1;
     }

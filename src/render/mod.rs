@@ -15,6 +15,7 @@ pub mod radiance_estimate;
 pub mod radiosity;
 pub mod ray_rates;
 pub mod ray_trace;
+pub mod search_work;
 pub mod software;
 pub mod sppm;
 pub mod sppm_adaptive;
@@ -973,6 +974,8 @@ impl GatherRun<'_> {
             .expect("a gather run has final-gather options");
         let estimate = EstimateOptions {
             float_addressing: self.options.photons.faithful,
+            cull: self.options.estimate.cull && !self.options.photons.faithful,
+            runs: self.options.estimate.runs && !self.options.photons.faithful,
             leak: fg.leak,
             ..self.options.estimate.clone()
         };
@@ -1098,6 +1101,8 @@ impl EstimateRun<'_> {
         let (k, max_radius) = (self.scene.photon_map.k, self.scene.photon_map.max_radius);
         let options = EstimateOptions {
             float_addressing: self.options.photons.faithful,
+            cull: self.options.estimate.cull && !self.options.photons.faithful,
+            runs: self.options.estimate.runs && !self.options.photons.faithful,
             ..self.options.estimate.clone()
         };
         let compose = || {

@@ -7,6 +7,7 @@ use crate::gpu::{Bindings, DrawState, Gpu, Program, Query, Result, Target, TexFo
 use crate::photon::PhotonMap;
 use crate::scene::pack::SceneTextures;
 
+use super::search_work::{LaneUse, SearchWork};
 use super::{DirectLight, Image};
 
 /// How the search passes are drawn.
@@ -63,6 +64,15 @@ pub struct EstimateOptions {
     /// Which photons in the sphere may light the query point (default:
     /// visibility; README, "Light through walls").
     pub leak: LeakTest,
+    /// Skip cells beyond the search radius unopened (the same result, bit for
+    /// bit); false visits every cell of every ring, as the paper's search.
+    pub cull: bool,
+    /// Read a face row's cells as one range of photons in a sorted uniform
+    /// grid (the same result, bit for bit); false opens cells one by one.
+    pub runs: bool,
+    /// Read the search state back after every pass to measure divergence
+    /// (`SearchWork::lanes`); slows the search, so for profiles only.
+    pub profile_lanes: bool,
 }
 
 impl Default for EstimateOptions {
@@ -73,6 +83,9 @@ impl Default for EstimateOptions {
             max_passes: 100_000,
             float_addressing: false,
             leak: LeakTest::Visibility,
+            cull: true,
+            runs: true,
+            profile_lanes: false,
         }
     }
 }
@@ -90,6 +103,8 @@ pub struct EstimateStats {
     pub tiles: u64,
     pub gpu_seconds: f64,
     pub wall_seconds: f64,
+    /// Steps, photons examined and cells opened (and lane use, if profiled).
+    pub work: SearchWork,
 }
 
 /// The points a search serves: positions (w = 1 where a query exists) and
@@ -133,12 +148,13 @@ pub struct RadianceEstimate {
     height: u32,
 }
 
-type SearchKey = (bool, bool, bool, LeakTest);
+/// Routed map, tiles, float addressing, leak test, culling.
+type SearchKey = (bool, bool, bool, LeakTest, bool);
 
 /// The search program for a map kind, a way of drawing and a leak test.
 fn search_program(
     gpu: &Gpu,
-    (routed, tiles, float_addressing, leak): SearchKey,
+    (routed, tiles, float_addressing, leak, cull): SearchKey,
 ) -> Result<Program> {
     let mut defines: Vec<(&str, String)> = if routed {
         vec![("ROUTED", "1".into())]
@@ -149,6 +165,9 @@ fn search_program(
         defines.push(("FLOAT_ADDRESSING", "1".into()));
     }
     defines.extend(leak.defines());
+    if !cull {
+        defines.push(("NO_CULL", "1".into()));
+    }
     if tiles {
         defines.push(("TILED", "1".into()));
     }
@@ -193,7 +212,13 @@ impl RadianceEstimate {
     ) -> Result<std::rc::Rc<Program>> {
         let routed = matches!(map, PhotonMap::Routed(_));
         let tiled = matches!(options.mode, EstimateMode::Tiled { .. });
-        let key = (routed, tiled, options.float_addressing, options.leak);
+        let key = (
+            routed,
+            tiled,
+            options.float_addressing,
+            options.leak,
+            options.cull,
+        );
         if let Some(p) = self.search.borrow().get(&key) {
             return Ok(p.clone());
         }
@@ -233,12 +258,14 @@ impl RadianceEstimate {
             k,
             max_radius,
             budget: options.budget,
+            runs: options.runs,
         };
         let mut tiles = Tiles::new(options.mode, self.width, self.height);
         stats.tiles = tiles.count as u64;
         let queries: Vec<Query> = (0..tiles.count.max(1))
             .map(|_| Query::occlusion(&self.gpu))
             .collect::<Result<_>>()?;
+        let mut lanes = options.profile_lanes.then(LaneUse::default);
         for pass in 0..options.max_passes {
             crate::interrupt::check()?;
             timer.begin();
@@ -263,6 +290,9 @@ impl RadianceEstimate {
             }
             stats.passes = pass + 1;
             stats.searching_per_pass.push(searching);
+            if let Some(lanes) = &mut lanes {
+                lanes.add_pass(&self.done.read_i32(), self.width as usize);
+            }
             on_pass(&PassReport {
                 pass,
                 searching,
@@ -274,6 +304,9 @@ impl RadianceEstimate {
         self.gpu.check("radiance estimate")?;
         self.gpu.finish();
         stats.wall_seconds = wall.elapsed().as_secs_f64();
+        // Read after the clock stops: the counters are not the search's work.
+        stats.work = SearchWork::from_done(&self.done.read_i32());
+        stats.work.lanes = lanes;
         Ok(stats)
     }
 
@@ -286,7 +319,8 @@ impl RadianceEstimate {
                     .texture("u_map_power", &m.power)
                     .texture("u_grid_first", &m.grid_first)
                     .int("u_grid_width", m.grid_width as i32)
-                    .int("u_sorted_width", m.position.width as i32);
+                    .int("u_sorted_width", m.position.width as i32)
+                    .int("u_cell_runs", q.runs as i32);
             }
             PhotonMap::Routed(m) => {
                 b.texture("u_map_position", &m.position)
@@ -406,6 +440,7 @@ struct SearchQuery<'a> {
     k: u32,
     max_radius: f32,
     budget: u32,
+    runs: bool,
 }
 
 /// The tiles of tiled mode (section 3.3): those still searching are drawn,
