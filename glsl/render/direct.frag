@@ -5,7 +5,8 @@
 // blending: one call per batch of shadow samples adds its share. It also records
 // the first diffuse hit of each eye path, where the radiance estimate will add
 // indirect light and caustics: an eye path ends at its diffuse hit, so each
-// pixel's record is written once and the blend onto zero copies it.
+// pixel's record is written once and the blend onto zero copies it. Later
+// batches of a depth draw into the radiance target alone.
 #include "common/scene.glsl"
 #include "common/random.glsl"
 
@@ -30,19 +31,29 @@ layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the
 // Where shadow sample s of area light l lands: the point q, the light's
 // unit normal there, and the light's area (its pdf is 1 / area). Strata are
 // (su, sv); a LIGHT_TRIANGLES light picks its triangle with su.
-vec3 area_light_point(int l, float su, float sv, out vec3 light_normal, out float area) {
+// A parallelogram light's corner, edges and normal, read once per pixel,
+// not once per sample.
+struct AreaLight { bool triangles; vec3 a, e1, e2, normal; float area; };
+
+AreaLight area_light(int l) {
     vec4 head = light_texel(l, 0);
-    if (int(head.x) == LIGHT_TRIANGLES) {
+    AreaLight L;
+    L.triangles = int(head.x) == LIGHT_TRIANGLES;
+    L.a = light_texel(l, 1).xyz;
+    L.e1 = light_texel(l, 2).xyz;
+    L.e2 = light_texel(l, 3).xyz;
+    L.normal = head.yzw;
+    L.area = L.triangles ? light_texel(l, 1).z : length(cross(L.e1, L.e2));
+    return L;
+}
+
+vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal) {
+    if (L.triangles) {
         int prim;
-        area = light_texel(l, 1).z;
         return sample_light_triangle(l, su, sv, light_normal, prim);
     }
-    vec3 a = light_texel(l, 1).xyz;
-    vec3 e1 = light_texel(l, 2).xyz;
-    vec3 e2 = light_texel(l, 3).xyz;
-    light_normal = head.yzw;
-    area = length(cross(e1, e2));
-    return a + su * e1 + sv * e2;
+    light_normal = L.normal;
+    return L.a + su * L.e1 + sv * L.e2;
 }
 
 void main() {
@@ -53,7 +64,9 @@ void main() {
     o_diffuse_throughput = vec4(0.0);
     vec4 hp = texelFetch(u_hit_position, px, 0);
     vec4 ht = texelFetch(u_hit_throughput, px, 0);
-    if (hp.w < 0.0 || ht.w == 0.0) return;
+    // Nothing to add (the blend would add zeros): discard, which skips the
+    // blend's read and write of every target.
+    if (hp.w < 0.0 || ht.w == 0.0) discard;
     int mat = int(hp.w);
     int kind = material_kind(mat);
     vec3 d = texelFetch(u_hit_direction, px, 0).xyz;
@@ -62,6 +75,7 @@ void main() {
     bool first_batch = u_sample_begin == 0;
 
     if (kind == MAT_EMITTER) {
+        if (!first_batch) discard;
         // One-sided: radiance leaves on the side of the light's normal only
         // (.w = 1: the primitive's own front face, its geometric normal).
         vec4 ln = material_texel(mat, 2);
@@ -70,7 +84,7 @@ void main() {
             o_radiance = vec4(ht.rgb * material_texel(mat, 1).rgb, 0.0);
         return;
     }
-    if (kind != MAT_DIFFUSE) return;
+    if (kind != MAT_DIFFUSE) discard;
 
     vec3 nf = dot(n, d) < 0.0 ? n : -n; // one BRDF on both sides: shade the side seen
     vec3 p = hp.xyz;
@@ -103,14 +117,14 @@ void main() {
         }
         vec3 emitted = light_texel(l, 4).rgb;
         vec3 light_sum = vec3(0.0);
-        float area = 0.0;
+        AreaLight L = area_light(l);
         for (int s = u_sample_begin; s < u_sample_end; ++s) {
             uint rng = rng_init(u_seed, uvec2(px),
                                 0x40000000u | (uint(u_depth) << 24) | (uint(l) << 12) | uint(s));
             float su = (float(s % u_strata_x) + rng_next(rng)) / float(u_strata_x);
             float sv = (float(s / u_strata_x) + rng_next(rng)) / float(strata_y);
             vec3 light_normal;
-            vec3 q = area_light_point(l, su, sv, light_normal, area);
+            vec3 q = area_light_point(l, L, su, sv, light_normal);
             vec3 to_light = q - origin;
             float dist = length(to_light);
             vec3 wi = to_light / dist;
@@ -122,7 +136,7 @@ void main() {
             float cos_s = shaded ? max(dot(nsf, wi), 0.0) : cos_x;
             light_sum += emitted * (cos_s * cos_l / (dist * dist));
         }
-        sum += light_sum * (area / float(u_shadow_rays));
+        sum += light_sum * (L.area / float(u_shadow_rays));
     }
     o_radiance = vec4(ht.rgb * (albedo / PI) * sum, 0.0);
     if (first_batch) {

@@ -44,29 +44,40 @@ struct Variant {
     apply: fn(&mut EstimateOptions),
 }
 
-const VARIANTS: [Variant; 3] = [
+const VARIANTS: [Variant; 5] = [
     Variant {
         label: "paper",
         what: "every cell of every ring opened, one by one (the paper's search)",
         apply: |o| {
-            o.cull = false;
-            o.runs = false;
+            (o.cull, o.runs, o.budget) = (false, false, 64);
         },
     },
     Variant {
         label: "culled",
         what: "cells, rows and planes beyond the search radius skipped unopened",
         apply: |o| {
-            o.cull = true;
-            o.runs = false;
+            (o.cull, o.runs, o.budget) = (true, false, 64);
         },
     },
     Variant {
         label: "culled + runs",
         what: "and a face row's cells read as one range of photons (sorted map)",
         apply: |o| {
-            o.cull = true;
-            o.runs = true;
+            (o.cull, o.runs, o.budget) = (true, true, 64);
+        },
+    },
+    Variant {
+        label: "... 128 steps a pass",
+        what: "and 128 steps a pixel a pass, not 64: half the passes",
+        apply: |o| {
+            (o.cull, o.runs, o.budget) = (true, true, 128);
+        },
+    },
+    Variant {
+        label: "... 256 steps a pass",
+        what: "and 256 steps a pixel a pass: a quarter of the passes",
+        apply: |o| {
+            (o.cull, o.runs, o.budget) = (true, true, 256);
         },
     },
 ];

@@ -16,6 +16,8 @@ pub struct DirectLight {
     /// Path throughput up to that hit, w = the primitive hit.
     pub diffuse_throughput: Texture,
     pub(crate) target: Target,
+    /// The radiance alone: a depth's later batches add only light.
+    radiance_target: Target,
     program: Program,
 }
 
@@ -35,7 +37,9 @@ impl DirectLight {
                 &diffuse_throughput,
             ],
         )?;
+        let radiance_target = Target::new(gpu, &[&radiance])?;
         Ok(Self {
+            radiance_target,
             radiance,
             diffuse_position,
             diffuse_normal,
@@ -72,8 +76,13 @@ impl DirectLight {
             .int("u_strata_x", nx as i32)
             .int("u_sample_begin", samples.start as i32)
             .int("u_sample_end", samples.end as i32)
-            .int("u_light_sampling", light_sampling as i32)
-            .draw_fullscreen(&self.target, &DrawState::ADDITIVE)
+            .int("u_light_sampling", light_sampling as i32);
+        let target = if samples.start == 0 {
+            &self.target
+        } else {
+            &self.radiance_target
+        };
+        b.draw_fullscreen(target, &DrawState::ADDITIVE)
     }
 
     /// The first diffuse hits, as the radiance estimate's queries.

@@ -50,7 +50,8 @@ pub struct RenderOptions {
     pub seed: u32,
     pub width: u32,
     pub height: u32,
-    /// Shadow samples per area light drawn in one pass (bounds work per pass).
+    /// Shadow samples per area light drawn in one pass (bounds work per
+    /// pass); 0 chooses by image size (`PassPlan::new`).
     pub shadow_batch: u32,
     /// Eye samples per pixel: 1 (the paper) shoots through the pixel centre;
     /// more are stratified, jittered and box-filtered.
@@ -87,7 +88,7 @@ impl RenderOptions {
             seed: 1,
             width: scene.camera.width,
             height: scene.camera.height,
-            shadow_batch: 8,
+            shadow_batch: 0,
             spp: 1,
             global: Some(GlobalIllumination::default()),
         }

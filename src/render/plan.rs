@@ -31,6 +31,9 @@ pub struct PassPlan {
     pub light_sampling: bool,
 }
 
+/// Shadow rays one pass draws at most, when the batch is chosen by image size.
+pub const SHADOW_RAYS_PER_PASS: u64 = 1 << 23;
+
 impl PassPlan {
     pub fn new(scene: &Scene, options: &RenderOptions) -> Self {
         let specular = scene.has_specular();
@@ -38,7 +41,17 @@ impl PassPlan {
             .lights
             .iter()
             .any(|l| matches!(l, Light::Area { .. } | Light::Triangles { .. }));
-        let shadow_batch = options.shadow_batch.max(1);
+        let shadow_batch = match options.shadow_batch {
+            // A pass of about SHADOW_RAYS_PER_PASS rays, at least 8 a pixel:
+            // each pass costs more than its rays (a full-screen draw that
+            // every later depth repeats), so the paper's 32 shadow rays at
+            // 512 x 512 go in one pass, not four.
+            0 => {
+                let pixels = (options.width as u64 * options.height as u64).max(1);
+                (SHADOW_RAYS_PER_PASS / pixels).clamp(8, u32::MAX as u64) as u32
+            }
+            n => n,
+        };
         Self {
             width: options.width,
             height: options.height,
