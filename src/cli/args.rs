@@ -103,8 +103,8 @@ pub struct EstimateArgs {
     #[arg(long, value_name = "N", value_parser = in_range(1, 100_000))]
     pub mask: Option<u32>,
     /// Steps per pixel per pass, a step being one photon examined or one
-    /// cell moved (1..=100000).
-    #[arg(long, default_value_t = 64, value_parser = in_range(1, 100_000))]
+    /// range of cells opened (1..=100000).
+    #[arg(long, default_value_t = DEFAULT_BUDGET, value_parser = in_range(1, 100_000))]
     pub budget: u32,
     /// Which photons in the search sphere may light a pixel: all (none, the
     /// paper's; light leaks through walls thinner than the radius), those near
@@ -119,13 +119,15 @@ pub struct EstimateArgs {
     pub paper_search: bool,
 }
 
+const DEFAULT_BUDGET: u32 = photonmap::render::radiance_estimate::DEFAULT_BUDGET;
+
 impl EstimateArgs {
     /// The first switch given that only the kNN estimate reads.
     pub fn switch_given(&self) -> Option<&'static str> {
         [
             (self.tile != 16, "--tile"),
             (self.mask.is_some(), "--mask"),
-            (self.budget != 64, "--budget"),
+            (self.budget != DEFAULT_BUDGET, "--budget"),
             (self.leak_test != LeakTest::Visibility, "--leak-test"),
             (self.paper_search, "--paper-search"),
         ]

@@ -67,7 +67,7 @@ const VARIANTS: [Variant; 5] = [
         },
     },
     Variant {
-        label: "... 128 steps a pass",
+        label: "... 128 steps a pass (default)",
         what: "and 128 steps a pixel a pass, not 64: half the passes",
         apply: |o| {
             (o.cull, o.runs, o.budget) = (true, true, 128);
