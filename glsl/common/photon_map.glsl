@@ -78,3 +78,26 @@ ivec2 photon_texel(int base, int i) {
     return texel_of_index(base + i, u_sorted_width);
 #endif
 }
+
+// The corner of the block that a range's photons fill (stencil routing's
+// m x m block of the slot), for photon_texel_next.
+ivec2 photon_block_origin(int base) {
+#ifdef ROUTED
+    return texel_of_index(base, u_blocks_per_row) * u_block;
+#else
+    return ivec2(0);
+#endif
+}
+
+// The texel of a range's next photon, from its previous one's, without the
+// divisions of photon_texel (SIMD lanes pay dearly for them): the next texel
+// of the row in the sorted map; in stencil routing, whose slots count down
+// row by row within the block at `origin`, the one before.
+ivec2 photon_texel_next(ivec2 previous, ivec2 origin) {
+#ifdef ROUTED
+    return previous.x > origin.x ? ivec2(previous.x - 1, previous.y)
+                                 : ivec2(origin.x + u_block - 1, previous.y - 1);
+#else
+    return previous.x + 1 < u_sorted_width ? ivec2(previous.x + 1, previous.y) : ivec2(0, previous.y + 1);
+#endif
+}

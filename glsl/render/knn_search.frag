@@ -176,8 +176,9 @@ void main() {
         if (p >= count) { j += last - cell.x + 1; p = 0; continue; }
         // The range's photons, one a step; by default in a loop of their own,
         // so the lanes of a SIMD group run this tight body, not the whole step.
+        ivec2 t = photon_texel(base, p);
+        ivec2 origin = photon_block_origin(base);
         while (true) {
-            ivec2 t = photon_texel(base, p);
             vec3 photon = texelFetch(u_map_position, t, 0).xyz;
             vec3 offset = photon - x;
             float dist2 = dot(offset, offset);
@@ -204,6 +205,7 @@ void main() {
             if (p >= count || step + 1 >= u_budget) break;
             step += 1;
             steps += 1;
+            t = photon_texel_next(t, origin);
 #endif
         }
 #ifndef NO_CULL
