@@ -1544,10 +1544,14 @@ fn differentials_run_and_refuse_what_they_cannot_do() {
         "{sample}"
     );
     assert!(sample["passes"].as_u64().unwrap() >= 1);
-    let refused: [(&[&str], &str); 9] = [
+    let refused: [(&[&str], &str); 10] = [
         (&["--leaf-size", "8"], "--method differentials"),
         (&["--method", "differentials", "--grid", "hash"], "--grid"),
         (&["--method", "differentials", "--tile", "8"], "--tile"),
+        (
+            &["--method", "differentials", "--paper-search"],
+            "--paper-search",
+        ),
         (
             &["--method", "sppm", "--smoothing", "3"],
             "photon differentials'",
