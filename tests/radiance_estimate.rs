@@ -17,6 +17,18 @@ fn render_gi(
     mode: EstimateMode,
 ) -> RenderOutput {
     let gpu = common::gpu();
+    let o = gi_options(scene, width, height, build, mode);
+    render(&gpu, scene, &o, &mut ()).unwrap()
+}
+
+/// The paper's estimate (no leak test) with `build`, at width x height.
+fn gi_options(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    build: BuildMethod,
+    mode: EstimateMode,
+) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (width, height, 3);
     let mut gi = GlobalIllumination {
@@ -32,7 +44,7 @@ fn render_gi(
     // reference compute (the leak tests have their own test below).
     gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
     o.global = Some(gi);
-    render(&gpu, scene, &o, &mut ()).unwrap()
+    o
 }
 
 /// Per query pixel: (position, GPU flux, GPU r^2, GPU accepted).
@@ -453,18 +465,9 @@ fn culled_searches_end_in_the_paper_search_s_state_bit_for_bit() {
             let mut states = Vec::new();
             for (cull, runs) in [(false, false), (true, false), (true, true)] {
                 let gpu = common::gpu();
-                let mut o = RenderOptions::for_scene(&scene);
-                (o.width, o.height, o.seed) = (w, h, 3);
-                let mut gi = GlobalIllumination {
-                    photons: PhotonConfig {
-                        build,
-                        ..PhotonConfig::default()
-                    },
-                    ..GlobalIllumination::default()
-                };
-                gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
+                let mut o = gi_options(&scene, w, h, build, EstimateMode::Tiled { tile: 16 });
+                let gi = o.global.as_mut().unwrap();
                 (gi.estimate.cull, gi.estimate.runs) = (cull, runs);
-                o.global = Some(gi);
                 let out = render(&gpu, &scene, &o, &mut ()).unwrap();
                 // Read now: the next render makes its own context current.
                 let est = out.state.estimate.as_ref().unwrap();

@@ -54,6 +54,13 @@ layout(location = 2) out ivec4 o_done;
 
 const int SKIPS_PER_STEP = 64;
 
+// Per axis, how far x lies outside `cell`'s box, less the slack for rounding
+// (0 inside): the box's squared distance is its dot with itself.
+vec3 cell_gap(ivec3 cell, vec3 x, vec3 cell_size) {
+    vec3 lo = u_grid_min + vec3(cell) * cell_size;
+    return max(max(lo - x, x - lo - cell_size) - CULL_SLACK * cell_size, 0.0);
+}
+
 // Moves cursor j of shell `ring` past cells that can hold no candidate;
 // returns whether it moved (false: the cell at j is to be opened). One call
 // skips one run: a plane, a row, or cells of a row.
@@ -75,8 +82,7 @@ bool skip_empty(inout int j, int ring, ivec3 c0, vec3 x, vec3 cell_size, float r
     // Beyond the reach: the cell's box (less a slack for rounding) farther
     // than it, and with it the whole plane or row when those are, or the
     // cells of the row before the first within it.
-    vec3 lo = u_grid_min + vec3(cell) * cell_size;
-    vec3 gap = max(max(lo - x, x - lo - cell_size) - CULL_SLACK * cell_size, 0.0);
+    vec3 gap = cell_gap(cell, x, cell_size);
     float gap_yz2 = gap.y * gap.y + gap.z * gap.z;
     if (gap.z * gap.z > reach2) { j = (d.z + ring + 1) * plane; return true; }
     if (gap_yz2 > reach2) { j = (j / side + 1) * side; return true; }
@@ -161,8 +167,7 @@ void main() {
         if (u_cell_runs != 0 && u_hash_buckets == 0 && (abs(d.y) == ring || abs(d.z) == ring)) {
             last = min(c0.x + ring, u_grid_resolution.x - 1);
 #ifndef NO_CULL
-            vec3 lo = u_grid_min + vec3(cell) * cell_size;
-            vec2 gap_yz = max(max(lo.yz - x.yz, x.yz - lo.yz - cell_size.yz) - CULL_SLACK * cell_size.yz, 0.0);
+            vec2 gap_yz = cell_gap(cell, x, cell_size).yz;
             float reach_x = sqrt(max(reach2 - dot(gap_yz, gap_yz), 0.0));
             last = min(last, int(floor((x.x + reach_x - u_grid_min.x) / cell_size.x)) + 1);
 #endif

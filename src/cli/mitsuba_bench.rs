@@ -87,19 +87,14 @@ pub struct MitsubaBench {
 /// A material's triangles: (material, vertices, faces).
 type MeshOf = (usize, Vec<[f32; 3]>, Vec<[u32; 3]>);
 
-/// The scene as `mitsuba_render.py` reads it, at `width` x `height`.
-pub fn export(scene: &Scene, width: u32, height: u32, max_depth: u32) -> serde_json::Value {
+/// The scene's shapes as the script reads them: planar shapes become one
+/// triangle mesh per material (an emitter's triangles wound so that their
+/// front faces its emitting side); spheres and cylinders stay analytic.
+fn shapes(
+    scene: &Scene,
+    material: &dyn Fn(usize) -> serde_json::Value,
+) -> (Vec<MeshOf>, Vec<serde_json::Value>, Vec<serde_json::Value>) {
     let v = |p: glam::Vec3| [p.x, p.y, p.z];
-    let material = |m: usize| match scene.materials[m] {
-        Material::Diffuse { albedo } => json!({"type": "diffuse", "albedo": v(albedo)}),
-        Material::Mirror { reflectance } => {
-            json!({"type": "mirror", "reflectance": v(reflectance)})
-        }
-        Material::Glass { ior } => json!({"type": "glass", "ior": ior}),
-        Material::Emitter { radiance, .. } => json!({"type": "emitter", "radiance": v(radiance)}),
-    };
-    // Planar shapes become one triangle mesh per material; an emitter's
-    // triangles wound so that their front faces its emitting side.
     let mut meshes: Vec<MeshOf> = Vec::new();
     let (mut spheres, mut cylinders) = (Vec::new(), Vec::new());
     for shape in &scene.shapes {
@@ -150,6 +145,21 @@ pub fn export(scene: &Scene, width: u32, height: u32, max_depth: u32) -> serde_j
             mesh.2.push([first, first + 1, first + 2]);
         }
     }
+    (meshes, spheres, cylinders)
+}
+
+/// The scene as `mitsuba_render.py` reads it, at `width` x `height`.
+pub fn export(scene: &Scene, width: u32, height: u32, max_depth: u32) -> serde_json::Value {
+    let v = |p: glam::Vec3| [p.x, p.y, p.z];
+    let material = |m: usize| match scene.materials[m] {
+        Material::Diffuse { albedo } => json!({"type": "diffuse", "albedo": v(albedo)}),
+        Material::Mirror { reflectance } => {
+            json!({"type": "mirror", "reflectance": v(reflectance)})
+        }
+        Material::Glass { ior } => json!({"type": "glass", "ior": ior}),
+        Material::Emitter { radiance, .. } => json!({"type": "emitter", "radiance": v(radiance)}),
+    };
+    let (meshes, spheres, cylinders) = shapes(scene, &material);
     let points: Vec<_> = scene
         .lights
         .iter()
@@ -227,13 +237,7 @@ fn render_mitsuba(
             tail.into_iter().rev().collect::<Vec<_>>().join("\n")
         );
     }
-    let report: serde_json::Value = serde_json::from_slice(
-        run.stdout
-            .split(|&b| b == b'\n')
-            .rfind(|l| l.starts_with(b"{"))
-            .unwrap_or_default(),
-    )
-    .context("Mitsuba's report line")?;
+    let report = report_line(&run.stdout)?;
     let image = Image::read_exr(&exr)?;
     let _ = std::fs::remove_file(&exr);
     Ok((
@@ -241,6 +245,15 @@ fn render_mitsuba(
         report["seconds"].as_f64().unwrap_or(f64::NAN),
         report["spp"].as_u64().unwrap_or(0) as u32,
     ))
+}
+
+/// The script's report: its last line of stdout that is a JSON object.
+fn report_line(stdout: &[u8]) -> Result<serde_json::Value> {
+    let line = stdout
+        .split(|&b| b == b'\n')
+        .rfind(|l| l.first() == Some(&b'{'))
+        .unwrap_or_default();
+    serde_json::from_slice(line).context("Mitsuba's report line")
 }
 
 const EXPORT_FILE: &str = "export.json";

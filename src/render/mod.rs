@@ -82,6 +82,20 @@ pub struct GlobalIllumination {
     pub radiosity: Option<RadiosityOptions>,
 }
 
+impl GlobalIllumination {
+    /// The estimate's options as the photon config constrains them: under
+    /// `--faithful`, the paper's float addressing and the paper's walk.
+    fn estimate_options(&self) -> EstimateOptions {
+        let faithful = self.photons.faithful;
+        EstimateOptions {
+            float_addressing: faithful,
+            cull: self.estimate.cull && !faithful,
+            runs: self.estimate.runs && !faithful,
+            ..self.estimate.clone()
+        }
+    }
+}
+
 impl RenderOptions {
     pub fn for_scene(scene: &Scene) -> Self {
         Self {
@@ -974,11 +988,8 @@ impl GatherRun<'_> {
             .as_ref()
             .expect("a gather run has final-gather options");
         let estimate = EstimateOptions {
-            float_addressing: self.options.photons.faithful,
-            cull: self.options.estimate.cull && !self.options.photons.faithful,
-            runs: self.options.estimate.runs && !self.options.photons.faithful,
             leak: fg.leak,
-            ..self.options.estimate.clone()
+            ..self.options.estimate_options()
         };
         let at = self.at;
         self.gather.run(
@@ -1100,12 +1111,7 @@ impl EstimateRun<'_> {
         observer: &mut dyn RenderObserver,
     ) -> Result<(Option<Image>, EstimateStats)> {
         let (k, max_radius) = (self.scene.photon_map.k, self.scene.photon_map.max_radius);
-        let options = EstimateOptions {
-            float_addressing: self.options.photons.faithful,
-            cull: self.options.estimate.cull && !self.options.photons.faithful,
-            runs: self.options.estimate.runs && !self.options.photons.faithful,
-            ..self.options.estimate.clone()
-        };
+        let options = self.options.estimate_options();
         let compose = || {
             self.estimate
                 .compose(self.textures, self.direct, k, max_radius, true, true)
