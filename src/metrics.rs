@@ -15,25 +15,42 @@ pub struct Metrics {
     /// Mean structural similarity of sRGB luminance (11 x 11 Gaussian window,
     /// sigma 1.5, K1 = 0.01, K2 = 0.03): 1 is identical.
     pub ssim: f64,
+    /// RMSE over the mean of the reference (both over the pixels compared):
+    /// the relative error that independent ground truth is quoted in.
+    pub rel_rmse: f64,
+    /// Mean of `a` over the mean of the reference, same pixels: 1 conserves energy.
+    pub energy: f64,
     pub pixels_compared: usize,
 }
 
-/// Sums over the kept pixels' channels of (a - b)^2 and (a - b)^2 / (b^2 +
-/// 0.01), and the pixels kept.
-fn squared_errors(a: &Image, b: &Image, keep: impl Fn(usize) -> bool) -> (f64, f64, usize) {
-    let (mut se, mut rel, mut n) = (0f64, 0f64, 0usize);
+/// Sums over the kept pixels' channels.
+#[derive(Default)]
+struct Sums {
+    /// (a - b)^2
+    se: f64,
+    /// (a - b)^2 / (b^2 + 0.01)
+    rel: f64,
+    a: f64,
+    b: f64,
+    pixels: usize,
+}
+
+fn squared_errors(a: &Image, b: &Image, keep: impl Fn(usize) -> bool) -> Sums {
+    let mut s = Sums::default();
     for (i, (p, q)) in a.pixels.iter().zip(&b.pixels).enumerate() {
         if !keep(i) {
             continue;
         }
         for c in 0..3 {
             let d = p[c] as f64 - q[c] as f64;
-            se += d * d;
-            rel += d * d / (q[c] as f64 * q[c] as f64 + 0.01);
+            s.se += d * d;
+            s.rel += d * d / (q[c] as f64 * q[c] as f64 + 0.01);
+            s.a += p[c] as f64;
+            s.b += q[c] as f64;
         }
-        n += 1;
+        s.pixels += 1;
     }
-    (se, rel, n)
+    s
 }
 
 fn same_size(a: &Image, b: &Image) -> Result<()> {
@@ -51,8 +68,8 @@ fn same_size(a: &Image, b: &Image) -> Result<()> {
 /// RMSE of linear RGB alone (no SSIM): for tests and noise figures.
 pub fn rmse(a: &Image, b: &Image) -> Result<f64> {
     same_size(a, b)?;
-    let (se, _, n) = squared_errors(a, b, |_| true);
-    Ok((se / (n.max(1) * 3) as f64).sqrt())
+    let s = squared_errors(a, b, |_| true);
+    Ok((s.se / (s.pixels.max(1) * 3) as f64).sqrt())
 }
 
 /// Compares `a` with the reference `b`; `mask` (same size) keeps pixels where it is true.
@@ -68,7 +85,8 @@ pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics> {
         }
     }
     let keep = |i: usize| mask.is_none_or(|m| m[i]);
-    let (se, rel, n) = squared_errors(a, b, keep);
+    let s = squared_errors(a, b, keep);
+    let n = s.pixels;
     if n == 0 {
         return Err(Error::InvalidOption("the mask keeps no pixel".into()));
     }
@@ -80,10 +98,14 @@ pub fn compare(a: &Image, b: &Image, mask: Option<&[bool]>) -> Result<Metrics> {
         .map(|(_, v)| *v)
         .sum::<f64>()
         / n as f64;
+    let rmse = (s.se / (3 * n) as f64).sqrt();
+    let mean_b = s.b / (3 * n) as f64;
     Ok(Metrics {
-        rmse: (se / (3 * n) as f64).sqrt(),
-        rel_mse: rel / (3 * n) as f64,
+        rmse,
+        rel_mse: s.rel / (3 * n) as f64,
         ssim,
+        rel_rmse: rmse / mean_b,
+        energy: s.a / s.b,
         pixels_compared: n,
     })
 }

@@ -53,6 +53,10 @@ struct Report {
     pixels_compared: usize,
     rmse: f64,
     rel_mse: f64,
+    /// RMSE over the reference's mean (how ground truth is quoted).
+    rel_rmse: f64,
+    /// The image's mean over the reference's, same pixels.
+    energy: f64,
     ssim: f64,
     flip: f64,
     /// Percentage of pixels with a channel beyond --fail (when given).
@@ -131,6 +135,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         pixels_compared: metrics.pixels_compared,
         rmse: metrics.rmse,
         rel_mse: metrics.rel_mse,
+        rel_rmse: metrics.rel_rmse,
+        energy: metrics.energy,
         ssim: metrics.ssim,
         flip,
         percent_beyond,
@@ -144,6 +150,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         println!("pixels compared  {}", report.pixels_compared);
         println!("RMSE (linear)    {:.6}", report.rmse);
         println!("relative MSE     {:.6}", report.rel_mse);
+        println!("RMSE / mean      {:.6}", report.rel_rmse);
+        println!("energy ratio     {:.6}", report.energy);
         println!("SSIM (luminance) {:.6}", report.ssim);
         println!("FLIP (mean)      {:.6}", report.flip);
         if let Some(p) = report.percent_beyond {
