@@ -1663,6 +1663,46 @@ fn bench_mitsuba_and_tables_refuse_what_they_cannot_do() {
     assert_refused(&out, "--table1-only needs --out");
 }
 
+/// `bench mitsuba` refuses a budget that is not a positive number of
+/// seconds, a --reference or --mask that is not there, and a mask of another
+/// size, before it runs Mitsuba or writes anything.
+#[test]
+fn bench_mitsuba_refuses_bad_budgets_references_and_masks() {
+    let d = tmp("bench-mitsuba");
+    let out_dir = d.join("out");
+    let refused: [(&[&str], &str); 5] = [
+        (&["--seconds", "0"], "--seconds"),
+        (&["--seconds", "30,-1"], "--seconds"),
+        (
+            &["--reference", "/nonexistent/truth.exr"],
+            "/nonexistent/truth.exr",
+        ),
+        (
+            &["--mask", "/nonexistent/mask.png"],
+            "/nonexistent/mask.png",
+        ),
+        (
+            &[
+                "--mask",
+                "reference_images/truth/cornell_box_interior_mask.png",
+            ],
+            "256 x 256",
+        ),
+    ];
+    for (args, says) in refused {
+        let out = photonmap()
+            .args(["bench", "mitsuba", "--scene", "glass_ball", "--quiet"])
+            .args(["--python", "/nonexistent/python3", "--out"])
+            .arg(&out_dir)
+            .args(args)
+            .current_dir(common::root())
+            .output()
+            .unwrap();
+        assert_refused(&out, says);
+        assert!(!out_dir.exists(), "{args:?} wrote {}", out_dir.display());
+    }
+}
+
 /// `bench differentials --quick` on RING: both methods, the leaf sizes with
 /// the automatic one last, and the footprint scales each beside the
 /// kNN-grid at the k_PD they reached; errors against the SPPM reference.

@@ -184,7 +184,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
 }
 
 /// A PNG mask of the image's size: bright pixels count.
-fn read_mask(path: &std::path::Path, image: &Image) -> Result<Vec<bool>> {
+pub(crate) fn read_mask(path: &std::path::Path, image: &Image) -> Result<Vec<bool>> {
     let m = ::image::open(path)
         .map_err(|e| anyhow!("cannot read the mask {}: {e}", path.display()))?
         .to_luma8();

@@ -2,16 +2,22 @@
 """Renders a scene exported by `photonmap bench mitsuba` with Mitsuba 3 for a
 wall-clock budget, and writes the image as linear EXR.
 
-Usage: mitsuba_render.py EXPORT.json BUDGET_SECONDS OUT.exr INTEGRATOR VARIANT
+Usage: mitsuba_render.py EXPORT.json BUDGET_SECONDS OUT.exr INTEGRATOR VARIANT [CHECKPOINTS]
 
 The clock starts before the first render call (so Mitsuba's JIT compilation
-counts, as a user would wait for it) and stops after the batch that crosses
-the budget; importing Mitsuba and loading the scene do not count. Batches of
-`batch` samples per pixel with distinct seeds are averaged. Prints one JSON
-line: {"seconds": ..., "spp": ..., "load_seconds": ...}.
+counts, as a user would wait for it) and stops after the pass that crosses
+the budget; importing Mitsuba and loading the scene do not count. Passes
+with distinct seeds are accumulated: `batch` samples per pixel at first,
+doubled (up to 64) after each pass that took under a quarter second.
+CHECKPOINTS (comma-separated seconds, optional) writes the running mean as
+OUT-without-.exr + "_<k>.exr" after the first pass that crosses each; the
+clock does not count writing them. Prints one JSON line: {"seconds": ...,
+"spp": ..., "load_seconds": ..., "checkpoints": [{"seconds", "spp",
+"file"}, ...]}.
 """
 import json
 import os
+import shutil
 import struct
 import sys
 import tempfile
@@ -47,6 +53,7 @@ def bsdf(m):
 
 def main():
     export, budget, out, integrator, variant = sys.argv[1:6]
+    checkpoints = sys.argv[6] if len(sys.argv) > 6 else ""
     budget = float(budget)
     import mitsuba as mi
     mi.set_variant(variant)
@@ -88,21 +95,38 @@ def main():
     t = time.perf_counter()
     loaded = mi.load_dict(scene)
     load_seconds = time.perf_counter() - t
+    shutil.rmtree(folder, ignore_errors=True)
 
     batch = int(s.get("batch", 4))
-    total, spp, seed = None, 0, 0
+    marks = sorted(float(c) for c in checkpoints.split(",") if c) if checkpoints else []
+    written = []
+    total, spp, seed, paused = None, 0, 0, 0.0
     t0 = time.perf_counter()
     while True:
+        t1 = time.perf_counter()
         img = np.array(mi.render(loaded, spp=batch, seed=seed), dtype=np.float64)
         total = img * batch if total is None else total + img * batch
         spp += batch
         seed += 1
-        if time.perf_counter() - t0 >= budget:
+        # Fewer, larger passes once compiled: a pass's fixed cost is Mitsuba's
+        # to save, while one pass still overshoots the budget by little.
+        if seed > 1 and time.perf_counter() - t1 < 0.25 and batch < 64:
+            batch *= 2
+        elapsed = time.perf_counter() - t0 - paused
+        if elapsed >= budget:
             break
-    seconds = time.perf_counter() - t0
+        if marks and elapsed >= marks[0]:
+            t1 = time.perf_counter()
+            while marks and elapsed >= marks[0]:
+                marks.pop(0)
+            path = "%s_%d.exr" % (out[:-4] if out.endswith(".exr") else out, len(written))
+            mi.Bitmap((total / spp).astype(np.float32)).write(path)
+            written.append({"seconds": elapsed, "spp": spp, "file": path})
+            paused += time.perf_counter() - t1
+    seconds = time.perf_counter() - t0 - paused
     mi.Bitmap((total / spp).astype(np.float32)).write(out)
-    print(json.dumps({"seconds": seconds, "spp": spp, "load_seconds": load_seconds}))
-
+    print(json.dumps({"seconds": seconds, "spp": spp, "load_seconds": load_seconds,
+                      "checkpoints": written}))
 
 if __name__ == "__main__":
     main()
