@@ -557,7 +557,10 @@ fn reference_and_accuracy_bench_write_their_results() {
         (Some(64), Some(8), Some("sppm"))
     );
     assert!(info["residual_noise_rmse"].as_f64().unwrap() > 0.0);
-    assert!(info["residual_bias_rmse"].as_f64().unwrap() >= 0.0);
+    let bound = info["bias_bound_rmse_95"].as_f64().unwrap();
+    assert!(bound > 0.0 && bound >= info["bias_estimate_rmse"].as_f64().unwrap());
+    assert!(info["bias_resolved"].is_boolean() && info["bias_model"].is_string());
+    assert!(info.get("residual_bias_rmse").is_none());
     assert!(info["command"]
         .as_str()
         .unwrap()

@@ -3,11 +3,12 @@
 //! against truth and not against the paper's estimator itself. Two independent
 //! halves (their own seeds) are rendered; their mean is the reference, half
 //! their RMSE difference its remaining noise, and the change since a quarter of
-//! the iterations bounds its remaining bias.
+//! the iterations, extrapolated by SPPM's rate of convergence, estimates and
+//! bounds its remaining bias (see [`bias_bound`]).
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::{Deserialize, Serialize};
 
@@ -62,10 +63,11 @@ pub struct ReferenceInfo {
     pub alpha: f32,
     /// RMSE of the reference's remaining noise: half the RMSE between the halves.
     pub residual_noise_rmse: f64,
-    /// A bound on its remaining bias: SPPM's bias falls as i^-(1 - alpha), so
-    /// the change from i/4 to i iterations is (4^(1 - alpha) - 1) times the
-    /// bias left at i (noise removed).
-    pub residual_bias_rmse: f64,
+    /// Its remaining bias, estimated and bounded (see [`bias_bound`]). Absent
+    /// from references written before it was (their `residual_bias_rmse`, a
+    /// change clipped to 0 within the noise, is not read: it was no bound).
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub bias: Option<ReferenceBias>,
     pub seconds: f64,
     pub command: String,
     pub renderer: String,
@@ -100,11 +102,18 @@ pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
     let progress = super::progress_lines(a.quiet);
     let (img, info) = make_reference(&gpu, &scene, a, command, &progress)?;
     write_reference(&img, &info, &out)?;
+    let bias = info.bias.as_ref().expect("a new reference has its bias");
     eprintln!(
-        "wrote {} (remaining noise RMSE {:.5}, bias RMSE at most about {:.5})",
+        "wrote {} (remaining noise RMSE {:.5}; bias RMSE estimated {:.5}, at most {:.5} at 95%{})",
         out.display(),
         info.residual_noise_rmse,
-        info.residual_bias_rmse
+        bias.bias_estimate_rmse,
+        bias.bias_bound_rmse_95,
+        if bias.bias_resolved {
+            ""
+        } else {
+            "; not resolved from the noise, which sets the bound"
+        }
     );
     Ok(())
 }
@@ -169,11 +178,12 @@ pub fn make_reference(
         halves.push(run.image()?);
     }
     let noise = rmse(&halves[0], &halves[1])? / 2.0;
-    let quarter_noise = rmse(&quarters[0], &quarters[1])? / 2.0;
-    let (full, quarter) = (Image::average(&halves), Image::average(&quarters));
-    let change = rmse(&quarter, &full)?;
-    let change2 = (change * change - noise * noise - quarter_noise * quarter_noise).max(0.0);
-    let factor = 4f64.powf(1.0 - sppm.alpha as f64) - 1.0;
+    let bias = bias_bound(
+        [&quarters[0], &quarters[1]],
+        [&halves[0], &halves[1]],
+        sppm.alpha,
+    )?;
+    let full = Image::average(&halves);
     let info = ReferenceInfo {
         scene: scene.name.clone(),
         method: "sppm".into(),
@@ -184,12 +194,133 @@ pub fn make_reference(
         initial_radius,
         alpha: sppm.alpha,
         residual_noise_rmse: noise,
-        residual_bias_rmse: change2.sqrt() / factor,
+        bias: Some(bias),
         seconds: wall.elapsed().as_secs_f64(),
         command,
         renderer: gpu.capabilities().gl_renderer,
     };
     Ok((full, info))
+}
+
+/// A reference's remaining bias, estimated and bounded by [`bias_bound`].
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct ReferenceBias {
+    /// The RMSE over pixel-channels of the bias left at N iterations, from the
+    /// unbiased estimate of its mean square (0 where that is not positive).
+    pub bias_estimate_rmse: f64,
+    /// A one-sided 95% upper bound on that RMSE (the noise's own size where
+    /// the bias is not resolved; never 0 while there is noise).
+    pub bias_bound_rmse_95: f64,
+    /// Whether the bias is resolved from the noise: the 95% lower bound on its
+    /// mean square is above 0. If not, what was seen may be all noise, and
+    /// the bound is set by the noise's size.
+    pub bias_resolved: bool,
+    /// The unbiased estimate of the bias's mean square (may be negative).
+    pub bias_mse_estimate: f64,
+    /// Its standard error.
+    pub bias_mse_stderr: f64,
+    /// r / (1 - r), r = 4^-(1 - alpha): the bias left at N over the change
+    /// from N/4 to N.
+    pub bias_extrapolation: f64,
+    /// The model these figures assume.
+    pub bias_model: String,
+}
+
+/// Side in pixels of the tiles whose means give the standard error: pixels
+/// near each other share photons (a pixel's channels share all of theirs), so
+/// their noise is correlated and single pixels are not independent samples.
+const BIAS_TILE: u32 = 8;
+/// The standard normal's one-sided 95% point.
+const Z_95: f64 = 1.644_853_626_951_472_2;
+
+/// The bias left in a reference of two independent SPPM halves A and B at N
+/// iterations, from their images Q_A, Q_B at N/4 and F_A, F_B at N.
+///
+/// Model: a pixel's SPPM bias falls as beta(i) = c i^-(1 - alpha) (the radius
+/// shrinks so that R^2 ~ i^-(1 - alpha), and the bias of a smooth radiance
+/// goes as R^2), with the scheme's alpha, already from N/4 iterations on. Then
+/// with r = beta(N) / beta(N/4) = 4^-(1 - alpha), the change
+/// b = E[F - Q] = beta(N) (1 - 1/r), so the bias left at N is
+///
+///   beta(N) = -b r / (1 - r)            (r / (1 - r) = 1.94 at alpha = 0.7).
+///
+/// The noise: D_A = F_A - Q_A and D_B = F_B - Q_B are independent, each with
+/// mean b. (Q is a prefix of the same run as F, so the noise of the two is
+/// correlated, and D's noise is not var Q + var F; the halves give it
+/// directly.) D = (D_A + D_B) / 2 has E[D^2] = b^2 + var D, and
+/// ((D_A - D_B) / 2)^2 has mean var D, so per pixel-channel
+///
+///   u = D^2 - ((D_A - D_B) / 2)^2 = D_A D_B,   E[u] = b^2.
+///
+/// U, the mean of u over the M pixel-channels, is unbiased for the mean
+/// square of b. Its standard error comes from tiles of 8 x 8 pixels (all
+/// channels; single pixels where the image holds fewer than 16 such tiles),
+/// T tiles with sums S_t of n_t values:
+///
+///   SE^2 = T / (T - 1) * sum_t (S_t - n_t U)^2 / M^2.
+///
+/// With k = r / (1 - r) the bias's mean square at N is estimated by k^2 U, and
+///
+///   bias_estimate_rmse = k sqrt(max(U, 0)),
+///   bias_bound_rmse_95 = k sqrt(max(U, 0) + 1.645 SE)   (one-sided 95%),
+///   bias_resolved      = U - 1.645 SE > 0.
+///
+/// Flooring U at 0 in the bound only widens it, so that it is never below the
+/// noise's own size (a negative U is noise too).
+pub fn bias_bound(quarters: [&Image; 2], fulls: [&Image; 2], alpha: f32) -> Result<ReferenceBias> {
+    let (w, h) = (fulls[0].width, fulls[0].height);
+    if quarters
+        .iter()
+        .chain(&fulls)
+        .any(|i| (i.width, i.height) != (w, h) || i.pixels.len() != w as usize * h as usize)
+    {
+        bail!("the reference's four images are not all {w} x {h}");
+    }
+    if (w as u64) * (h as u64) < 2 {
+        bail!("a {w} x {h} reference is too small to estimate its bias");
+    }
+    let tile = if (w / BIAS_TILE) * (h / BIAS_TILE) >= 16 {
+        BIAS_TILE
+    } else {
+        1
+    };
+    let tiles_x = w.div_ceil(tile);
+    let mut tiles = vec![(0f64, 0f64); (tiles_x * h.div_ceil(tile)) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let t = &mut tiles[((y / tile) * tiles_x + x / tile) as usize];
+            for c in 0..3 {
+                let da = fulls[0].pixels[i][c] as f64 - quarters[0].pixels[i][c] as f64;
+                let db = fulls[1].pixels[i][c] as f64 - quarters[1].pixels[i][c] as f64;
+                t.0 += da * db;
+                t.1 += 1.0;
+            }
+        }
+    }
+    let m: f64 = tiles.iter().map(|t| t.1).sum();
+    let u = tiles.iter().map(|t| t.0).sum::<f64>() / m;
+    let count = tiles.len() as f64;
+    let spread: f64 = tiles.iter().map(|t| (t.0 - t.1 * u).powi(2)).sum();
+    let se = (count / (count - 1.0) * spread).sqrt() / m;
+    let r = 4f64.powf(-(1.0 - alpha as f64));
+    let k = r / (1.0 - r);
+    Ok(ReferenceBias {
+        bias_estimate_rmse: k * u.max(0.0).sqrt(),
+        bias_bound_rmse_95: k * (u.max(0.0) + Z_95 * se).sqrt(),
+        bias_resolved: u - Z_95 * se > 0.0,
+        bias_mse_estimate: k * k * u,
+        bias_mse_stderr: k * k * se,
+        bias_extrapolation: k,
+        bias_model: format!(
+            "SPPM's bias at iteration i is c i^-(1 - alpha) per pixel, alpha = {alpha} (the \
+             scheme's), from N/4 iterations on; so the bias left at N is -D r/(1 - r), \
+             r = 4^-(1 - alpha) = {r:.4}, D the mean image at N less the mean at N/4. \
+             D's noise is removed using the two independent halves (the mean of D_A D_B is \
+             unbiased for D's squared mean); the bound is one-sided 95%, from the standard \
+             error over {tile} x {tile}-pixel tiles"
+        ),
+    })
 }
 
 pub fn write_reference(img: &Image, info: &ReferenceInfo, exr: &Path) -> Result<()> {
@@ -210,4 +341,152 @@ pub fn read_reference(exr: &Path) -> Result<(Image, ReferenceInfo)> {
     )
     .with_context(|| format!("{}: not a reference's JSON", json.display()))?;
     Ok((img, info))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Standard normal deviates: splitmix64, then Box-Muller.
+    struct Normal(u64);
+
+    impl Normal {
+        fn uniform(&mut self) -> f64 {
+            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn next(&mut self) -> f64 {
+            let (a, b) = (1.0 - self.uniform(), self.uniform());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        }
+    }
+
+    const ALPHA: f32 = 0.7;
+
+    /// Two halves, each a quarter image and a full one, of a truth of 0.5 with
+    /// `beta` the bias left at N (so beta / r at N/4), and Gaussian noise of
+    /// sd 0.05 at N/4 and 0.03 at N, correlated 0.5 within a half as a prefix
+    /// of the same run would be. Returns the quarters, the fulls and the true
+    /// RMSE of the mean's bias.
+    fn synthetic(
+        w: u32,
+        h: u32,
+        beta: impl Fn(u32, u32, usize) -> f64,
+        seed: u64,
+    ) -> ([Image; 2], [Image; 2], f64) {
+        let r = 4f64.powf(-(1.0 - ALPHA as f64));
+        let (sq, sf, rho) = (0.05, 0.03, 0.5f64);
+        let mut rng = Normal(seed);
+        let blank = Image {
+            width: w,
+            height: h,
+            pixels: vec![[0.0; 3]; (w * h) as usize],
+        };
+        let (mut q, mut f) = ([blank.clone(), blank.clone()], [blank.clone(), blank]);
+        let mut se = 0.0;
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                for c in 0..3 {
+                    let b = beta(x, y, c);
+                    se += b * b;
+                    for half in 0..2 {
+                        let nq = rng.next();
+                        let nf = rho * nq + (1.0 - rho * rho).sqrt() * rng.next();
+                        q[half].pixels[i][c] = (0.5 + b / r + sq * nq) as f32;
+                        f[half].pixels[i][c] = (0.5 + b + sf * nf) as f32;
+                    }
+                }
+            }
+        }
+        (q, f, (se / (w * h * 3) as f64).sqrt())
+    }
+
+    fn bound(q: &[Image; 2], f: &[Image; 2]) -> ReferenceBias {
+        bias_bound([&q[0], &q[1]], [&f[0], &f[1]], ALPHA).unwrap()
+    }
+
+    #[test]
+    fn extrapolation_is_the_power_laws() {
+        let k = 4f64.powf(-0.3) / (1.0 - 4f64.powf(-0.3));
+        assert!((k - 1.0 / (4f64.powf(0.3) - 1.0)).abs() < 1e-12);
+        let (q, f, _) = synthetic(16, 16, |_, _, _| 0.0, 1);
+        assert!((bound(&q, &f).bias_extrapolation - k).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_known_bias_is_estimated_and_covered() {
+        let beta = |x: u32, y: u32, c: usize| {
+            0.01 * (1.0 + 0.5 * (x as f64 / 7.0).sin() * (y as f64 / 5.0).cos()) * (1 + c) as f64
+        };
+        let (q, f, truth) = synthetic(128, 96, beta, 7);
+        let b = bound(&q, &f);
+        assert!(b.bias_resolved, "{b:?}");
+        assert!(
+            (b.bias_estimate_rmse - truth).abs() < 0.1 * truth,
+            "estimate {} against the true {truth}",
+            b.bias_estimate_rmse
+        );
+        assert!(b.bias_bound_rmse_95 >= truth, "{b:?} against {truth}");
+        assert!(b.bias_bound_rmse_95 < 1.3 * truth, "{b:?} against {truth}");
+        // Without the noise removed the change would overstate it many times.
+        let (fm, qm) = (Image::average(&f), Image::average(&q));
+        let raw = rmse(&fm, &qm).unwrap() * b.bias_extrapolation;
+        assert!(raw > 2.0 * truth, "raw {raw} against {truth}");
+    }
+
+    #[test]
+    fn pure_noise_is_not_resolved_and_its_bound_is_not_zero() {
+        let (q, f, truth) = synthetic(128, 96, |_, _, _| 0.0, 11);
+        assert_eq!(truth, 0.0);
+        let b = bound(&q, &f);
+        assert!(!b.bias_resolved, "{b:?}");
+        assert!(b.bias_bound_rmse_95 > 0.0, "{b:?}");
+        assert!(b.bias_bound_rmse_95 > b.bias_estimate_rmse, "{b:?}");
+        // The bound is the noise's size: D's sd over sqrt(2) (the mean of two
+        // halves), scaled by k, then shrunk by the pixels' count.
+        assert!(b.bias_bound_rmse_95 < 0.01, "{b:?}");
+    }
+
+    #[test]
+    fn the_bound_covers_a_bias_near_the_noise_at_least_nine_times_in_ten() {
+        let mut covered = 0;
+        let trials = 40;
+        for seed in 0..trials {
+            let beta = |x: u32, _: u32, _: usize| if x < 32 { 0.004 } else { -0.002 };
+            let (q, f, truth) = synthetic(64, 48, beta, 1000 + seed);
+            covered += (bound(&q, &f).bias_bound_rmse_95 >= truth) as u32;
+        }
+        assert!(covered >= 36, "covered {covered} of {trials}");
+    }
+
+    #[test]
+    fn images_of_different_sizes_or_one_pixel_are_refused() {
+        let (q, f, _) = synthetic(16, 16, |_, _, _| 0.0, 3);
+        let (small, _, _) = synthetic(8, 16, |_, _, _| 0.0, 3);
+        assert!(bias_bound([&q[0], &small[1]], [&f[0], &f[1]], ALPHA).is_err());
+        let (q, f, _) = synthetic(1, 1, |_, _, _| 0.0, 3);
+        assert!(bias_bound([&q[0], &q[1]], [&f[0], &f[1]], ALPHA).is_err());
+    }
+
+    #[test]
+    fn old_references_still_read_and_new_ones_round_trip() {
+        let old: ReferenceInfo =
+            serde_json::from_str(include_str!("../../reference_images/glass_ball.sppm.json"))
+                .unwrap();
+        assert!(old.bias.is_none());
+        let (q, f, _) = synthetic(16, 16, |_, _, _| 0.01, 5);
+        let info = ReferenceInfo {
+            bias: Some(bound(&q, &f)),
+            ..old
+        };
+        let json = serde_json::to_value(&info).unwrap();
+        assert!(json["bias_bound_rmse_95"].as_f64().unwrap() > 0.0);
+        assert!(json.get("residual_bias_rmse").is_none());
+        let back: ReferenceInfo = serde_json::from_value(json).unwrap();
+        assert_eq!(back.bias, info.bias);
+    }
 }
