@@ -41,10 +41,10 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
         let scene = common::paper_scene(name);
         let sppm_options = SppmOptions {
             photons_per_iteration: 1 << 15,
+            leak: Some(leak),
             ..SppmOptions::default()
         };
-        let mut o = options(&scene, 64, 48, 5, build);
-        o.global.as_mut().unwrap().estimate.leak = leak;
+        let o = options(&scene, 64, 48, 5, build);
         let mut run = Sppm::new(&gpu, &scene, &o, &sppm_options).unwrap();
         let mut timings = Timings::default();
         run.iterate(&mut timings, &mut ()).unwrap();

@@ -15,11 +15,7 @@
 // photon of one iteration's batch. The leak tests of the kNN estimate
 // (VISIBILITY_TEST, DISC_TEST) may restrict the gather too; as R shrinks to
 // zero they change nothing, so SPPM stays consistent with them.
-#include "common/scene.glsl"
-#include "common/photon_map.glsl"
-#ifdef VISIBILITY_TEST
-#include "common/visibility.glsl"
-#endif
+#include "render/sppm_gather.glsl"
 
 uniform sampler2D u_state_flux;         // tau.rgb, R^2
 uniform sampler2D u_state_direct;       // direct-light sum .rgb, N
@@ -27,15 +23,11 @@ uniform sampler2D u_direct;             // this iteration's direct light
 uniform sampler2D u_diffuse_position;   // x, w = 1 where there is one
 uniform sampler2D u_diffuse_normal;     // facing the eye, w = material + 1
 uniform sampler2D u_diffuse_throughput; // path weight up to x
-uniform sampler2D u_map_incoming;       // each photon's direction of arrival
 uniform float u_alpha;
 // A pixel that has gathered nothing yet (N = 0) takes its first radius lazily:
 // at most the grid's cell, so its gather stays within 2 cells per axis.
 uniform float u_first_radius2;
 uniform int u_gather;                   // 0: direct light only (the photon half off)
-#ifdef DISC_TEST
-uniform float u_disc_radius;            // the disc's thickness is relative to this
-#endif
 
 layout(location = 0) out vec4 o_flux;
 layout(location = 1) out vec4 o_direct;
@@ -55,37 +47,9 @@ void main() {
     }
     float n_count = sums.w;
     float r2 = n_count > 0.0 ? flux.w : min(flux.w, u_first_radius2);
-    float r = sqrt(r2);
-    vec3 x = vp.xyz;
-    vec3 nf = nm.xyz;
-    vec3 cell_size = (u_grid_max - u_grid_min) / vec3(u_grid_resolution);
-    ivec3 lo = clamp(ivec3(floor((x - r - u_grid_min) / cell_size)), ivec3(0), u_grid_resolution - 1);
-    ivec3 hi = clamp(ivec3(floor((x + r - u_grid_min) / cell_size)), ivec3(0), u_grid_resolution - 1);
-    vec3 gathered = vec3(0.0);
-    float m = 0.0;
-    for (int cz = lo.z; cz <= hi.z; ++cz)
-        for (int cy = lo.y; cy <= hi.y; ++cy)
-            for (int cx = lo.x; cx <= hi.x; ++cx) {
-                int cell = cx + u_grid_resolution.x * (cy + u_grid_resolution.y * cz);
-                int base;
-                int count = cell_photon_count(cell, base);
-                for (int i = 0; i < count; ++i) {
-                    ivec2 t = photon_texel(base, i);
-                    vec3 photon = texelFetch(u_map_position, t, 0).xyz;
-                    vec3 offset = photon - x;
-                    if (dot(offset, offset) >= r2) continue;
-                    if (!photon_in_cell(photon, cell)) continue; // a hash bucket's other cells
-                    if (dot(texelFetch(u_map_incoming, t, 0).xyz, nf) >= 0.0) continue;
-#ifdef DISC_TEST
-                    if (abs(dot(offset, nf)) > DISC_THICKNESS * u_disc_radius) continue;
-#endif
-#ifdef VISIBILITY_TEST
-                    if (!photon_visible(x, nf, x + offset)) continue;
-#endif
-                    gathered += texelFetch(u_map_power, t, 0).rgb;
-                    m += photon_weight(cell, t);
-                }
-            }
+    vec3 gathered;
+    float m;
+    sppm_gather(vp.xyz, nm.xyz, r2, gathered, m);
     if (m > 0.0) {
         vec3 albedo = material_texel(mat, 1).rgb;
         vec3 phi = texelFetch(u_diffuse_throughput, px, 0).rgb * (albedo / PI) * gathered;

@@ -7,7 +7,7 @@ use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::radiosity::FormFactor;
-use photonmap::render::sppm::{DirectLighting, SppmOptions};
+use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart, DEFAULT_START_PIXELS};
 use photonmap::render::{
     DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel, RadiosityOptions,
 };
@@ -53,8 +53,8 @@ pub struct PhotonMapArgs {
     /// How the grid stores its cells: one slot per cell (uniform), or a hash
     /// table keyed by the cell's address (hash, section 4.4: memory follows
     /// the photons, so grids up to 1024^3 fit).
-    #[arg(long, value_enum, default_value_t = GridKind::Uniform)]
-    pub grid: GridKind,
+    #[arg(long, value_enum)]
+    pub grid: Option<GridKind>,
     /// Hash buckets of `--grid hash` (1..=16777216; default: the next power
     /// of two at or above the photons stored).
     #[arg(long, value_name = "N", value_parser = in_range(1, MAX_HASH_BUCKETS))]
@@ -68,7 +68,7 @@ impl PhotonMapArgs {
             (self.build != BuildMethod::Bitonic, "--build"),
             (self.stencil_m != 4, "--stencil-m"),
             (self.feed != VertexFeed::VertexFetch, "--feed"),
-            (self.grid != GridKind::Uniform, "--grid"),
+            (self.grid.is_some(), "--grid"),
             (self.hash_buckets.is_some(), "--hash-buckets"),
         ]
         .into_iter()
@@ -85,7 +85,7 @@ impl From<&PhotonMapArgs> for PhotonConfig {
             faithful: a.faithful,
             all_bounces: a.all_bounces,
             projection_maps: !a.no_projection_map,
-            grid: a.grid,
+            grid: a.grid.unwrap_or_default(),
             hash_buckets: a.hash_buckets,
         }
     }
@@ -109,9 +109,9 @@ pub struct EstimateArgs {
     /// Which photons in the search sphere may light a pixel: all (none, the
     /// paper's; light leaks through walls thinner than the radius), those near
     /// its tangent plane (disc), those nothing blocks (visibility, the
-    /// default), or both.
-    #[arg(long, value_enum, default_value_t = LeakTest::Visibility)]
-    pub leak_test: LeakTest,
+    /// default; SPPM's default is none), or both.
+    #[arg(long, value_enum)]
+    pub leak_test: Option<LeakTest>,
     /// Search as the paper does, opening every cell of each ring one by one,
     /// instead of skipping cells beyond the search radius and reading a row's
     /// cells as one range (the same image, bit for bit; only slower).
@@ -128,7 +128,7 @@ impl EstimateArgs {
             (self.tile != 16, "--tile"),
             (self.mask.is_some(), "--mask"),
             (self.budget != DEFAULT_BUDGET, "--budget"),
-            (self.leak_test != LeakTest::Visibility, "--leak-test"),
+            (self.leak_test.is_some(), "--leak-test"),
             (self.paper_search, "--paper-search"),
         ]
         .into_iter()
@@ -145,7 +145,7 @@ impl From<&EstimateArgs> for EstimateOptions {
                 (None, tile) => EstimateMode::Tiled { tile },
             },
             budget: a.budget,
-            leak: a.leak_test,
+            leak: a.leak_test.unwrap_or(LeakTest::Visibility),
             cull: !a.paper_search,
             runs: !a.paper_search,
             ..EstimateOptions::default()
@@ -190,10 +190,11 @@ fn fraction(s: &str) -> Result<f32, String> {
 /// Stochastic progressive photon mapping (`--method sppm`).
 #[derive(Args, Clone, Debug)]
 pub struct SppmArgs {
-    /// SPPM: iterations (1..=1000000).
-    #[arg(long, default_value_t = 64, value_parser = in_range(1, 1_000_000))]
-    pub iterations: u32,
-    /// SPPM: stop after this many seconds instead (whichever comes first).
+    /// SPPM: iterations (1..=1000000; default 64, or as many as --time allows).
+    #[arg(long, value_parser = in_range(1, 1_000_000))]
+    pub iterations: Option<u32>,
+    /// SPPM: run for this many seconds (with --iterations too, whichever
+    /// comes first).
     #[arg(long, value_name = "SECONDS", value_parser = positive)]
     pub time: Option<f64>,
     /// SPPM: the fraction of new photons kept, in (0, 1).
@@ -202,9 +203,20 @@ pub struct SppmArgs {
     /// SPPM: photons emitted per iteration (64..=4194304).
     #[arg(long, default_value_t = 16384, value_parser = in_range(64, 1 << 22))]
     pub photons_per_iteration: u32,
-    /// SPPM: every pixel's first radius (default: the scene's max_radius).
+    /// SPPM: every pixel's first radius (default: each pixel's own, from
+    /// --start-pixels).
     #[arg(long, value_parser = positive)]
     pub radius: Option<f64>,
+    /// SPPM: each pixel's first radius in pixel footprints at its visible
+    /// point (the width of its cone there), at most the scene's max_radius
+    /// (default 4).
+    #[arg(long, value_name = "P", value_parser = positive, conflicts_with_all = ["radius", "start_photons"])]
+    pub start_pixels: Option<f64>,
+    /// SPPM: each pixel's first radius holds the K nearest photons of the
+    /// first iteration (progressive photon mapping's kNN start; 1..=65536),
+    /// at most the scene's max_radius.
+    #[arg(long, value_name = "K", value_parser = in_range(1, 1 << 16), conflicts_with = "radius")]
+    pub start_photons: Option<u32>,
     /// SPPM: photon bounces (1..=64); Russian roulette ends most far sooner.
     #[arg(long, default_value_t = 32, value_parser = in_range(1, 64))]
     pub photon_bounces: u32,
@@ -220,14 +232,37 @@ pub struct SppmArgs {
     pub adaptive_pilot: Option<u32>,
 }
 
+/// SPPM's iterations when neither --iterations nor --time is given.
+pub const DEFAULT_SPPM_ITERATIONS: u32 = 64;
+/// The most iterations a render runs: what `--time` alone allows.
+pub const MAX_SPPM_ITERATIONS: u32 = 1_000_000;
+
+impl SppmArgs {
+    /// The iterations to run: as given; else as many as --time allows; else 64.
+    pub fn iteration_limit(&self) -> u32 {
+        match (self.iterations, self.time) {
+            (Some(n), _) => n,
+            (None, Some(_)) => MAX_SPPM_ITERATIONS,
+            (None, None) => DEFAULT_SPPM_ITERATIONS,
+        }
+    }
+}
+
 impl From<&SppmArgs> for SppmOptions {
     fn from(a: &SppmArgs) -> Self {
         SppmOptions {
-            iterations: a.iterations,
+            iterations: a.iteration_limit(),
             seconds: a.time,
             alpha: a.alpha,
             photons_per_iteration: a.photons_per_iteration,
             initial_radius: a.radius.map(|r| r as f32),
+            start: match (a.start_photons, a.start_pixels) {
+                (Some(k), _) => SppmStart::Photons(k),
+                (None, Some(p)) => SppmStart::Pixels(p as f32),
+                (None, None) => SppmStart::Pixels(DEFAULT_START_PIXELS),
+            },
+            leak: None,
+            grid: None,
             max_bounces: a.photon_bounces,
             direct: a.sppm_direct,
             shadow_rays: a.sppm_shadow_rays,

@@ -715,6 +715,10 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
         &dir.join("mitsuba.json"),
         serde_json::to_string_pretty(&report)?.as_bytes(),
     )?;
+    write_atomically(
+        &dir.join(TABLE_FILE),
+        markdown_table(&report, &command_line()).as_bytes(),
+    )?;
     if a.json {
         super::print_json(&report)
     } else {
@@ -725,6 +729,48 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
 }
 
 const PLOT_FILE: &str = "convergence.svg";
+const TABLE_FILE: &str = "table.md";
+
+/// This run's command line, for the table's heading (arguments as given).
+fn command_line() -> String {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    format!("photonmap {}", args.join(" "))
+}
+
+/// The rows as a Markdown table, headed by the command that made them, for
+/// the documentation to link rather than retype.
+fn markdown_table(b: &MitsubaBench, command: &str) -> String {
+    let mut s = format!(
+        "`{command}`\n\n{} ({} x {}), against {} ({}), {}, {} pixels; {}.\n\n",
+        b.scene,
+        b.width,
+        b.height,
+        b.reference,
+        b.reference_kind,
+        b.mask
+            .as_deref()
+            .map_or("no mask".into(), |m| format!("mask {m}")),
+        b.pixels_compared,
+        b.gl_renderer
+    );
+    s += "| renderer | budget (s) | seconds | samples | camera paths/s | photons/s | relative RMSE | energy |\n";
+    s += "|---|---|---|---|---|---|---|---|\n";
+    for r in &b.rows {
+        s += &format!(
+            "| {} | {} | {:.1} | {} | {:.3e} | {} | {:.4} | {:.4} |\n",
+            r.renderer,
+            r.budget.map_or("-".into(), |x| format!("{x:.0}")),
+            r.seconds,
+            r.samples,
+            r.paths_per_second,
+            r.photons_per_second
+                .map_or("-".into(), |p| format!("{p:.3e}")),
+            r.rel_rmse,
+            r.energy
+        );
+    }
+    s
+}
 
 const COLOURS: [&str; 6] = [
     "#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#8c564b", "#9467bd",

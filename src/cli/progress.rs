@@ -18,6 +18,10 @@ pub struct ProgressReport {
     total: u64,
     last_stage: String,
     last_tenth: u64,
+    /// A progressive render's time limit: the report follows the clock
+    /// when that comes before the iterations.
+    seconds: Option<f64>,
+    clock: std::time::Instant,
 }
 
 impl ProgressReport {
@@ -36,7 +40,11 @@ impl ProgressReport {
                 if direct_only { 0 } else { 100 },
                 (samples as u64) * (views as u64),
             ),
-            Work::Iterations(n) => (0, 0, 1, n as u64),
+            Work::Iterations { iterations, .. } => (0, 0, 1, iterations as u64),
+        };
+        let seconds = match work {
+            Work::Iterations { seconds, .. } => seconds,
+            Work::Paper { .. } => None,
         };
         let total = photon_units + runs * (passes + estimate);
         let terminal = std::io::stderr().is_terminal();
@@ -62,15 +70,28 @@ impl ProgressReport {
             total,
             last_stage: String::new(),
             last_tenth: 0,
+            seconds,
+            clock: std::time::Instant::now(),
         }
     }
 
     pub fn update(&mut self, p: &Progress<'_>) {
         let per_run = self.passes_per_sample + self.estimate_units;
         let (position, what) = match p.at {
-            None if p.stage == "SPPM iterations" => {
-                (p.done, format!("iteration {}/{}", p.done, p.total))
-            }
+            None if p.stage == "SPPM iterations" => match self.seconds {
+                // Whichever of the clock and the iterations is further on.
+                Some(s) => {
+                    let elapsed = self.clock.elapsed().as_secs_f64();
+                    let by_time = (elapsed / s * self.total as f64) as u64;
+                    let what = if p.total >= super::args::MAX_SPPM_ITERATIONS as u64 {
+                        format!("iteration {}, {elapsed:.0} of {s} s", p.done)
+                    } else {
+                        format!("iteration {}/{}, {elapsed:.0} of {s} s", p.done, p.total)
+                    };
+                    (p.done.max(by_time), what)
+                }
+                None => (p.done, format!("iteration {}/{}", p.done, p.total)),
+            },
             None => (0, p.stage.to_string()),
             Some(at) => {
                 let run = (at.view as u64) * at.samples as u64 + at.sample as u64;
@@ -123,5 +144,9 @@ pub enum Work {
         views: usize,
         direct_only: bool,
     },
-    Iterations(u32),
+    /// SPPM: iterations at most, and seconds at most when given.
+    Iterations {
+        iterations: u32,
+        seconds: Option<f64>,
+    },
 }

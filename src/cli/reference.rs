@@ -125,8 +125,9 @@ fn stem(scene: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// The options every reference half runs with: the visibility leak test, so
-/// that thin walls do not leak while the radius is still large.
+/// The size and seed every reference half runs with (and the visibility leak
+/// test for the paper's estimate; SPPM's own is set in `make_reference`, so
+/// that thin walls do not leak while the radius is still large).
 pub fn reference_options(scene: &Scene, scale: u32, seed: u32) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     o.width = (scene.camera.width / scale).max(1);
@@ -149,6 +150,7 @@ pub fn make_reference(
         iterations: a.iterations,
         photons_per_iteration: a.photons_per_iteration,
         initial_radius: a.radius,
+        leak: Some(LeakTest::Visibility),
         ..SppmOptions::default()
     };
     let wall = std::time::Instant::now();

@@ -13,7 +13,7 @@ use photonmap::provenance::Provenance;
 use photonmap::render::sppm::SppmOptions;
 use photonmap::render::{
     self, AdaptiveOptions, EstimatePass, FinalGatherOptions, GlobalIllumination, Image, PassPlan,
-    Progress, RenderObserver, RenderOptions,
+    Progress, RenderObserver, RenderOptions, StopReason,
 };
 use photonmap::scene::Scene;
 
@@ -450,12 +450,24 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
     let options = args.options(scene);
     let gpu = super::gpu(platform)?;
     let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
-    let work = Work::Iterations(args.sppm.iterations);
+    if args.adaptive
+        && args.sppm.iterations.is_none()
+        && args.sppm.time.is_some()
+        && args.sppm.adaptive_pilot.is_none()
+    {
+        bail!("--adaptive with --time alone cannot take its pilot as an eighth of the iterations: give --adaptive-pilot N (iterations at every pixel before the plan) or --iterations");
+    }
+    let work = Work::Iterations {
+        iterations: args.sppm.iteration_limit(),
+        seconds: args.sppm.time,
+    };
     let mut observer = CliObserver::new(args, scene, &outputs, work);
     let sppm = SppmOptions {
         adaptive: args.adaptive.then_some(AdaptiveOptions {
             threshold: args.adaptive_threshold,
         }),
+        leak: args.estimate.leak_test,
+        grid: args.photons.grid,
         ..(&args.sppm).into()
     };
     let out = render::sppm::render_sppm(&gpu, scene, &options, &sppm, &mut observer)?;
@@ -469,6 +481,7 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "method": "sppm",
                 "sppm": sppm,
                 "iterations": out.iterations,
+                "stopped_by": out.stopped_by,
                 "photons_emitted": out.photons_emitted,
                 "initial_radius": out.initial_radius,
                 "final_largest_radius": out.final_largest_radius,
@@ -484,8 +497,16 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
     if !args.quiet {
         eprint!("{}", out.timings.table());
         eprintln!(
-            "SPPM: {} iterations, {} photons emitted, radius {} -> {:.5} (largest)",
-            out.iterations, out.photons_emitted, out.initial_radius, out.final_largest_radius
+            "SPPM: {} iterations in {:.1} s (stopped by {}), {} photons emitted, radius {} -> {:.5} (largest)",
+            out.iterations,
+            out.timings.wall_seconds,
+            match out.stopped_by {
+                StopReason::Iterations => "its iterations",
+                StopReason::Time => "--time",
+            },
+            out.photons_emitted,
+            out.initial_radius,
+            out.final_largest_radius
         );
         if let Some((pilot, s)) = &out.adaptive {
             let pixels = (options.width * options.height) as u64;
@@ -672,6 +693,9 @@ pub struct SnapshotRecord {
     /// Seconds of radiance estimate so far (writing snapshots not counted).
     pub seconds: f64,
     pub searching_pixels: u64,
+    /// A progressive render's last snapshot: what ended it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped_by: Option<StopReason>,
 }
 
 /// Writes the running estimate of a render's first estimate as numbered PNGs
@@ -716,6 +740,7 @@ impl RenderObserver for SnapshotWriter {
             pass: pass.pass,
             seconds: pass.seconds,
             searching_pixels: pass.searching,
+            stopped_by: pass.stopped_by,
         });
         self.last = (pass.pass, pass.seconds);
         if pass.finished {

@@ -36,7 +36,7 @@ pub use direct::DirectLight;
 pub use explain::ExplainLine;
 pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
 pub use igi::{Igi, IgiOptions, IgiStats, VplReport, Vpls};
-pub use observer::{EstimatePass, Progress, RenderObserver};
+pub use observer::{EstimatePass, Progress, RenderObserver, StopReason};
 pub use plan::PassPlan;
 pub use radiance_estimate::{
     EstimateMode, EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate,
@@ -1020,7 +1020,7 @@ pub struct At {
 }
 
 /// One eye sample of one view.
-pub(crate) struct EyeSample<'a> {
+pub struct EyeSample<'a> {
     pub camera: &'a Camera,
     pub sample: u32,
     pub seed: u32,
@@ -1030,7 +1030,7 @@ pub(crate) struct EyeSample<'a> {
 /// depth the closest hits, shadow rays and the specular continuation. Each
 /// pass is timed by timer query and by wall clock (glFinish on both sides).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn trace_eye_paths(
+pub fn trace_eye_paths(
     gpu: &Gpu,
     plan: &PassPlan,
     textures: &SceneTextures,
@@ -1059,6 +1059,12 @@ pub(crate) fn trace_eye_paths(
         observer.progress(&Progress::at("ray tracing", done, total, at));
         Ok(())
     };
+    if plan.fused {
+        timed("eye paths (fused)", &|| {
+            tracer.eye_paths_fused(textures, direct, eye.camera, plan, eye.sample, eye.seed)
+        })?;
+        return gpu.check("ray tracing");
+    }
     timed("eye rays", &|| {
         tracer.eye_rays(eye.camera, plan, eye.sample, eye.seed)
     })?;
@@ -1137,6 +1143,7 @@ impl EstimateRun<'_> {
                     return;
                 }
                 let pass = EstimatePass {
+                    stopped_by: None,
                     at: self.at,
                     pass: r.pass,
                     searching: r.searching,
@@ -1168,6 +1175,7 @@ impl EstimateRun<'_> {
         }
         let image = compose()?;
         observer.estimate_pass(&EstimatePass {
+            stopped_by: None,
             at: self.at,
             pass: stats.passes,
             searching: 0,

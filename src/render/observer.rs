@@ -48,7 +48,19 @@ pub struct EstimatePass<'a> {
     /// Seconds of estimate so far, observers' own time not counted.
     pub seconds: f64,
     pub finished: bool,
+    /// A progressive render's last pass: what ended it.
+    pub stopped_by: Option<StopReason>,
     pub(super) image: &'a dyn Fn() -> Result<Image>,
+}
+
+/// What ended a progressive render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StopReason {
+    /// It ran the iterations asked for.
+    Iterations,
+    /// Its time (`--time`) was up.
+    Time,
 }
 
 impl EstimatePass<'_> {

@@ -29,6 +29,9 @@ pub struct PassPlan {
     pub direct_passes: u32,
     /// Shadow rays sample the lights (off when photons carry direct light).
     pub light_sampling: bool,
+    /// Each eye path in one fused pass (`render/eye_path.frag`) instead of
+    /// the paper's pass per bounce: the same image to rounding.
+    pub fused: bool,
 }
 
 /// Shadow rays one pass draws at most, when the batch is chosen by image size.
@@ -74,6 +77,7 @@ impl PassPlan {
                 1
             },
             light_sampling: true,
+            fused: false,
         }
     }
 
@@ -84,8 +88,12 @@ impl PassPlan {
     }
 
     /// Ray-tracing passes of one eye sample: eye rays, then per depth an
-    /// intersect and the shadow batches, and a specular pass between depths.
+    /// intersect and the shadow batches, and a specular pass between depths;
+    /// fused, one.
     pub fn passes_per_sample(&self) -> u32 {
+        if self.fused {
+            return 1;
+        }
         1 + self.depths * (1 + self.direct_passes) + (self.depths - 1)
     }
 }

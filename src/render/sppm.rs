@@ -18,8 +18,8 @@
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::photon::{
-    BitonicBuild, BuildMethod, Grid, PhotonBatch, PhotonMap, PhotonTracer, StencilRouting,
-    TraceConfig,
+    BitonicBuild, BuildMethod, Grid, GridKind, PhotonBatch, PhotonMap, PhotonTracer,
+    StencilRouting, TraceConfig,
 };
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
@@ -31,7 +31,7 @@ pub use super::sppm_adaptive::SppmState;
 use super::sppm_adaptive::{default_pilot, SppmAdaptive};
 use super::{
     trace_eye_paths, At, DirectLight, EstimatePass, ExplainLine, EyeSample, Image, PassPlan,
-    Progress, RayTracer, RenderObserver, RenderOptions,
+    Progress, RayTracer, RenderObserver, RenderOptions, StopReason,
 };
 
 /// Where direct light comes from.
@@ -53,8 +53,14 @@ pub struct SppmOptions {
     pub alpha: f32,
     /// Photons emitted per iteration (the same every iteration).
     pub photons_per_iteration: u32,
-    /// First radius of every pixel (default: the scene's max_radius).
+    /// First radius of every pixel; None: each pixel's own, as `start` says.
     pub initial_radius: Option<f32>,
+    /// How each pixel's first radius is chosen when `initial_radius` is None.
+    pub start: SppmStart,
+    /// The leak tests of the gather (None: `DEFAULT_SPPM_LEAK`).
+    pub leak: Option<LeakTest>,
+    /// The grid's storage (None: hashed, or uniform under `--faithful`).
+    pub grid: Option<GridKind>,
     /// Photon bounces (Russian roulette ends most photons long before).
     pub max_bounces: u32,
     pub direct: DirectLighting,
@@ -75,6 +81,9 @@ impl Default for SppmOptions {
             alpha: 0.7,
             photons_per_iteration: 1 << 14,
             initial_radius: None,
+            start: SppmStart::Pixels(DEFAULT_START_PIXELS),
+            leak: None,
+            grid: None,
             max_bounces: 32,
             direct: DirectLighting::ShadowRays,
             shadow_rays: 1,
@@ -83,6 +92,27 @@ impl Default for SppmOptions {
         }
     }
 }
+
+/// How each pixel's first radius is chosen (at the first iteration, at its
+/// visible point, at most the scene's max_radius; `glsl/render/sppm_start.frag`).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SppmStart {
+    /// This many pixel footprints: the width of a pixel's cone at the point.
+    Pixels(f32),
+    /// The radius that holds this many of the first iteration's photons
+    /// (progressive photon mapping's kNN start).
+    Photons(u32),
+}
+
+/// The first radius in pixel footprints by default. Chosen against the
+/// independent truth at equal time (README, "The truth: SPPM").
+pub const DEFAULT_START_PIXELS: f32 = 4.0;
+
+/// The gather's leak test by default: none. The leak vanishes as the radii
+/// shrink, and the visibility test's shadow ray per photon cost more error
+/// at equal time than it removed (README, "The truth: SPPM").
+pub const DEFAULT_SPPM_LEAK: LeakTest = LeakTest::None;
 
 /// Cells per grid at most, by build: the sorted map's cell table, and stencil
 /// routing's m x m slots a cell.
@@ -136,6 +166,9 @@ pub struct Sppm {
     pub leak: LeakTest,
     /// Adaptive sampling's plan and packed state (`--adaptive`).
     pub adaptive: Option<SppmAdaptive>,
+    /// The start of each pixel's radius, until the first iteration has used it.
+    pending_start: Option<SppmStart>,
+    start: Program,
 }
 
 impl Sppm {
@@ -146,13 +179,23 @@ impl Sppm {
         sppm: &SppmOptions,
     ) -> Result<Self> {
         let global = options.global.clone().unwrap_or_default();
-        let (config, leak) = (global.photons, global.estimate.leak);
+        let mut config = global.photons;
+        let leak = sppm.leak.unwrap_or(DEFAULT_SPPM_LEAK);
+        // A hash table's size follows the photons, not the cells, so small
+        // radii cost no larger cell table.
+        config.grid = sppm.grid.unwrap_or(if config.faithful {
+            GridKind::Uniform
+        } else {
+            GridKind::Hash
+        });
         let scene = sppm_scene(scene, sppm)?;
         let (w, h) = (options.width, options.height);
         let mut plan = PassPlan::new(&scene, options);
         plan.jitter = true;
         plan.spp = 1;
         plan.light_sampling = sppm.direct == DirectLighting::ShadowRays;
+        // `--faithful` keeps the paper's pass per bounce.
+        plan.fused = !config.faithful;
         let textures = SceneTextures::new(gpu, &scene)?;
         let photons = PhotonTracer::with_config(
             gpu,
@@ -194,6 +237,15 @@ impl Sppm {
             }
         };
         let initial_radius = sppm.initial_radius.unwrap_or(scene.photon_map.max_radius);
+        let mut gather_defines = leak.defines();
+        if config.build == BuildMethod::Stencil {
+            gather_defines.push(("ROUTED", "1".to_string()));
+        }
+        let pending_start = pending_start(sppm)?;
+        let mut start_defines = gather_defines.clone();
+        if matches!(sppm.start, SppmStart::Photons(_)) {
+            start_defines.push(("START_PHOTONS", "1".to_string()));
+        }
         if !(initial_radius > 0.0 && initial_radius.is_finite()) {
             return Err(Error::InvalidOption(format!(
                 "--radius {initial_radius}: the first radius must be a positive number"
@@ -218,13 +270,7 @@ impl Sppm {
             builder,
             storage: config.storage(sppm.photons_per_iteration),
             state,
-            update: Program::fullscreen_with(gpu, "render/sppm_update.frag", &{
-                let mut d = leak.defines();
-                if config.build == BuildMethod::Stencil {
-                    d.push(("ROUTED", "1".to_string()));
-                }
-                d
-            })?,
+            update: Program::fullscreen_with(gpu, "render/sppm_update.frag", &gather_defines)?,
             compose: Program::fullscreen(gpu, "render/sppm_compose.frag")?,
             radius: Program::fullscreen(gpu, "render/sppm_radius.frag")?,
             reduce: Program::fullscreen(gpu, "common/max_reduce.frag")?,
@@ -239,7 +285,67 @@ impl Sppm {
             textures,
             scene,
             adaptive,
+            pending_start,
+            start: Program::fullscreen_with(gpu, "render/sppm_start.frag", &start_defines)?,
         })
+    }
+
+    /// Each pixel's first radius, at this first iteration's visible points
+    /// (and map, for `SppmStart::Photons`): `glsl/render/sppm_start.frag`.
+    fn start_radii(&self, map: &PhotonMap, grid: &Grid, start: SppmStart) -> Result<()> {
+        let camera = &self.scene.camera;
+        let mut b = self.start.bind();
+        match start {
+            SppmStart::Photons(k) => {
+                self.bind_gather(&mut b, map, grid);
+                b.int("u_k", k as i32);
+            }
+            SppmStart::Pixels(pixels) => {
+                b.float("u_pixels", pixels);
+            }
+        }
+        b.texture("u_state_flux", &self.state.flux)
+            .texture("u_state_direct", &self.state.sums)
+            .texture("u_diffuse_position", &self.direct.diffuse_position)
+            .texture("u_diffuse_normal", &self.direct.diffuse_normal)
+            .float("u_first_radius2", self.cell * self.cell)
+            .vec3("u_camera_position", camera.position.to_array())
+            .float(
+                "u_pixel_angle",
+                2.0 * (camera.vfov_degrees.to_radians() * 0.5).tan() / self.plan.height as f32,
+            )
+            .draw_fullscreen(&self.state.target, &DrawState::PLAIN)?;
+        self.gpu.texture_barrier();
+        Ok(())
+    }
+
+    /// The photon map, its grid and the leak tests' inputs, as
+    /// `render/sppm_gather.glsl` declares them.
+    fn bind_gather(&self, b: &mut crate::gpu::Bindings<'_>, map: &PhotonMap, grid: &Grid) {
+        self.textures.bind(b);
+        match map {
+            PhotonMap::Sorted(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_incoming", &m.incoming)
+                    .texture("u_grid_first", &m.grid_first)
+                    .int("u_grid_width", m.grid_width as i32)
+                    .int("u_sorted_width", m.position.width as i32);
+            }
+            PhotonMap::Routed(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_incoming", &m.incoming)
+                    .texture("u_map_counts", &m.counts)
+                    .int("u_count_width", m.count_width as i32)
+                    .int("u_block", m.block as i32)
+                    .int("u_blocks_per_row", m.blocks_per_row as i32);
+            }
+        }
+        grid.bind(b);
+        if matches!(self.leak, LeakTest::Disc | LeakTest::DiscAndVisibility) {
+            b.float("u_disc_radius", self.initial_radius);
+        }
     }
 
     /// The scene as SPPM traces it.
@@ -322,6 +428,12 @@ impl Sppm {
             wall.elapsed().as_secs_f64(),
             passes,
         );
+        if let Some(start) = self.pending_start.take() {
+            let wall = std::time::Instant::now();
+            self.start_radii(&map, &grid, start)?;
+            self.gpu.finish();
+            timings.add_both("first radii", 0.0, wall.elapsed().as_secs_f64(), 1);
+        }
         let wall = std::time::Instant::now();
         self.gather_and_update(&map, &grid)?;
         self.gpu.finish();
@@ -381,27 +493,7 @@ impl Sppm {
         rows: Option<i32>,
     ) -> Result<()> {
         let mut b = self.update.bind();
-        self.textures.bind(&mut b);
-        match map {
-            PhotonMap::Sorted(m) => {
-                b.texture("u_map_position", &m.position)
-                    .texture("u_map_power", &m.power)
-                    .texture("u_map_incoming", &m.incoming)
-                    .texture("u_grid_first", &m.grid_first)
-                    .int("u_grid_width", m.grid_width as i32)
-                    .int("u_sorted_width", m.position.width as i32);
-            }
-            PhotonMap::Routed(m) => {
-                b.texture("u_map_position", &m.position)
-                    .texture("u_map_power", &m.power)
-                    .texture("u_map_incoming", &m.incoming)
-                    .texture("u_map_counts", &m.counts)
-                    .int("u_count_width", m.count_width as i32)
-                    .int("u_block", m.block as i32)
-                    .int("u_blocks_per_row", m.blocks_per_row as i32);
-            }
-        }
-        grid.bind(&mut b);
+        self.bind_gather(&mut b, map, grid);
         let d = hits;
         b.texture("u_state_flux", &state.flux)
             .texture("u_state_direct", &state.sums)
@@ -412,9 +504,6 @@ impl Sppm {
             .float("u_alpha", self.options.alpha)
             .float("u_first_radius2", self.cell * self.cell)
             .int("u_gather", gather as i32);
-        if matches!(self.leak, LeakTest::Disc | LeakTest::DiscAndVisibility) {
-            b.float("u_disc_radius", self.initial_radius);
-        }
         match rows {
             None => b.draw_fullscreen(&state.target, &DrawState::PLAIN)?,
             Some(rows) => b.draw_region(
@@ -494,6 +583,24 @@ impl Sppm {
     }
 }
 
+/// The start of each pixel's radius (None: the fixed `initial_radius`).
+fn pending_start(sppm: &SppmOptions) -> Result<Option<SppmStart>> {
+    Ok(match (sppm.initial_radius, sppm.start) {
+        (Some(_), _) => None,
+        (None, SppmStart::Photons(0)) => {
+            return Err(Error::InvalidOption(
+                "--start-photons 0: the start's radius must hold at least 1 photon".into(),
+            ))
+        }
+        (None, SppmStart::Pixels(p)) if !(p > 0.0 && p.is_finite()) => {
+            return Err(Error::InvalidOption(format!(
+                "--start-pixels {p}: give a positive number of pixel footprints"
+            )))
+        }
+        (None, start) => Some(start),
+    })
+}
+
 /// The scene as SPPM traces it: its photons bounce up to `max_bounces`, direct
 /// light is sampled by `shadow_rays` per iteration, and first hits are stored
 /// only when photons carry direct light.
@@ -519,6 +626,8 @@ fn sppm_scene(scene: &Scene, o: &SppmOptions) -> Result<Scene> {
 /// What a progressive render did.
 pub struct SppmOutput {
     pub image: Image,
+    /// Whether the iterations or the time ran out.
+    pub stopped_by: StopReason,
     pub timings: Timings,
     pub iterations: u32,
     pub photons_emitted: u64,
@@ -545,12 +654,14 @@ pub fn render_sppm(
     let mut timings = Timings::default();
     let wall = std::time::Instant::now();
     let mut observed = 0.0;
+    let mut stopped_by = StopReason::Iterations;
     while run.iteration < sppm.iterations {
         crate::interrupt::check()?;
         if sppm
             .seconds
             .is_some_and(|s| run.iteration > 0 && wall.elapsed().as_secs_f64() - observed >= s)
         {
+            stopped_by = StopReason::Time;
             break;
         }
         run.iterate(&mut timings, observer)?;
@@ -561,6 +672,7 @@ pub fn render_sppm(
             sppm.iterations as u64,
         ));
         observer.estimate_pass(&EstimatePass {
+            stopped_by: None,
             at: At {
                 view: 0,
                 views: 1,
@@ -590,6 +702,7 @@ pub fn render_sppm(
         query_pixels: 0,
         seconds: timings.wall_seconds - observed,
         finished: true,
+        stopped_by: Some(stopped_by),
         image: &|| Ok(image.clone()),
     })?;
     observer.frame(0, &image)?;
@@ -599,6 +712,7 @@ pub fn render_sppm(
         .adaptive_stats()
         .map(|s| (run.adaptive.as_ref().expect("adaptive").pilot, s.clone()));
     Ok(SppmOutput {
+        stopped_by,
         adaptive,
         image,
         timings,

@@ -1,0 +1,106 @@
+// Direct light at a diffuse hit by shadow rays (stratified over each area
+// light, a parallelogram or the emissive triangles of an OBJ group sampled by
+// area; one ray per point light), and the radiance of an emitter seen.
+// render/direct.frag (a pass per depth and shadow batch) and the fused
+// render/eye_path.frag share it, with the same random streams.
+#include "common/scene.glsl"
+#include "common/random.glsl"
+
+// Where shadow sample s of area light l lands: the point q, the light's
+// unit normal there, and the light's area (its pdf is 1 / area). Strata are
+// (su, sv); a LIGHT_TRIANGLES light picks its triangle with su.
+// A parallelogram light's corner, edges and normal, read once per pixel,
+// not once per sample.
+struct AreaLight { bool triangles; vec3 a, e1, e2, normal; float area; };
+
+AreaLight area_light(int l) {
+    vec4 head = light_texel(l, 0);
+    AreaLight L;
+    L.triangles = int(head.x) == LIGHT_TRIANGLES;
+    L.a = light_texel(l, 1).xyz;
+    L.e1 = light_texel(l, 2).xyz;
+    L.e2 = light_texel(l, 3).xyz;
+    L.normal = head.yzw;
+    L.area = L.triangles ? light_texel(l, 1).z : length(cross(L.e1, L.e2));
+    return L;
+}
+
+vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal) {
+    if (L.triangles) {
+        int prim;
+        return sample_light_triangle(l, su, sv, light_normal, prim);
+    }
+    light_normal = L.normal;
+    return L.a + su * L.e1 + sv * L.e2;
+}
+
+// The radiance an emitter (material mat, geometric normal n) sends back
+// along d: one-sided, it leaves on the side of the light's normal only
+// (.w = 1: the primitive's own front face, its geometric normal).
+vec3 emitter_seen(int mat, vec3 n, vec3 d) {
+    vec4 ln = material_texel(mat, 2);
+    vec3 light_normal = ln.w != 0.0 ? n : ln.xyz;
+    return dot(d, light_normal) < 0.0 ? material_texel(mat, 1).rgb : vec3(0.0);
+}
+
+// Irradiance-like sum for direct light at the diffuse hit p (geometric
+// normal n, primitive prim, material mat) seen along d; the light reflected
+// is throughput * (albedo / PI) * sum, in that order (the rounding the
+// stored images were made with):
+// point lights when `point_lights`, and area-light samples [begin, end) of
+// `shadow_rays` (strata_x columns), weighted as 1 / shadow_rays of the whole.
+// nf: the geometric normal on the side seen.
+vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int prim, int mat,
+                  bool point_lights, int begin, int end, int shadow_rays, int strata_x,
+                  bool light_sampling, out vec3 nf) {
+    nf = dot(n, d) < 0.0 ? n : -n; // one BRDF on both sides: shade the side seen
+    // Shading normal (vertex normals) on the side seen: it weighs the light
+    // by |cos| to it, while the geometric nf decides which side the light
+    // must be on and moves the shadow ray's origin.
+    bool shaded = has_shading_normal(prim);
+    vec3 nsf = nf;
+    if (shaded) nsf = shading_normal(prim, p, n) * (dot(n, d) < 0.0 ? 1.0 : -1.0);
+    vec3 origin = p + offset_scale(p) * nf;
+    vec3 sum = vec3(0.0);
+    int strata_y = shadow_rays / strata_x;
+
+    for (int l = 0; l < (light_sampling ? u_light_count : 0); ++l) {
+        vec4 head = light_texel(l, 0);
+        if (int(head.x) == LIGHT_POINT) {
+            if (!point_lights) continue;
+            vec3 a = light_texel(l, 1).xyz;
+            vec3 emitted = light_texel(l, 4).rgb;
+            vec3 to_light = a - origin;
+            float dist = length(to_light);
+            vec3 wi = to_light / dist;
+            float cos_x = dot(nf, wi);
+            float cos_s = shaded ? max(dot(nsf, wi), 0.0) : cos_x;
+            if (cos_x > 0.0 && !occluded(origin, wi, dist))
+                sum += emitted * cos_s / (dist * dist);
+            continue;
+        }
+        vec3 emitted = light_texel(l, 4).rgb;
+        vec3 light_sum = vec3(0.0);
+        AreaLight L = area_light(l);
+        for (int s = begin; s < end; ++s) {
+            uint rng = rng_init(seed, px,
+                                0x40000000u | (uint(depth) << 24) | (uint(l) << 12) | uint(s));
+            float su = (float(s % strata_x) + rng_next(rng)) / float(strata_x);
+            float sv = (float(s / strata_x) + rng_next(rng)) / float(strata_y);
+            vec3 light_normal;
+            vec3 q = area_light_point(l, L, su, sv, light_normal);
+            vec3 to_light = q - origin;
+            float dist = length(to_light);
+            vec3 wi = to_light / dist;
+            float cos_x = dot(nf, wi);
+            float cos_l = -dot(light_normal, wi);
+            if (cos_x <= 0.0 || cos_l <= 0.0) continue;
+            // Stop short of the light's own surface by its offset scale.
+            if (occluded(origin, wi, dist - 2.0 * offset_scale(q))) continue;
+            float cos_s = shaded ? max(dot(nsf, wi), 0.0) : cos_x;
+            light_sum += emitted * (cos_s * cos_l / (dist * dist));
+        }
+        sum += light_sum * (L.area / float(shadow_rays));
+    }
+    return sum;
+}

@@ -1,0 +1,63 @@
+#version 450 core
+// A pixel's whole eye path in one pass: the eye ray, the stochastic mirror and
+// glass chain, emitters seen along it, and at its first diffuse hit every
+// shadow ray and the visible point's record. It computes what the pass per
+// bounce does (eye_rays, then per depth intersect, direct and specular), with
+// the same functions and random streams, so the two give the same image to
+// rounding (tests/fused_eye_path.rs); `--faithful` keeps the passes. A path
+// ends at its first diffuse or emitting hit, after max_specular_depth + 1
+// hits, or when it leaves the scene.
+#include "common/camera.glsl"
+#include "common/direct_light.glsl"
+#include "common/specular_step.glsl"
+
+uniform uint u_seed;
+uniform int u_depths;        // hits at most: max_specular_depth + 1
+uniform int u_shadow_rays;   // N per area light
+uniform int u_strata_x;      // N = strata_x * strata_y
+uniform int u_light_sampling; // 0: no shadow rays (direct light comes from photons)
+
+layout(location = 0) out vec4 o_radiance;
+layout(location = 1) out vec4 o_diffuse_position;   // xyz, w = 1 where recorded
+layout(location = 2) out vec4 o_diffuse_normal;     // facing the viewer, w = material + 1
+layout(location = 3) out vec4 o_diffuse_throughput; // path throughput up to the hit, w = primitive
+
+void main() {
+    uvec2 px = uvec2(gl_FragCoord.xy);
+    o_radiance = vec4(0.0);
+    o_diffuse_position = vec4(0.0);
+    o_diffuse_normal = vec4(0.0);
+    o_diffuse_throughput = vec4(0.0);
+    vec3 o = u_camera_position;
+    vec3 d = eye_ray_direction(px, u_seed);
+    vec3 throughput = vec3(1.0);
+    for (int depth = 0; depth < u_depths; ++depth) {
+        vec4 hit;
+        int prim = closest_hit(o, d, hit);
+        if (prim < 0) return; // background radiance is zero
+        vec3 n;
+        vec3 p = surface_point(prim, o, d, hit, n);
+        int mat = primitive_material(prim);
+        int kind = material_kind(mat);
+        if (kind == MAT_EMITTER) {
+            o_radiance = vec4(throughput * emitter_seen(mat, n, d), 0.0);
+            return;
+        }
+        if (kind == MAT_DIFFUSE) {
+            vec3 nf;
+            vec3 sum = direct_light(u_seed, px, depth, p, n, d, prim, mat, true, 0,
+                                      u_shadow_rays, u_shadow_rays, u_strata_x,
+                                      u_light_sampling != 0, nf);
+            o_radiance = vec4(throughput * (material_texel(mat, 1).rgb / PI) * sum, 0.0);
+            o_diffuse_position = vec4(p, 1.0);
+            o_diffuse_normal = vec4(nf, float(mat + 1));
+            o_diffuse_throughput = vec4(throughput, float(prim));
+            return;
+        }
+        if (kind != MAT_MIRROR && kind != MAT_GLASS) return;
+        vec3 next_origin, next;
+        specular_step(u_seed, px, depth, p, n, d, prim, mat, kind, throughput, next_origin, next);
+        o = next_origin;
+        d = next;
+    }
+}
