@@ -560,3 +560,71 @@ radiance = [10.0, 10.0, 10.0]
         "{err}"
     );
 }
+
+/// The fused trace (every bounce of a photon in one pass) against the pass
+/// per bounce: the same functions and random streams, so the same stored
+/// records to float rounding, the same frames read, and nothing left over
+/// from an earlier trace into the same batch (SPPM traces one batch anew
+/// every iteration; the second seed here is traced after the first).
+#[test]
+fn the_fused_trace_stores_the_same_photons_as_the_pass_per_bounce() {
+    let gpu = common::gpu();
+    // Every photon path (SPPM's), and the paper's caustics only through
+    // projection maps (RING, with the random-number texture).
+    for (name, random, caustics_only) in [
+        ("cornell_box", RandomSource::Hash, false),
+        ("glass_ball", RandomSource::Hash, false),
+        ("ring", RandomSource::Texture, true),
+        ("obj", RandomSource::Hash, false),
+    ] {
+        let mut scene = match name {
+            "obj" => obj_scene(),
+            _ => common::paper_scene(name),
+        };
+        scene.photon_map.max_bounces = 16;
+        scene.photon_map.caustics_only = caustics_only;
+        let textures = SceneTextures::new(&gpu, &scene).unwrap();
+        let traced = |fused: bool| {
+            let config = TraceConfig {
+                random,
+                fused,
+                ..TraceConfig::default()
+            };
+            let tracer = PhotonTracer::with_config(&gpu, config).unwrap();
+            let mut batch = tracer.batch(&scene, 6000).unwrap();
+            let mut out = Vec::new();
+            for seed in [5, 6] {
+                tracer
+                    .trace_batch(&scene, &textures, &mut batch, seed)
+                    .unwrap();
+                let f = &batch.frames;
+                let used = (f.width * f.frame_height * f.frames) as usize;
+                out.push((f.frames, records(f)[..used].to_vec()));
+            }
+            out
+        };
+        let (passes, fused) = (traced(false), traced(true));
+        let size = scene.size();
+        for ((frames_p, p), (frames_f, f)) in passes.iter().zip(&fused) {
+            assert_eq!(frames_p, frames_f, "{name}: frames read");
+            let (mut stored, mut differ) = (0, 0);
+            for (a, b) in p.iter().zip(f) {
+                assert_eq!(a.power.w, b.power.w, "{name}: a record stored by one only");
+                if a.power.w == 0.0 {
+                    continue;
+                }
+                stored += 1;
+                let power = a.power.truncate().abs().max_element().max(1e-20);
+                if !close(a.position, b.position, size) || !close(a.power, b.power, power) {
+                    differ += 1;
+                }
+            }
+            eprintln!("{name}: {stored} stored records, {differ} differ beyond 1e-4");
+            assert!(stored > 300, "{name}: only {stored} stored records");
+            assert_eq!(
+                differ, 0,
+                "{name}: {differ} of {stored} stored records differ"
+            );
+        }
+    }
+}

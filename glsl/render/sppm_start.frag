@@ -1,6 +1,9 @@
 #version 450 core
 // Each pixel's first SPPM radius, at the first iteration, at its visible
-// point x, never above the maximum radius:
+// point x: the smallest of the maximum radius and these bounds:
+// - u_pixels > 0: u_pixels pixel footprints at x: the width a pixel's cone
+//   has at x's distance from the camera. The blur then starts at a few
+//   pixels wherever x lies, whatever the scene's scale.
 // - START_PHOTONS: the radius that holds the k nearest photons of that
 //   iteration's map (progressive photon mapping's original choice, Hachisuka,
 //   Ogaki and Jensen 2008), or the maximum where fewer than k lie within it.
@@ -9,10 +12,8 @@
 //   the radius is the outer edge of the bin where the count from the centre
 //   reaches k: the k-th nearest distance, rounded up by at most sqrt(2).
 //   (The paper's kNN-grid search would not do: it keeps the first k photons
-//   met in cell order, which can lie a cell away.)
-// - otherwise: u_pixels pixel footprints at x: the width a pixel's cone has
-//   at x's distance from the camera. The blur then starts at a few pixels
-//   wherever x lies, whatever the scene's scale.
+//   met in cell order, which can lie a cell away.) Within the footprint
+//   bound, bright caustics start smaller than their footprints.
 // Pixels with no visible point, or that have gathered already, keep theirs.
 #ifdef START_PHOTONS
 #define START_BINS 16
@@ -42,6 +43,11 @@ void main() {
     vec4 nm = texelFetch(u_diffuse_normal, px, 0);
     if (sums.w > 0.0 || vp.w <= 0.0 || int(nm.w) < 1) return;
     float r2 = min(flux.w, u_first_radius2);
+    if (u_pixels > 0.0) {
+        float f = u_pixels * u_pixel_angle * distance(u_camera_position, vp.xyz);
+        r2 = min(r2, f * f);
+    }
+    o_flux.w = r2;
 #ifdef START_PHOTONS
     vec3 gathered;
     float m;
@@ -54,9 +60,5 @@ void main() {
             return;
         }
     }
-    o_flux.w = r2;
-#else
-    float f = u_pixels * u_pixel_angle * distance(u_camera_position, vp.xyz);
-    o_flux.w = min(r2, f * f);
 #endif
 }

@@ -7,7 +7,7 @@ use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::radiosity::FormFactor;
-use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart, DEFAULT_START_PIXELS};
+use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart, DEFAULT_START_PHOTONS};
 use photonmap::render::{
     DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel, RadiosityOptions,
 };
@@ -209,12 +209,13 @@ pub struct SppmArgs {
     pub radius: Option<f64>,
     /// SPPM: each pixel's first radius in pixel footprints at its visible
     /// point (the width of its cone there), at most the scene's max_radius
-    /// (default 4).
-    #[arg(long, value_name = "P", value_parser = positive, conflicts_with_all = ["radius", "start_photons"])]
+    /// (default 4; with --start-photons, the smaller of the two).
+    #[arg(long, value_name = "P", value_parser = positive, conflicts_with = "radius")]
     pub start_pixels: Option<f64>,
     /// SPPM: each pixel's first radius holds the K nearest photons of the
     /// first iteration (progressive photon mapping's kNN start; 1..=65536),
-    /// at most the scene's max_radius.
+    /// at most the scene's max_radius (and --start-pixels footprints, when
+    /// given).
     #[arg(long, value_name = "K", value_parser = in_range(1, 1 << 16), conflicts_with = "radius")]
     pub start_photons: Option<u32>,
     /// SPPM: photon bounces (1..=64); Russian roulette ends most far sooner.
@@ -257,9 +258,16 @@ impl From<&SppmArgs> for SppmOptions {
             photons_per_iteration: a.photons_per_iteration,
             initial_radius: a.radius.map(|r| r as f32),
             start: match (a.start_photons, a.start_pixels) {
-                (Some(k), _) => SppmStart::Photons(k),
-                (None, Some(p)) => SppmStart::Pixels(p as f32),
-                (None, None) => SppmStart::Pixels(DEFAULT_START_PIXELS),
+                (None, None) => SppmStart::DEFAULT,
+                // The kNN start alone, as progressive photon mapping's.
+                (Some(k), None) => SppmStart {
+                    pixels: None,
+                    photons: Some(k),
+                },
+                (k, Some(p)) => SppmStart {
+                    pixels: Some(p as f32),
+                    photons: k.or(DEFAULT_START_PHOTONS),
+                },
             },
             leak: None,
             grid: None,

@@ -76,9 +76,10 @@ pub struct MitsubaBenchArgs {
     /// The Python that imports mitsuba.
     #[arg(long, default_value = "python3")]
     pub python: String,
-    /// Mitsuba's longest path (max_depth, 1..=64).
-    #[arg(long, default_value_t = 16, value_parser = in_range(1, 64))]
-    pub max_depth: u32,
+    /// Mitsuba's longest path (max_depth: -1, Mitsuba's default, leaves
+    /// paths to Russian roulette; else 1..=1024).
+    #[arg(long, default_value_t = -1, allow_negative_numbers = true, value_parser = max_depth)]
+    pub max_depth: i32,
     /// Folder for the export, the script, each image, mitsuba.json and
     /// convergence.svg (default photonmap-out/mitsuba/<scene>).
     #[arg(long)]
@@ -87,6 +88,14 @@ pub struct MitsubaBenchArgs {
     pub json: bool,
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// Mitsuba's max_depth: -1 (unbounded) or 1..=1024.
+fn max_depth(s: &str) -> Result<i32, String> {
+    match s.trim().parse::<i32>() {
+        Ok(v) if v == -1 || (1..=1024).contains(&v) => Ok(v),
+        _ => Err(format!("{s}: give -1 (no limit) or a depth in 1..=1024")),
+    }
 }
 
 /// A budget: a positive number of seconds, at most a day.
@@ -157,7 +166,7 @@ pub struct MitsubaBench {
     pub truth_noise: Option<f64>,
     pub gl_renderer: String,
     pub variant: String,
-    pub max_depth: u32,
+    pub max_depth: i32,
     pub budgets: Vec<f64>,
     pub rows: Vec<Row>,
     pub curves: Vec<Curve>,
@@ -229,7 +238,7 @@ fn shapes(
 }
 
 /// The scene as `mitsuba_render.py` reads it, at `width` x `height`.
-pub fn export(scene: &Scene, width: u32, height: u32, max_depth: u32) -> serde_json::Value {
+pub fn export(scene: &Scene, width: u32, height: u32, max_depth: i32) -> serde_json::Value {
     let v = |p: glam::Vec3| [p.x, p.y, p.z];
     let material = |m: usize| match scene.materials[m] {
         Material::Diffuse { albedo } => json!({"type": "diffuse", "albedo": v(albedo)}),

@@ -220,6 +220,20 @@ impl Gpu {
         }
     }
 
+    /// Makes what earlier draws stored through images (`Bindings::image`)
+    /// visible to later draws' texture fetches, image access and
+    /// framebuffer writes (glMemoryBarrier).
+    pub fn image_barrier(&self) {
+        // SAFETY: module doc; the bits are GL constants.
+        unsafe {
+            self.gl().memory_barrier(
+                glow::TEXTURE_FETCH_BARRIER_BIT
+                    | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
+                    | glow::FRAMEBUFFER_BARRIER_BIT,
+            )
+        }
+    }
+
     /// Blocks until every command issued so far has run (for wall-clock timing).
     pub fn finish(&self) {
         // SAFETY: module doc.

@@ -11,6 +11,7 @@ pub struct Bindings<'a> {
     program: &'a Program,
     gl: &'a glow::Context,
     next_unit: u32,
+    next_image: u32,
     error: Option<Error>,
 }
 
@@ -25,6 +26,7 @@ impl Program {
             program: self,
             gl,
             next_unit: 0,
+            next_image: 0,
             error: None,
         }
     }
@@ -54,6 +56,29 @@ impl Bindings<'_> {
         self.set(name, |gl, l| unsafe {
             gl.active_texture(glow::TEXTURE0 + unit);
             gl.bind_texture(glow::TEXTURE_2D, Some(texture.raw));
+            gl.uniform_1_i32(l, unit as i32);
+        })
+    }
+
+    /// Binds level 0 of `texture` as image `name`, for `imageStore` (the
+    /// shader declares its format). What a draw stores is visible to later
+    /// draws after `Gpu::image_barrier`.
+    pub fn image(&mut self, name: &str, texture: &Texture) -> &mut Self {
+        let unit = self.next_image;
+        self.next_image += 1;
+        let format = texture.format.gl().0;
+        // SAFETY: as for `texture`; the texture is immutable-format storage
+        // of `format`.
+        self.set(name, |gl, l| unsafe {
+            gl.bind_image_texture(
+                unit,
+                Some(texture.raw),
+                0,
+                false,
+                0,
+                glow::WRITE_ONLY,
+                format,
+            );
             gl.uniform_1_i32(l, unit as i32);
         })
     }

@@ -86,11 +86,15 @@ fn declare(line: &str, names: &mut HashSet<String>) {
         return;
     };
     let decl = rest.split(';').next().unwrap_or("");
-    // Skip the type (and any precision qualifier): names follow the last type word.
+    // Skip the type (and any precision or memory qualifier): names follow
+    // the last type word.
     let mut words = decl.splitn(2, char::is_whitespace);
     let mut ty = words.next().unwrap_or("");
     let mut list = words.next().unwrap_or("").trim_start();
-    while matches!(ty, "highp" | "mediump" | "lowp") {
+    while matches!(
+        ty,
+        "highp" | "mediump" | "lowp" | "writeonly" | "readonly" | "coherent" | "restrict"
+    ) {
         let mut w = list.splitn(2, char::is_whitespace);
         ty = w.next().unwrap_or("");
         list = w.next().unwrap_or("").trim_start();
@@ -427,11 +431,11 @@ mod tests {
     #[test]
     fn declared_uniforms_are_read_from_the_source() {
         let names = declared_uniforms(
-            "#version 450 core\nuniform sampler2D u_a; // x\n  uniform highp int u_b, u_c[4];\nlayout(binding = 0) uniform vec3 u_d;\nfloat uniform_x;\n",
+            "#version 450 core\nuniform sampler2D u_a; // x\n  uniform highp int u_b, u_c[4];\nlayout(binding = 0) uniform vec3 u_d;\nfloat uniform_x;\nlayout(rgba32f) uniform writeonly image2D u_e;\n",
         );
         let mut names: Vec<_> = names.into_iter().collect();
         names.sort();
-        assert_eq!(names, ["u_a", "u_b", "u_c", "u_d"]);
+        assert_eq!(names, ["u_a", "u_b", "u_c", "u_d", "u_e"]);
         // Only the branches the defines make active.
         let names = declared_uniforms(
             "#version 450 core\n#define A 1\n#ifdef A\nuniform int u_a;\n#else\nuniform int u_not_a;\n#endif\n#ifdef B\nuniform int u_b;\n#endif\n#ifndef B\nuniform int u_not_b;\n#endif\n",

@@ -30,7 +30,7 @@ impl TexFormat {
         )
     }
 
-    fn gl(self) -> (u32, u32, u32) {
+    pub(crate) fn gl(self) -> (u32, u32, u32) {
         match self {
             TexFormat::Rgba32F => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
             TexFormat::Rg32F => (glow::RG32F, glow::RG, glow::FLOAT),

@@ -60,6 +60,7 @@ impl PhotonConfig {
             },
             stop_when_dead: !self.all_bounces,
             projection_maps: self.projection_maps,
+            fused: false,
         }
     }
 

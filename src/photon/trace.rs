@@ -1,6 +1,8 @@
 //! Breadth-first photon tracing (section 2.1): emission into frame 0, then one
 //! pass per bounce, each writing its own frame (a band of rows) of four RGBA32F
 //! textures. Photon i sits at texel (i % width, i / width) of every frame.
+//! `TraceConfig::fused` traces every bounce of a photon in one pass instead,
+//! storing the same records through images (glsl/photon/trace_fused.frag).
 
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
@@ -31,6 +33,9 @@ pub struct PhotonFrames {
     pub power_scale: f32,
     /// GPU time of the emission and bounce passes (timer query).
     pub gpu_seconds: f64,
+    /// Tracing passes drawn: emission and each bounce's, or emission and
+    /// the fused pass.
+    pub passes: u32,
     /// The projection maps photons were aimed by (scenes that store caustics only).
     pub projection: Option<ProjectionMaps>,
 }
@@ -59,6 +64,7 @@ impl PhotonFrames {
             photons_used: width * frame_height,
             power_scale: 1.0,
             gpu_seconds: 0.0,
+            passes: 0,
             projection: None,
         })
     }
@@ -187,7 +193,7 @@ const PRIMES: [u32; HALTON_DIMENSIONS] = [
 
 /// Random numbers a photon draws at emission (light, two for the point, two
 /// for the direction; projection maps draw one more, which is never a Halton
-/// one) and at each bounce (glsl/photon/emit.frag, trace.frag).
+/// one) and at each bounce (glsl/photon/emit.frag, bounce.glsl).
 const EMISSION_NUMBERS: usize = 5;
 const BOUNCE_NUMBERS: usize = 3;
 
@@ -253,6 +259,10 @@ pub struct TraceConfig {
     /// Aim photons by projection maps when the scene stores caustics only
     /// (off: emit everywhere and keep only the caustic paths, to compare).
     pub projection_maps: bool,
+    /// Every bounce of a photon in one pass after emission, instead of a
+    /// pass per bounce. The records a build reads are the same; frames after
+    /// a photon's end keep only power 0 (not stored), not a dead record.
+    pub fused: bool,
 }
 
 impl Default for TraceConfig {
@@ -261,6 +271,7 @@ impl Default for TraceConfig {
             random: RandomSource::Hash,
             stop_when_dead: true,
             projection_maps: true,
+            fused: false,
         }
     }
 }
@@ -272,6 +283,8 @@ pub struct PhotonTracer {
     bounce: Program,
     count: Program,
     probe: Program,
+    /// The fused path (`TraceConfig::fused`).
+    fused: Option<Program>,
     /// Emission through projection maps, compiled on first use.
     emit_projected: std::cell::OnceCell<Program>,
     defines: Vec<(&'static str, String)>,
@@ -294,6 +307,15 @@ pub struct PhotonBatch {
     timer: Query,
     alive: Query,
     probe: Option<(Texture, Target)>,
+    /// The fused path's per-photon last live frame, and a target that clears
+    /// the power texture alone.
+    fused: Option<FusedTargets>,
+}
+
+struct FusedTargets {
+    last: Texture,
+    last_target: Target,
+    power: Target,
 }
 
 impl PhotonTracer {
@@ -315,6 +337,14 @@ impl PhotonTracer {
             bounce: Program::fullscreen_with(gpu, "photon/trace.frag", &defines)?,
             count: Program::fullscreen(gpu, "photon/stored_count.frag")?,
             probe: Program::fullscreen(gpu, "photon/alive_probe.frag")?,
+            fused: match config.fused {
+                true => Some(Program::fullscreen_with(
+                    gpu,
+                    "photon/trace_fused.frag",
+                    &defines,
+                )?),
+                false => None,
+            },
             emit_projected: std::cell::OnceCell::new(),
             defines,
         })
@@ -406,6 +436,7 @@ impl PhotonTracer {
             timer: Query::timer(&self.gpu)?,
             alive: Query::occlusion(&self.gpu)?,
             probe: None,
+            fused: None,
         })
     }
 
@@ -431,18 +462,31 @@ impl PhotonTracer {
         let mut gpu_seconds = 0.0;
         self.gpu.finish();
         let wall = std::time::Instant::now();
+        if self.fused.is_some() {
+            self.clear_power(batch)?;
+        }
         gpu_seconds += self.emit_pass(scene, textures, batch, seed)?;
         let mut frames_used = frames;
-        for bounce in 1..frames {
-            crate::interrupt::check()?;
-            gpu_seconds += self.bounce_pass(scene, textures, batch, seed, bounce)?;
-            if self.config.stop_when_dead
-                && bounce + 1 < frames
-                && self.live_photons(batch, bounce)? == 0
-            {
-                // No photon of this frame goes on: the rest is dark.
-                frames_used = bounce + 1;
-                break;
+        if self.fused.is_some() {
+            let (seconds, last) = self.fused_pass(scene, textures, batch, seed)?;
+            gpu_seconds += seconds;
+            // As the per-bounce passes stop: the first frame with no live
+            // photon is the last one read.
+            if self.config.stop_when_dead {
+                frames_used = (last.max(0) as u32 + 2).min(frames);
+            }
+        } else {
+            for bounce in 1..frames {
+                crate::interrupt::check()?;
+                gpu_seconds += self.bounce_pass(scene, textures, batch, seed, bounce)?;
+                if self.config.stop_when_dead
+                    && bounce + 1 < frames
+                    && self.live_photons(batch, bounce)? == 0
+                {
+                    // No photon of this frame goes on: the rest is dark.
+                    frames_used = bounce + 1;
+                    break;
+                }
             }
         }
         self.gpu.finish();
@@ -452,6 +496,7 @@ impl PhotonTracer {
         let wall = wall.elapsed().as_secs_f64();
         self.gpu.check("photon tracing")?;
         batch.frames.frames = frames_used;
+        batch.frames.passes = if self.fused.is_some() { 2 } else { frames_used };
         batch.frames.gpu_seconds = gpu_seconds.min(wall);
         Ok(())
     }
@@ -530,6 +575,72 @@ impl PhotonTracer {
         pass.timer.end();
         drawn?;
         Ok(pass.timer.seconds())
+    }
+
+    /// Before emission on the fused path: every frame reads as not stored
+    /// until a photon's bounce stores it there.
+    fn clear_power(&self, batch: &mut PhotonBatch) -> Result<()> {
+        if batch.fused.is_none() {
+            let f = &batch.frames;
+            let last = Texture::new(&self.gpu, f.width, f.frame_height, TexFormat::R32F)?;
+            batch.fused = Some(FusedTargets {
+                last_target: Target::new(&self.gpu, &[&last])?,
+                last,
+                power: Target::new(&self.gpu, &[&f.power])?,
+            });
+        }
+        batch
+            .fused
+            .as_ref()
+            .expect("made above")
+            .power
+            .clear([0.0; 4]);
+        Ok(())
+    }
+
+    /// Every bounce after emission in one pass (glsl/photon/trace_fused.frag):
+    /// its GPU seconds and the last frame in which any photon goes on (-1:
+    /// none was emitted).
+    fn fused_pass(
+        &self,
+        scene: &Scene,
+        textures: &SceneTextures,
+        batch: &mut PhotonBatch,
+        seed: u32,
+    ) -> Result<(f64, i32)> {
+        let program = self
+            .fused
+            .as_ref()
+            .expect("fused_pass needs the fused program");
+        let (f, targets) = (
+            &batch.frames,
+            batch.fused.as_ref().expect("clear_power made them"),
+        );
+        let mut b = program.bind();
+        textures.bind(&mut b);
+        if let Some((_, r)) = &batch.random {
+            b.texture("u_random_numbers", r);
+        }
+        b.texture("u_position", &f.position)
+            .texture("u_power", &f.power)
+            .texture("u_incoming", &f.incoming)
+            .texture("u_outgoing", &f.outgoing)
+            .image("u_position_out", &f.position)
+            .image("u_power_out", &f.power)
+            .image("u_incoming_out", &f.incoming)
+            .image("u_outgoing_out", &f.outgoing)
+            .uint("u_seed", seed)
+            .int("u_frame_height", f.frame_height as i32)
+            .int("u_frames", f.frames as i32)
+            .int("u_store_direct", scene.photon_map.store_direct as i32)
+            .int("u_caustics_only", scene.photon_map.caustics_only as i32);
+        batch.timer.begin();
+        let drawn = b.draw_fullscreen(&targets.last_target, &DrawState::PLAIN);
+        batch.timer.end();
+        drawn?;
+        self.gpu.image_barrier();
+        let last = targets.last.read_f32().into_iter().fold(-1.0f32, f32::max);
+        Ok((batch.timer.seconds(), last as i32))
     }
 
     /// How many photons of frame `bounce` go on (an occlusion query).

@@ -175,7 +175,7 @@ pub fn sample_light_triangle(
     )
 }
 
-/// glsl/photon/trace.frag: bounce `bounce` of a photon whose last record is `last`.
+/// glsl/photon/bounce.glsl: bounce `bounce` of a photon whose last record is `last`.
 pub fn bounce(
     scene: &Scene,
     seed: u32,

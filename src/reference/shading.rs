@@ -88,7 +88,7 @@ pub fn specular_shaded(
 }
 
 /// The photon's weight at a diffuse hit with shading normal ms:
-/// |w_in . n_s| / |w_in . n_g| (glsl/photon/trace.frag).
+/// |w_in . n_s| / |w_in . n_g| (glsl/photon/bounce.glsl).
 pub fn diffuse_adjoint(d: Vec3, nf: Vec3, ms: Vec3) -> f32 {
     let cos_g = -nf.dot(d);
     if cos_g > 0.0 {

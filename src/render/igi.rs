@@ -154,6 +154,7 @@ impl Vpls {
                 random: RandomSource::Halton,
                 stop_when_dead: true,
                 projection_maps: false,
+                fused: false,
             },
         )?;
         let frames = tracer.trace(&s, textures, seed, paths)?;

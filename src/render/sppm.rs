@@ -81,7 +81,7 @@ impl Default for SppmOptions {
             alpha: 0.7,
             photons_per_iteration: 1 << 14,
             initial_radius: None,
-            start: SppmStart::Pixels(DEFAULT_START_PIXELS),
+            start: SppmStart::DEFAULT,
             leak: None,
             grid: None,
             max_bounces: 32,
@@ -94,20 +94,31 @@ impl Default for SppmOptions {
 }
 
 /// How each pixel's first radius is chosen (at the first iteration, at its
-/// visible point, at most the scene's max_radius; `glsl/render/sppm_start.frag`).
+/// visible point; `glsl/render/sppm_start.frag`): the smallest of the scene's
+/// max_radius and the bounds given.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SppmStart {
-    /// This many pixel footprints: the width of a pixel's cone at the point.
-    Pixels(f32),
-    /// The radius that holds this many of the first iteration's photons
-    /// (progressive photon mapping's kNN start).
-    Photons(u32),
+pub struct SppmStart {
+    /// At most this many pixel footprints: the width of a pixel's cone at
+    /// the point.
+    pub pixels: Option<f32>,
+    /// At most the radius that holds this many of the first iteration's
+    /// photons (progressive photon mapping's kNN start).
+    pub photons: Option<u32>,
+}
+
+impl SppmStart {
+    pub const DEFAULT: SppmStart = SppmStart {
+        pixels: Some(DEFAULT_START_PIXELS),
+        photons: DEFAULT_START_PHOTONS,
+    };
 }
 
 /// The first radius in pixel footprints by default. Chosen against the
 /// independent truth at equal time (README, "The truth: SPPM").
 pub const DEFAULT_START_PIXELS: f32 = 4.0;
+
+/// The kNN bound on the first radius by default.
+pub const DEFAULT_START_PHOTONS: Option<u32> = None;
 
 /// The gather's leak test by default: none. The leak vanishes as the radii
 /// shrink, and the visibility test's shadow ray per photon cost more error
@@ -201,6 +212,8 @@ impl Sppm {
             gpu,
             TraceConfig {
                 stop_when_dead: true,
+                // `--faithful` keeps the paper's pass per bounce.
+                fused: !config.faithful,
                 ..config.trace()
             },
         )?;
@@ -243,7 +256,7 @@ impl Sppm {
         }
         let pending_start = pending_start(sppm)?;
         let mut start_defines = gather_defines.clone();
-        if matches!(sppm.start, SppmStart::Photons(_)) {
+        if sppm.start.photons.is_some() {
             start_defines.push(("START_PHOTONS", "1".to_string()));
         }
         if !(initial_radius > 0.0 && initial_radius.is_finite()) {
@@ -295,15 +308,12 @@ impl Sppm {
     fn start_radii(&self, map: &PhotonMap, grid: &Grid, start: SppmStart) -> Result<()> {
         let camera = &self.scene.camera;
         let mut b = self.start.bind();
-        match start {
-            SppmStart::Photons(k) => {
-                self.bind_gather(&mut b, map, grid);
-                b.int("u_k", k as i32);
-            }
-            SppmStart::Pixels(pixels) => {
-                b.float("u_pixels", pixels);
-            }
+        if let Some(k) = start.photons {
+            self.bind_gather(&mut b, map, grid);
+            b.int("u_k", k as i32);
         }
+        // 0: no bound by footprints.
+        b.float("u_pixels", start.pixels.unwrap_or(0.0));
         b.texture("u_state_flux", &self.state.flux)
             .texture("u_state_direct", &self.state.sums)
             .texture("u_diffuse_position", &self.direct.diffuse_position)
@@ -404,7 +414,7 @@ impl Sppm {
             "trace photons",
             frames.gpu_seconds,
             wall.elapsed().as_secs_f64(),
-            frames.frames as usize,
+            frames.passes as usize,
         );
         let wall = std::time::Instant::now();
         let grid =
@@ -587,12 +597,22 @@ impl Sppm {
 fn pending_start(sppm: &SppmOptions) -> Result<Option<SppmStart>> {
     Ok(match (sppm.initial_radius, sppm.start) {
         (Some(_), _) => None,
-        (None, SppmStart::Photons(0)) => {
+        (
+            None,
+            SppmStart {
+                photons: Some(0), ..
+            },
+        ) => {
             return Err(Error::InvalidOption(
                 "--start-photons 0: the start's radius must hold at least 1 photon".into(),
             ))
         }
-        (None, SppmStart::Pixels(p)) if !(p > 0.0 && p.is_finite()) => {
+        (
+            None,
+            SppmStart {
+                pixels: Some(p), ..
+            },
+        ) if !(p > 0.0 && p.is_finite()) => {
             return Err(Error::InvalidOption(format!(
                 "--start-pixels {p}: give a positive number of pixel footprints"
             )))
