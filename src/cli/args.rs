@@ -7,7 +7,7 @@ use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::radiosity::FormFactor;
-use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart, DEFAULT_START_PHOTONS};
+use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart};
 use photonmap::render::{
     DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel, RadiosityOptions,
 };
@@ -179,6 +179,14 @@ fn positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Pixel footprints: 0 (no bound) or a positive number, at most 1e6.
+fn footprints(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if (0.0..=1e6).contains(&v) => Ok(v),
+        _ => Err(format!("{s}: give pixel footprints in 0..=1000000 (0: no bound)")),
+    }
+}
+
 /// A number strictly between 0 and 1.
 fn fraction(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
@@ -207,16 +215,16 @@ pub struct SppmArgs {
     /// --start-pixels).
     #[arg(long, value_parser = positive)]
     pub radius: Option<f64>,
-    /// SPPM: each pixel's first radius in pixel footprints at its visible
-    /// point (the width of its cone there), at most the scene's max_radius
-    /// (default 4; with --start-photons, the smaller of the two).
-    #[arg(long, value_name = "P", value_parser = positive, conflicts_with = "radius")]
+    /// SPPM: each pixel's first radius is at most P pixel footprints at its
+    /// visible point (the width of its cone there); 0: no such bound
+    /// (default 4). The first radius is the smallest of the scene's
+    /// max_radius and both bounds.
+    #[arg(long, value_name = "P", value_parser = footprints, conflicts_with = "radius")]
     pub start_pixels: Option<f64>,
-    /// SPPM: each pixel's first radius holds the K nearest photons of the
-    /// first iteration (progressive photon mapping's kNN start; 1..=65536),
-    /// at most the scene's max_radius (and --start-pixels footprints, when
-    /// given).
-    #[arg(long, value_name = "K", value_parser = in_range(1, 1 << 16), conflicts_with = "radius")]
+    /// SPPM: each pixel's first radius holds at most the K nearest photons
+    /// of the first iteration (progressive photon mapping's kNN start),
+    /// 0..=65536; 0: no such bound (default 16).
+    #[arg(long, value_name = "K", value_parser = in_range(0, 1 << 16), conflicts_with = "radius")]
     pub start_photons: Option<u32>,
     /// SPPM: photon bounces (1..=64); Russian roulette ends most far sooner.
     #[arg(long, default_value_t = 32, value_parser = in_range(1, 64))]
@@ -257,16 +265,15 @@ impl From<&SppmArgs> for SppmOptions {
             alpha: a.alpha,
             photons_per_iteration: a.photons_per_iteration,
             initial_radius: a.radius.map(|r| r as f32),
-            start: match (a.start_photons, a.start_pixels) {
-                (None, None) => SppmStart::DEFAULT,
-                // The kNN start alone, as progressive photon mapping's.
-                (Some(k), None) => SppmStart {
-                    pixels: None,
-                    photons: Some(k),
+            // Each flag replaces its own bound; 0 switches it off.
+            start: SppmStart {
+                pixels: match a.start_pixels {
+                    Some(p) => (p > 0.0).then_some(p as f32),
+                    None => SppmStart::DEFAULT.pixels,
                 },
-                (k, Some(p)) => SppmStart {
-                    pixels: Some(p as f32),
-                    photons: k.or(DEFAULT_START_PHOTONS),
+                photons: match a.start_photons {
+                    Some(k) => (k > 0).then_some(k),
+                    None => SppmStart::DEFAULT.photons,
                 },
             },
             leak: None,
