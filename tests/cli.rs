@@ -1377,7 +1377,7 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
     );
     let interpolated = json["adaptive_samples"]["interpolated"].as_u64().unwrap();
     assert!(0 < interpolated && interpolated < 40 * 36, "{interpolated}");
-    let refused: [(&[&str], &str); 10] = [
+    let refused: [(&[&str], &str); 13] = [
         (
             &["--adaptive", "--method", "sppm", "--sppm-direct", "photons"],
             "shadow-rays",
@@ -1411,6 +1411,18 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
         ),
         (&["--gather-k", "10"], "--final-gather"),
         (&["--adaptive-threshold", "0.2"], "--adaptive"),
+        (
+            &["--method", "sppm", "--start-photons", "70000"],
+            "0..=65536",
+        ),
+        (
+            &["--method", "sppm", "--start-pixels=-1"],
+            "0..=1000000 (0: no bound)",
+        ),
+        (
+            &["--method", "sppm", "--start-pixels", "2", "--radius", "0.1"],
+            "--radius",
+        ),
     ];
     for (args, says) in refused {
         let ring = args.contains(&"--scene-name-ring");
@@ -1667,14 +1679,31 @@ fn bench_mitsuba_and_tables_refuse_what_they_cannot_do() {
 }
 
 /// `bench mitsuba` refuses a budget that is not a positive number of
-/// seconds, a --reference or --mask that is not there, and a mask of another
-/// size, before it runs Mitsuba or writes anything.
+/// seconds, a --reference or --mask that is not there, a mask of another
+/// size, and a --mitsuba-reference that cannot be made, before it runs
+/// Mitsuba or writes anything.
 #[test]
 fn bench_mitsuba_refuses_bad_budgets_references_and_masks() {
     let d = tmp("bench-mitsuba");
     let out_dir = d.join("out");
-    let refused: [(&[&str], &str); 5] = [
+    let refused: [(&[&str], &str); 10] = [
         (&["--seconds", "0"], "--seconds"),
+        (&["--mitsuba-reference", "0"], "--mitsuba-reference"),
+        (&["--mitsuba-reference", "10", "--scale", "3"], "--scale 3"),
+        (&["--scale", "2"], "--mitsuba-reference"),
+        (
+            &["--mitsuba-reference", "10", "--reference", "x.exr"],
+            "cannot be used with",
+        ),
+        (
+            &[
+                "--mitsuba-reference",
+                "10",
+                "--mask",
+                "reference_images/truth/cornell_box_interior_mask.png",
+            ],
+            "256 x 256",
+        ),
         (&["--seconds", "30,-1"], "--seconds"),
         (
             &["--reference", "/nonexistent/truth.exr"],

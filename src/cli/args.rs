@@ -183,7 +183,9 @@ fn positive(s: &str) -> Result<f64, String> {
 fn footprints(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(v) if (0.0..=1e6).contains(&v) => Ok(v),
-        _ => Err(format!("{s}: give pixel footprints in 0..=1000000 (0: no bound)")),
+        _ => Err(format!(
+            "{s}: give pixel footprints in 0..=1000000 (0: no bound)"
+        )),
     }
 }
 

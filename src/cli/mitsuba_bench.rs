@@ -48,8 +48,20 @@ pub struct MitsubaBenchArgs {
     /// reference_images/truth/<scene>.exr where it exists, else the scene's
     /// SPPM reference as `bench accuracy` finds it). Everything renders at
     /// its size, which must be the scene's divided by a whole number.
-    #[arg(long, value_name = "EXR")]
+    #[arg(long, value_name = "EXR", conflicts_with = "mitsuba_reference")]
     pub reference: Option<PathBuf>,
+    /// For scenes without committed truth: the reference is Mitsuba's path
+    /// tracer, two independent runs of this many seconds each, averaged
+    /// (`reference.exr` in --out); their difference gives its noise. Path
+    /// tracing converges to the exact image, but slowly where light reaches
+    /// diffuse surfaces through mirrors or glass, and never from a point
+    /// light through them: use it for scenes it handles.
+    #[arg(long, value_name = "SECONDS", value_parser = budget_seconds)]
+    pub mitsuba_reference: Option<f64>,
+    /// With --mitsuba-reference: render at the scene's size divided by this
+    /// (1..=16; the size must divide).
+    #[arg(long, default_value_t = 2, value_parser = in_range(1, 16), requires = "mitsuba_reference")]
+    pub scale: u32,
     /// Only pixels where this PNG (the reference's size) is bright count
     /// (default with the default truth: its interior mask,
     /// reference_images/truth/<scene>_interior_mask.png; otherwise every
@@ -161,8 +173,9 @@ pub struct MitsubaBench {
     pub reference_kind: String,
     pub mask: Option<String>,
     pub pixels_compared: usize,
-    /// The truth's own relative noise (full-size image), from its
-    /// noise.json: nothing is measured more finely.
+    /// The reference's own relative noise: the truth's noise.json figure
+    /// (full-size image), or a --mitsuba-reference's from its two runs.
+    /// Nothing is measured more finely.
     pub truth_noise: Option<f64>,
     pub gl_renderer: String,
     pub variant: String,
@@ -311,6 +324,7 @@ fn render_mitsuba(
     integrator: &str,
     seconds: f64,
     checkpoints: &[f64],
+    seed: u32,
 ) -> Result<(Taken, Vec<Taken>)> {
     let exr = dir.join(format!("mitsuba_{integrator}.exr"));
     let marks: Vec<String> = checkpoints.iter().map(|c| format!("{c}")).collect();
@@ -322,6 +336,7 @@ fn render_mitsuba(
         .arg(integrator)
         .arg(&a.variant)
         .arg(marks.join(","))
+        .arg(format!("{seed}"))
         .output()
         .with_context(|| format!("running {}", a.python))?;
     if !run.status.success() {
@@ -420,15 +435,7 @@ fn target(a: &MitsubaBenchArgs, scene: &Scene, name: &str) -> Result<(Target, u3
         }
         None => None,
     };
-    let mask = mask
-        .map(|m| -> Result<_> {
-            let keep = read_mask(&m, &image)?;
-            if !keep.contains(&true) {
-                bail!("--mask {}: keeps no pixel", m.display());
-            }
-            Ok((m, keep))
-        })
-        .transpose()?;
+    let mask = mask.map(|m| checked_mask(&m, &image)).transpose()?;
     let noise = (kind == "truth").then(|| truth_noise(name)).flatten();
     Ok((
         Target {
@@ -441,6 +448,97 @@ fn target(a: &MitsubaBenchArgs, scene: &Scene, name: &str) -> Result<(Target, u3
         scale,
     ))
 }
+
+/// The size a --mitsuba-reference renders at: the scene's over --scale.
+fn mitsuba_reference_size(a: &MitsubaBenchArgs, scene: &Scene) -> Result<(u32, u32)> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if w % a.scale != 0 || h % a.scale != 0 {
+        bail!(
+            "--scale {}: does not divide the scene's {w} x {h} pixels",
+            a.scale
+        );
+    }
+    Ok((w / a.scale, h / a.scale))
+}
+
+/// --mask, read and checked against a width x height image.
+fn mask_of_size(
+    a: &MitsubaBenchArgs,
+    width: u32,
+    height: u32,
+) -> Result<Option<(PathBuf, Vec<bool>)>> {
+    let blank = Image {
+        width,
+        height,
+        pixels: vec![[0.0; 3]; (width * height) as usize],
+    };
+    a.mask.as_ref().map(|m| checked_mask(m, &blank)).transpose()
+}
+
+/// The mask at `m`, which must be `image`'s size and keep some pixel.
+fn checked_mask(m: &Path, image: &Image) -> Result<(PathBuf, Vec<bool>)> {
+    let keep = read_mask(m, image)?;
+    if !keep.contains(&true) {
+        bail!("--mask {}: keeps no pixel", m.display());
+    }
+    Ok((m.to_path_buf(), keep))
+}
+
+/// The reference as Mitsuba's path tracer makes it (--mitsuba-reference):
+/// two runs with distinct seeds, averaged, written as `reference.exr`; its
+/// relative noise is half the RMSE between the runs over the mean, on the
+/// mask's pixels.
+fn mitsuba_target(
+    a: &MitsubaBenchArgs,
+    dir: &Path,
+    mask: Option<(PathBuf, Vec<bool>)>,
+    progress: &dyn Fn(&str),
+) -> Result<(Target, u32)> {
+    let seconds = a.mitsuba_reference.expect("only with --mitsuba-reference");
+    let mut halves = Vec::new();
+    for half in 0..2u32 {
+        progress(&format!(
+            "reference: Mitsuba path, run {} of 2, {seconds:.1} s",
+            half + 1
+        ));
+        let ((_, _, image), _) =
+            render_mitsuba(a, dir, "path", seconds, &[], REFERENCE_SEEDS * (half + 1))?;
+        halves.push(image);
+    }
+    let mut image = halves[0].clone();
+    for (p, q) in image.pixels.iter_mut().zip(&halves[1].pixels) {
+        for c in 0..3 {
+            p[c] = 0.5 * (p[c] + q[c]);
+        }
+    }
+    let keep = |i: usize| mask.as_ref().is_none_or(|m| m.1[i]);
+    let (mut squared, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for (i, (p, q)) in halves[0].pixels.iter().zip(&halves[1].pixels).enumerate() {
+        if keep(i) {
+            for c in 0..3 {
+                squared += f64::from(p[c] - q[c]).powi(2);
+                sum += 0.5 * f64::from(p[c] + q[c]);
+            }
+            n += 3;
+        }
+    }
+    let noise = 0.5 * (squared / n as f64).sqrt() / (sum / n as f64);
+    let path = dir.join("reference.exr");
+    write_atomically(&path, &image.exr_bytes()?)?;
+    Ok((
+        Target {
+            path,
+            kind: "Mitsuba path reference",
+            image,
+            mask,
+            noise: Some(noise),
+        },
+        a.scale,
+    ))
+}
+
+/// The reference runs' first seeds: far from the benchmark's own (0..).
+const REFERENCE_SEEDS: u32 = 1 << 20;
 
 /// The truth's relative noise (full-size image) from its noise.json.
 fn truth_noise(name: &str) -> Option<f64> {
@@ -617,7 +715,7 @@ fn race(
     rows.push(row);
     for integrator in &a.integrators {
         progress(&format!("Mitsuba {integrator}, {budget:.1} s"));
-        let (taken, along) = render_mitsuba(a, bench.dir, integrator, budget, &checkpoints)?;
+        let (taken, along) = render_mitsuba(a, bench.dir, integrator, budget, &checkpoints, 0)?;
         let (label, stem) = (
             format!("Mitsuba {integrator}"),
             format!("mitsuba_{integrator}_{tag}"),
@@ -631,23 +729,46 @@ fn race(
     Ok(())
 }
 
-pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
-    let scene = embedded::load_path_or_name(&a.scene)?;
-    let name = stem(&a.scene);
-    let (target, scale) = target(a, &scene, &name)?;
+/// Everything before the races: the reference (checked, or made by
+/// Mitsuba with --mitsuba-reference), the output folder, and the export and
+/// script Mitsuba runs from. Returns the reference, its scale and the folder.
+fn prepare(a: &MitsubaBenchArgs, scene: &Scene, name: &str) -> Result<(Target, u32, PathBuf)> {
+    let given = match a.mitsuba_reference {
+        None => Some(target(a, scene, name)?),
+        Some(_) => None,
+    };
+    let (width, height) = match &given {
+        Some((t, _)) => (t.image.width, t.image.height),
+        None => mitsuba_reference_size(a, scene)?,
+    };
+    let mitsuba_mask = match given {
+        Some(_) => None,
+        None => mask_of_size(a, width, height)?,
+    };
     check_mitsuba(a)?;
     let dir = a
         .out
         .clone()
-        .unwrap_or_else(|| super::out_dir("mitsuba").join(&name));
+        .unwrap_or_else(|| super::out_dir("mitsuba").join(name));
     std::fs::create_dir_all(&dir)?;
-    let progress = super::progress_lines(a.quiet);
-    let (width, height) = (target.image.width, target.image.height);
     write_atomically(
         &dir.join(EXPORT_FILE),
-        serde_json::to_string(&export(&scene, width, height, a.max_depth))?.as_bytes(),
+        serde_json::to_string(&export(scene, width, height, a.max_depth))?.as_bytes(),
     )?;
     write_atomically(&dir.join(SCRIPT_FILE), SCRIPT.as_bytes())?;
+    let (target, scale) = match given {
+        Some(t) => t,
+        None => mitsuba_target(a, &dir, mitsuba_mask, &super::progress_lines(a.quiet))?,
+    };
+    Ok((target, scale, dir))
+}
+
+pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
+    let scene = embedded::load_path_or_name(&a.scene)?;
+    let name = stem(&a.scene);
+    let (target, scale, dir) = prepare(a, &scene, &name)?;
+    let (width, height) = (target.image.width, target.image.height);
+    let progress = super::progress_lines(a.quiet);
     let gpu = super::gpu(platform)?;
     let bench = Bench {
         dir: &dir,
@@ -728,6 +849,9 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
         &dir.join(TABLE_FILE),
         markdown_table(&report, &command_line()).as_bytes(),
     )?;
+    // The script is this binary's own (src/cli/mitsuba_render.py); the
+    // export stays, as the record of what Mitsuba rendered.
+    let _ = std::fs::remove_file(dir.join(SCRIPT_FILE));
     if a.json {
         super::print_json(&report)
     } else {
@@ -750,7 +874,7 @@ fn command_line() -> String {
 /// the documentation to link rather than retype.
 fn markdown_table(b: &MitsubaBench, command: &str) -> String {
     let mut s = format!(
-        "`{command}`\n\n{} ({} x {}), against {} ({}), {}, {} pixels; {}.\n\n",
+        "`{command}`\n\n{} ({} x {}), against {} ({}), {}, {} pixels{}; {}.\n\n",
         b.scene,
         b.width,
         b.height,
@@ -760,6 +884,10 @@ fn markdown_table(b: &MitsubaBench, command: &str) -> String {
             .as_deref()
             .map_or("no mask".into(), |m| format!("mask {m}")),
         b.pixels_compared,
+        b.truth_noise.map_or(String::new(), |n| format!(
+            ", whose own noise is {:.2}%",
+            100.0 * n
+        )),
         b.gl_renderer
     );
     s += "| renderer | budget (s) | seconds | samples | camera paths/s | photons/s | relative RMSE | energy |\n";
@@ -828,7 +956,7 @@ fn plot(name: &str, target: &Target, rows: &[Row], curves: &[Curve]) -> String {
         p.points("#9467bd", one_map, false);
     }
     if let Some(n) = target.noise {
-        p.level("the truth's own noise (full-size image)", "#7f7f7f", n);
+        p.level("the reference's own noise", "#7f7f7f", n);
     }
     p.svg()
 }
@@ -846,7 +974,7 @@ fn print_table(b: &MitsubaBench) {
             .map_or("no mask".into(), |m| format!("mask {m}")),
         b.pixels_compared,
         b.truth_noise.map_or(String::new(), |n| format!(
-            "; the truth's own noise {:.2}%",
+            "; the reference's own noise {:.2}%",
             100.0 * n
         ))
     );

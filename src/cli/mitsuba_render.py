@@ -2,7 +2,7 @@
 """Renders a scene exported by `photonmap bench mitsuba` with Mitsuba 3 for a
 wall-clock budget, and writes the image as linear EXR.
 
-Usage: mitsuba_render.py EXPORT.json BUDGET_SECONDS OUT.exr INTEGRATOR VARIANT [CHECKPOINTS]
+Usage: mitsuba_render.py EXPORT.json BUDGET_SECONDS OUT.exr INTEGRATOR VARIANT [CHECKPOINTS [SEED]]
 
 The clock starts before the first render call (so Mitsuba's JIT compilation
 counts, as a user would wait for it) and stops after the pass that crosses
@@ -16,7 +16,9 @@ CHECKPOINTS (comma-separated seconds, optional) writes the running mean as
 OUT-without-.exr + "_<k>.exr" after the first pass that crosses each; the
 clock does not count writing them. Prints one JSON line: {"seconds": ...,
 "spp": ..., "load_seconds": ..., "checkpoints": [{"seconds", "spp",
-"file"}, ...]}.
+"file"}, ...]}. SEED (default 0) is the first pass's seed; each later
+pass takes the next, so runs whose seeds are a million apart are
+independent.
 """
 import json
 import os
@@ -57,6 +59,7 @@ def bsdf(m):
 def main():
     export, budget, out, integrator, variant = sys.argv[1:6]
     checkpoints = sys.argv[6] if len(sys.argv) > 6 else ""
+    first_seed = int(sys.argv[7]) if len(sys.argv) > 7 else 0
     budget = float(budget)
     import mitsuba as mi
     mi.set_variant(variant)
@@ -104,7 +107,7 @@ def main():
     pixels = cam["width"] * cam["height"]
     marks = sorted(float(c) for c in checkpoints.split(",") if c) if checkpoints else []
     written = []
-    total, spp, seed, paused = None, 0, 0, 0.0
+    total, spp, seed, paused = None, 0, first_seed, 0.0
     t0 = time.perf_counter()
     while True:
         t1 = time.perf_counter()
@@ -114,7 +117,7 @@ def main():
         seed += 1
         # Fewer, larger passes once compiled: a pass's fixed cost is Mitsuba's
         # to save, while one pass still overshoots the budget by little.
-        if seed > 1 and time.perf_counter() - t1 < min(1.0, budget / 16) and 2 * batch * pixels <= 1 << 25:
+        if seed > first_seed + 1 and time.perf_counter() - t1 < min(1.0, budget / 16) and 2 * batch * pixels <= 1 << 25:
             batch *= 2
         elapsed = time.perf_counter() - t0 - paused
         if elapsed >= budget:
