@@ -873,23 +873,7 @@ fn command_line() -> String {
 /// The rows as a Markdown table, headed by the command that made them, for
 /// the documentation to link rather than retype.
 fn markdown_table(b: &MitsubaBench, command: &str) -> String {
-    let mut s = format!(
-        "`{command}`\n\n{} ({} x {}), against {} ({}), {}, {} pixels{}; {}.\n\n",
-        b.scene,
-        b.width,
-        b.height,
-        b.reference,
-        b.reference_kind,
-        b.mask
-            .as_deref()
-            .map_or("no mask".into(), |m| format!("mask {m}")),
-        b.pixels_compared,
-        b.truth_noise.map_or(String::new(), |n| format!(
-            ", whose own noise is {:.2}%",
-            100.0 * n
-        )),
-        b.gl_renderer
-    );
+    let mut s = format!("`{command}`\n\n{}; {}.\n\n", heading(b), b.gl_renderer);
     s += "| renderer | budget (s) | seconds | samples | camera paths/s | photons/s | relative RMSE | energy |\n";
     s += "|---|---|---|---|---|---|---|---|\n";
     for r in &b.rows {
@@ -961,9 +945,10 @@ fn plot(name: &str, target: &Target, rows: &[Row], curves: &[Curve]) -> String {
     p.svg()
 }
 
-fn print_table(b: &MitsubaBench) {
-    println!(
-        "{} ({} x {}) against {} ({}), {}; {} pixels{}",
+/// What was compared with what: the tables' first line.
+fn heading(b: &MitsubaBench) -> String {
+    format!(
+        "{} ({} x {}), against {} ({}), {}, {} pixels{}",
         b.scene,
         b.width,
         b.height,
@@ -974,10 +959,14 @@ fn print_table(b: &MitsubaBench) {
             .map_or("no mask".into(), |m| format!("mask {m}")),
         b.pixels_compared,
         b.truth_noise.map_or(String::new(), |n| format!(
-            "; the reference's own noise {:.2}%",
+            ", whose own noise is {:.2}%",
             100.0 * n
         ))
-    );
+    )
+}
+
+fn print_table(b: &MitsubaBench) {
+    println!("{}", heading(b));
     println!(
         "{:<16} {:>7} {:>8} {:>8} {:>9} {:>9} {:>9} {:>7} {:>8}  image",
         "renderer",

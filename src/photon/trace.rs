@@ -108,6 +108,30 @@ impl PhotonFrames {
     }
 }
 
+/// What both bounce programs (per bounce and fused) read: the scene, the
+/// random numbers, the records, and `photon/bounce.glsl`'s uniforms.
+fn bind_bounce_inputs(
+    b: &mut crate::gpu::Bindings<'_>,
+    scene: &Scene,
+    textures: &SceneTextures,
+    batch: &PhotonBatch,
+    seed: u32,
+) {
+    let f = &batch.frames;
+    textures.bind(b);
+    if let Some((_, r)) = &batch.random {
+        b.texture("u_random_numbers", r);
+    }
+    b.texture("u_position", &f.position)
+        .texture("u_power", &f.power)
+        .texture("u_incoming", &f.incoming)
+        .texture("u_outgoing", &f.outgoing)
+        .uint("u_seed", seed)
+        .int("u_frame_height", f.frame_height as i32)
+        .int("u_store_direct", scene.photon_map.store_direct as i32)
+        .int("u_caustics_only", scene.photon_map.caustics_only as i32);
+}
+
 /// Frame width and height for `emitted` photons and `frames` frames: square-ish
 /// frames (width a power of two) stacked within the driver's texture size.
 pub fn frame_layout(emitted: u32, frames: u32, max_size: u32) -> Result<(u32, u32)> {
@@ -552,20 +576,9 @@ impl PhotonTracer {
         // The previous frame was drawn into these very textures.
         self.gpu.texture_barrier();
         let mut b = self.bounce.bind();
-        textures.bind(&mut b);
-        if let Some((_, r)) = &pass.random {
-            b.texture("u_random_numbers", r);
-        }
+        bind_bounce_inputs(&mut b, scene, textures, pass, seed);
         let fh = f.frame_height as i32;
-        b.texture("u_position", &f.position)
-            .texture("u_power", &f.power)
-            .texture("u_incoming", &f.incoming)
-            .texture("u_outgoing", &f.outgoing)
-            .uint("u_seed", seed)
-            .int("u_bounce", bounce as i32)
-            .int("u_frame_height", fh)
-            .int("u_store_direct", scene.photon_map.store_direct as i32)
-            .int("u_caustics_only", scene.photon_map.caustics_only as i32);
+        b.int("u_bounce", bounce as i32);
         pass.timer.begin();
         let drawn = b.draw_region(
             &f.target,
@@ -617,23 +630,12 @@ impl PhotonTracer {
             batch.fused.as_ref().expect("clear_power made them"),
         );
         let mut b = program.bind();
-        textures.bind(&mut b);
-        if let Some((_, r)) = &batch.random {
-            b.texture("u_random_numbers", r);
-        }
-        b.texture("u_position", &f.position)
-            .texture("u_power", &f.power)
-            .texture("u_incoming", &f.incoming)
-            .texture("u_outgoing", &f.outgoing)
-            .image("u_position_out", &f.position)
+        bind_bounce_inputs(&mut b, scene, textures, batch, seed);
+        b.image("u_position_out", &f.position)
             .image("u_power_out", &f.power)
             .image("u_incoming_out", &f.incoming)
             .image("u_outgoing_out", &f.outgoing)
-            .uint("u_seed", seed)
-            .int("u_frame_height", f.frame_height as i32)
-            .int("u_frames", f.frames as i32)
-            .int("u_store_direct", scene.photon_map.store_direct as i32)
-            .int("u_caustics_only", scene.photon_map.caustics_only as i32);
+            .int("u_frames", f.frames as i32);
         batch.timer.begin();
         let drawn = b.draw_fullscreen(&targets.last_target, &DrawState::PLAIN);
         batch.timer.end();
