@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Gpu, TexFormat, Texture};
 use crate::metrics::compare;
 use crate::photon::{BitonicBuild, BuildMethod, PhotonConfig, PhotonMap};
-use crate::render::{render, GlobalIllumination, RenderOptions, RenderOutput};
+use crate::render::{render, Method, PhotonMapOptions, RenderOptions, RenderOutput};
 use crate::scene::{embedded, load_scene_str, load_scene_str_translated, Light, Rebase, Scene};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -48,7 +48,7 @@ pub fn non_finite_buffers(out: &RenderOutput) -> String {
     check("diffuse positions", &d.diffuse_position);
     check("diffuse normals", &d.diffuse_normal);
     check("diffuse throughput", &d.diffuse_throughput);
-    match &out.state.map {
+    match out.map() {
         Some(PhotonMap::Sorted(m)) => {
             check("map positions", &m.position);
             check("map power", &m.power);
@@ -60,7 +60,7 @@ pub fn non_finite_buffers(out: &RenderOutput) -> String {
         }
         None => {}
     }
-    if let Some(e) = &out.state.estimate {
+    if let Some(e) = out.radiance_estimate() {
         check("estimate flux", &e.flux);
     }
     if out.image.has_non_finite() {
@@ -496,12 +496,12 @@ fn grids(gpu: &Gpu, quick: bool, progress: &dyn Fn(&str), cases: &mut Vec<Stress
         progress(&label);
         cases.push(case(&label, figure, || {
             let mut o = small(&scene, 64, 48, 1);
-            o.global = Some(GlobalIllumination {
+            o.method = Method::PhotonMap(PhotonMapOptions {
                 photons: PhotonConfig {
                     build,
                     ..PhotonConfig::default()
                 },
-                ..GlobalIllumination::default()
+                ..PhotonMapOptions::default()
             });
             let (out, bad) = finite_render(gpu, &scene, &o)?;
             let mean = out.image.mean()[0];

@@ -9,7 +9,7 @@ use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::reference::adaptive::{adaptive_light, FirstHits};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::{
-    render, AdaptiveOptions, EstimateOptions, FinalGatherOptions, GlobalIllumination, Image,
+    render, AdaptiveOptions, EstimateOptions, FinalGatherOptions, Image, Method, PhotonMapOptions,
     RenderOptions, RenderOutput,
 };
 use photonmap::scene::load_scene_str;
@@ -18,7 +18,7 @@ fn options(w: u32, h: u32, gather: bool, adaptive: bool, build: BuildMethod) -> 
     let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
     let mut o = RenderOptions::for_scene(&scene);
     (o.width, o.height, o.seed) = (w, h, 3);
-    o.global = Some(GlobalIllumination {
+    o.method = Method::PhotonMap(PhotonMapOptions {
         photons: PhotonConfig {
             build,
             ..PhotonConfig::default()
@@ -32,9 +32,6 @@ fn options(w: u32, h: u32, gather: bool, adaptive: bool, build: BuildMethod) -> 
             ..FinalGatherOptions::default()
         }),
         adaptive: adaptive.then(AdaptiveOptions::default),
-        igi: None,
-        differentials: None,
-        radiosity: None,
     });
     o
 }
@@ -80,7 +77,7 @@ fn check(gather: bool, build: BuildMethod) {
     let threshold = AdaptiveOptions::default().threshold;
     let (twin, levels) = adaptive_light(&first_hits(&ad), &|i| full_light[i], threshold);
     let got = global_light(&ad);
-    let stats = &ad.adaptive[0];
+    let stats = &ad.adaptive()[0];
     let apart = got
         .iter()
         .zip(&twin)

@@ -82,7 +82,7 @@ fn render_case(gpu: &photonmap::gpu::Gpu, c: &Case) -> Image {
     // The stored images were drawn 8 shadow samples a pass; the default
     // batch adds the same samples in another order (the test below).
     o.shadow_batch = 8;
-    let gi = o.global.as_mut().unwrap();
+    let gi = o.photon_map_mut().unwrap();
     gi.photons.build = c.build;
     gi.photons.faithful = c.faithful;
     render(gpu, &scene, &o, &mut ()).unwrap().image

@@ -13,8 +13,8 @@ use photonmap::photon::differentials::light_measures;
 use photonmap::reference::differentials::{self as twin, Footprint};
 use photonmap::reference::photon::PhotonRecord;
 use photonmap::render::{
-    render, DifferentialsOptions, DifferentialsRun, GlobalIllumination, Kernel, RenderOptions,
-    RenderOutput,
+    render, DifferentialsOptions, DifferentialsRun, Kernel, Method, RenderOptions, RenderOutput,
+    WithPhotons,
 };
 use photonmap::scene::{load_scene_str, Material, Scene};
 
@@ -25,15 +25,15 @@ fn scene(text: &str) -> Scene {
 fn run(scene: &Scene, w: u32, h: u32, o: DifferentialsOptions) -> RenderOutput {
     let mut options = RenderOptions::for_scene(scene);
     (options.width, options.height, options.seed) = (w, h, 5);
-    options.global = Some(GlobalIllumination {
-        differentials: Some(o),
-        ..GlobalIllumination::default()
+    options.method = Method::Differentials(WithPhotons {
+        method: o,
+        ..WithPhotons::default()
     });
     render(&common::gpu(), scene, &options, &mut ()).unwrap()
 }
 
 fn state(out: &RenderOutput) -> &DifferentialsRun {
-    out.state.differentials.as_ref().unwrap()
+    out.differentials_run().unwrap()
 }
 
 /// Every traced record, frames stacked.

@@ -10,14 +10,14 @@ use photonmap::reference::final_gather::{gather_ray, gathered_radiance, GatherHi
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::{
-    render, EstimateOptions, FinalGatherOptions, GlobalIllumination, RenderOptions,
+    render, EstimateOptions, FinalGatherOptions, Method, PhotonMapOptions, RenderOptions,
 };
 use photonmap::scene::{load_scene_str, Material, Scene};
 
 fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (w, h, seed);
-    o.global = Some(GlobalIllumination {
+    o.method = Method::PhotonMap(PhotonMapOptions {
         photons: PhotonConfig::default(),
         estimate: EstimateOptions {
             leak: LeakTest::None,
@@ -29,9 +29,6 @@ fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -
             leak: LeakTest::None,
         }),
         adaptive: None,
-        igi: None,
-        differentials: None,
-        radiosity: None,
     });
     o
 }
@@ -54,9 +51,9 @@ fn final_gather_equals_its_cpu_twin() {
         &mut (),
     )
     .unwrap();
-    let fg = out.state.gather.as_ref().unwrap();
+    let fg = out.gather().unwrap();
     assert_eq!(fg.batch, rays, "one batch holds every ray");
-    let map = CpuPhotonMap::from_gpu(out.state.gather_map.as_ref().unwrap());
+    let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
     let first = common::texels(&out.state.direct.diffuse_position);
     let first_normal = common::texels(&out.state.direct.diffuse_normal);
     let first_throughput = common::texels(&out.state.direct.diffuse_throughput);

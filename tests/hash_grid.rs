@@ -12,7 +12,7 @@ use photonmap::photon::{
 };
 use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
 use photonmap::reference::photon::route_hashed;
-use photonmap::render::{render, GlobalIllumination, RenderOptions, RenderOutput};
+use photonmap::render::{render, Method, PhotonMapOptions, RenderOptions, RenderOutput};
 use photonmap::scene::Scene;
 use photonmap::timing::Timings;
 
@@ -24,13 +24,13 @@ fn render_with(
     let gpu = common::gpu();
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (width, height, 3);
-    let mut gi = GlobalIllumination {
+    let mut gi = PhotonMapOptions {
         photons,
-        ..GlobalIllumination::default()
+        ..PhotonMapOptions::default()
     };
     gi.estimate.budget = 48;
     gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
-    o.global = Some(gi);
+    o.method = Method::PhotonMap(gi);
     render(&gpu, scene, &o, &mut ())
 }
 
@@ -45,7 +45,7 @@ fn config(build: BuildMethod, grid: GridKind, hash_buckets: Option<u32>) -> Phot
 
 /// (query pixel, position, flux, r^2, accepted, photons examined) of every query.
 fn queries(out: &RenderOutput) -> Vec<(usize, Vec3, Vec3, f32, u32, u64)> {
-    let est = out.state.estimate.as_ref().unwrap();
+    let est = out.radiance_estimate().unwrap();
     let (flux, cursor, done) = (
         est.flux.read_f32(),
         est.cursor.read_i32(),
@@ -79,7 +79,7 @@ fn hashed_maps_and_knn_search_equal_the_cpu_twin() {
         for buckets in [None, Some(61)] {
             let out =
                 render_with(&scene, (48, 36), config(build, GridKind::Hash, buckets)).unwrap();
-            let map = out.state.map.as_ref().unwrap();
+            let map = out.map().unwrap();
             assert!(map.grid().buckets().is_some());
             let cpu_map = CpuPhotonMap::from_gpu(map);
             let results = queries(&out);
@@ -162,7 +162,7 @@ fn a_1024_cubed_grid_renders_hashed_and_is_refused_uniform() {
         config(BuildMethod::Bitonic, GridKind::Hash, None),
     )
     .unwrap();
-    assert_eq!(out.state.map.as_ref().unwrap().grid().resolution, [1024; 3]);
+    assert_eq!(out.map().unwrap().grid().resolution, [1024; 3]);
     assert!(out.image.pixels.iter().flatten().all(|v| v.is_finite()));
     assert!(out.image.pixels.iter().flatten().any(|&v| v > 0.0));
 }

@@ -8,17 +8,15 @@ mod common;
 
 use glam::Vec3;
 use photonmap::reference::igi::{incident, Vpl};
-use photonmap::render::{render, GlobalIllumination, IgiOptions, RenderOptions, RenderOutput};
+use photonmap::render::{render, IgiOptions, Method, RenderOptions, RenderOutput, WithCausticMap};
 use photonmap::scene::{load_scene_str, Material, Scene};
 
 fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (w, h, seed);
-    o.global = Some(GlobalIllumination {
-        igi: Some(igi),
-        differentials: None,
-        radiosity: None,
-        ..GlobalIllumination::default()
+    o.method = Method::Igi(WithCausticMap {
+        method: igi,
+        ..WithCausticMap::default()
     });
     o
 }
@@ -28,10 +26,9 @@ fn mirror_box() -> Scene {
 }
 
 fn vpls(out: &RenderOutput) -> Vec<Vpl> {
-    out.state
-        .vpls
-        .as_ref()
+    out.igi_run()
         .unwrap()
+        .vpls
         .read()
         .into_iter()
         .map(|(p, n, i)| Vpl {
@@ -73,7 +70,7 @@ fn the_vpl_gather_equals_its_cpu_twin() {
         let v = vpls(&out);
         let pos = common::texels(&out.state.direct.diffuse_position);
         let nor = common::texels(&out.state.direct.diffuse_normal);
-        let got: Vec<Vec3> = common::texels(&out.state.igi.as_ref().unwrap().incident)
+        let got: Vec<Vec3> = common::texels(&out.igi_run().unwrap().igi.incident)
             .into_iter()
             .map(common::v3)
             .collect();
@@ -129,7 +126,7 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
     let m = igi.min_distance_for(&scene);
     let out = render(&gpu, &scene, &options(&scene, w, h, 4, igi), &mut ()).unwrap();
     let v = vpls(&out);
-    let state = out.state.igi.as_ref().unwrap();
+    let state = &out.igi_run().unwrap().igi;
     let pos = common::texels(&out.state.direct.diffuse_position);
     let nor = common::texels(&out.state.direct.diffuse_normal);
     let thr = common::texels(&out.state.direct.diffuse_throughput);
@@ -214,7 +211,7 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
     let points = (0..lw * lh)
         .filter(|&q| pos[shading(q % lw, q / lw)][3] > 0.0)
         .count() as u64;
-    assert_eq!(out.igi[0].shading_points, points);
+    assert_eq!(out.igi()[0].shading_points, points);
     // The joint bilateral upsampling on the GPU's filtered light.
     let albedo = |mat: f32| -> Vec3 {
         match scene.materials[mat as usize - 1] {
@@ -315,7 +312,7 @@ fn igi_in_the_furnace_converges_to_the_analytic_answer() {
         let bound = 3.0 / (2.0 * paths as f64).sqrt();
         eprintln!(
             "furnace, IGI {paths} paths ({} VPLs): mean {mean:.5} against {expected:.5} ({:+.3}%, 3 sigma of independent paths {:.2}%)",
-            out.vpls.as_ref().unwrap().vpls,
+            out.vpls().unwrap().vpls,
             100.0 * (mean / expected - 1.0),
             100.0 * bound
         );

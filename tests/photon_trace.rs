@@ -317,7 +317,7 @@ fn bounces_stop_when_no_photon_is_left_and_the_image_does_not_change() {
     let options = |all: bool| {
         let mut o = RenderOptions::for_scene(&scene);
         (o.width, o.height) = (32, 32);
-        if let Some(gi) = &mut o.global {
+        if let Some(gi) = o.photon_map_mut() {
             gi.photons.all_bounces = all;
         }
         o

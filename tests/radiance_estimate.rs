@@ -6,7 +6,9 @@ mod common;
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, Grid, PhotonConfig, PhotonFrames, PhotonMap};
 use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
-use photonmap::render::{render, EstimateMode, GlobalIllumination, RenderOptions, RenderOutput};
+use photonmap::render::{
+    render, EstimateMode, Method, PhotonMapOptions, RenderOptions, RenderOutput,
+};
 use photonmap::scene::Scene;
 
 fn render_gi(
@@ -31,25 +33,25 @@ fn gi_options(
 ) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (width, height, 3);
-    let mut gi = GlobalIllumination {
+    let mut gi = PhotonMapOptions {
         photons: PhotonConfig {
             build,
             ..PhotonConfig::default()
         },
-        ..GlobalIllumination::default()
+        ..PhotonMapOptions::default()
     };
     gi.estimate.mode = mode;
     gi.estimate.budget = 48;
     // The paper's estimate, which the CPU twin, brute force and the software
     // reference compute (the leak tests have their own test below).
     gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
-    o.global = Some(gi);
+    o.method = Method::PhotonMap(gi);
     o
 }
 
 /// Per query pixel: (position, GPU flux, GPU r^2, GPU accepted).
 fn gpu_results(out: &RenderOutput) -> Vec<(usize, Vec3, Vec3, f32, u32)> {
-    let est = out.state.estimate.as_ref().unwrap();
+    let est = out.radiance_estimate().unwrap();
     let flux = est.flux.read_f32();
     let cursor = est.cursor.read_i32();
     let done = est.done.read_i32();
@@ -80,7 +82,7 @@ fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
         let scene = common::paper_scene(name);
         for build in [BuildMethod::Bitonic, BuildMethod::Stencil] {
             let out = render_gi(&scene, w, h, build, EstimateMode::Tiled { tile: 16 });
-            let cpu_map = CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap());
+            let cpu_map = CpuPhotonMap::from_gpu(out.map().unwrap());
             let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
             let results = gpu_results(&out);
             assert!(
@@ -128,7 +130,7 @@ fn the_knn_grid_holds_the_true_k_nearest() {
         BuildMethod::Bitonic,
         EstimateMode::FullScreen,
     );
-    let cpu_map = CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap());
+    let cpu_map = CpuPhotonMap::from_gpu(out.map().unwrap());
     let photons: Vec<(Vec3, Vec3)> = cpu_map.photons().copied().collect();
     let (k, max_r) = (scene.photon_map.k as usize, scene.photon_map.max_radius);
     let mut checked = 0;
@@ -212,7 +214,7 @@ fn tiled_full_screen_and_masked_runs_give_identical_images() {
     assert_eq!(tiled.image, full.image, "tiled vs full screen");
     assert_eq!(tiled8.image, full.image, "8 x 8 tiles vs full screen");
     assert_eq!(masked.image, full.image, "masked vs full screen");
-    let e = tiled.estimate.unwrap();
+    let e = tiled.estimate().cloned().unwrap();
     assert!(
         e.tile_draws < e.tiles * e.passes as u64,
         "no tile ever stopped early: {e:?}"
@@ -339,7 +341,7 @@ fn the_software_reference_agrees_with_the_gpu() {
         EstimateMode::Tiled { tile: 16 },
     );
     // The CPU kNN-grid: the GPU's own rules, so the same image up to rounding.
-    let grid_img = software_image(&out.state, &scene, SoftwareEstimate::KnnGrid).unwrap();
+    let grid_img = software_image(&out, &scene, SoftwareEstimate::KnnGrid).unwrap();
     let close = out
         .image
         .pixels
@@ -354,7 +356,7 @@ fn the_software_reference_agrees_with_the_gpu() {
     );
     // Jensen's kd-tree takes exactly the k nearest where the kNN-grid takes at
     // least k: the same picture, slightly less blurred. Their means stay close.
-    let kd = software_image(&out.state, &scene, SoftwareEstimate::KdTree).unwrap();
+    let kd = software_image(&out, &scene, SoftwareEstimate::KdTree).unwrap();
     let (a, b) = (out.image.mean(), kd.mean());
     for c in 0..3 {
         assert!(
@@ -377,13 +379,13 @@ fn faithful_mode_renders_the_same_image() {
         for faithful in [false, true] {
             let mut o = RenderOptions::for_scene(&scene);
             (o.width, o.height) = (64, 48);
-            o.global = Some(GlobalIllumination {
+            o.method = Method::PhotonMap(PhotonMapOptions {
                 photons: PhotonConfig {
                     build,
                     faithful,
                     ..PhotonConfig::default()
                 },
-                ..GlobalIllumination::default()
+                ..PhotonMapOptions::default()
             });
             images.push(render(&gpu, &scene, &o, &mut ()).unwrap().image);
         }
@@ -410,11 +412,11 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
         ] {
             let mut o = RenderOptions::for_scene(&scene);
             (o.width, o.height, o.seed) = (w, h, 3);
-            let gi = o.global.as_mut().unwrap();
+            let gi = o.photon_map_mut().unwrap();
             gi.estimate.leak = leak;
             gi.estimate.budget = 48;
             let out = render(&gpu, &scene, &o, &mut ()).unwrap();
-            let cpu_map = CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap());
+            let cpu_map = CpuPhotonMap::from_gpu(out.map().unwrap());
             let normal = out.state.direct.diffuse_normal.read_f32();
             let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
             let thickness = photonmap::layout::DISC_THICKNESS * max_r;
@@ -466,19 +468,19 @@ fn culled_searches_end_in_the_paper_search_s_state_bit_for_bit() {
             for (cull, runs) in [(false, false), (true, false), (true, true)] {
                 let gpu = common::gpu();
                 let mut o = gi_options(&scene, w, h, build, EstimateMode::Tiled { tile: 16 });
-                let gi = o.global.as_mut().unwrap();
+                let gi = o.photon_map_mut().unwrap();
                 (gi.estimate.cull, gi.estimate.runs) = (cull, runs);
                 let out = render(&gpu, &scene, &o, &mut ()).unwrap();
                 // Read now: the next render makes its own context current.
-                let est = out.state.estimate.as_ref().unwrap();
+                let est = out.radiance_estimate().unwrap();
                 let twin = (cull, runs) == (false, false);
-                let cpu_map = twin.then(|| CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap()));
+                let cpu_map = twin.then(|| CpuPhotonMap::from_gpu(out.map().unwrap()));
                 let pos = out.state.direct.diffuse_position.read_f32();
                 states.push((
                     est.flux.read_f32(),
                     est.cursor.read_i32(),
                     est.done.read_i32(),
-                    out.estimate.unwrap().work,
+                    out.estimate().cloned().unwrap().work,
                 ));
                 let Some(cpu_map) = cpu_map else { continue };
                 let done = &states.last().unwrap().2;

@@ -22,7 +22,7 @@ use photonmap::reference::radiosity::{discontinuities, received, sub_shooters, S
 use photonmap::reference::ray_trace::closest_hit;
 use photonmap::render::radiosity::{block_outline, onto_surface, FormFactor};
 use photonmap::render::{
-    render, GlobalIllumination, RadiosityOptions, RenderOptions, RenderOutput,
+    render, Method, RadiosityOptions, RenderOptions, RenderOutput, WithCausticMap,
 };
 use photonmap::sampling::basis_around;
 use photonmap::scene::{load_scene_str, Scene};
@@ -53,9 +53,9 @@ fn scene(text: &str) -> Scene {
 fn solve(scene: &Scene, o: RadiosityOptions) -> RenderOutput {
     let mut options = RenderOptions::for_scene(scene);
     (options.width, options.height) = (16, 16);
-    options.global = Some(GlobalIllumination {
-        radiosity: Some(o),
-        ..GlobalIllumination::default()
+    options.method = Method::Radiosity(WithCausticMap {
+        method: o,
+        ..WithCausticMap::default()
     });
     render(&common::gpu(), scene, &options, &mut ()).unwrap()
 }
@@ -114,7 +114,7 @@ fn on_the_axis_the_disc_form_factor_is_the_analytic_point_to_disc_one() {
     // a^2 / (h^2 + a^2), with pi a^2 = A.
     let h = 0.5f32;
     let out = one_shooter_shot(h, FormFactor::Disc);
-    let r = out.state.radiosity.as_ref().unwrap();
+    let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let direct = common::texels(&r.direct);
     // The floor's upper side: patch 0 (side 0 faces +y); its middle element.
@@ -166,7 +166,7 @@ fn the_item_buffer_sees_what_shadow_rays_see() {
         ..RadiosityOptions::default()
     };
     let out = solve(&s, o.clone());
-    let r = out.state.radiosity.as_ref().unwrap();
+    let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let light = e.patches.iter().position(|p| p.emitter).unwrap() as u32;
     let g = &s.shapes[e.patches[light as usize].primitive].geometry;
@@ -284,8 +284,8 @@ intensity = [1.0, 1.0, 1.0]
             ..RadiosityOptions::default()
         };
         let out = solve(&s, o.clone());
-        let report = out.radiosity.as_ref().unwrap();
-        let r = out.state.radiosity.as_ref().unwrap();
+        let report = out.radiosity().unwrap();
+        let r = &out.radiosity_run().unwrap().radiosity;
         let (b, direct) = (common::texels(&r.radiosity), common::texels(&r.direct));
         let residual_now = common::texels(&r.residual);
         let e = &r.elements;
@@ -406,7 +406,7 @@ fn no_light_reaches_the_inside_of_a_closed_ball() {
     );
     let s = scene(&text);
     let out = solve(&s, RadiosityOptions::default());
-    let r = out.state.radiosity.as_ref().unwrap();
+    let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let b = common::texels(&r.radiosity);
     let ball = 1; // the second shape
@@ -444,7 +444,7 @@ fn the_polygon_form_factor_is_the_analytic_point_to_rectangle_one_everywhere() {
     // rectangle) exactly (to f32 rounding): nothing blocks.
     let h = 0.5f32;
     let out = one_shooter_shot(h, FormFactor::Polygon);
-    let r = out.state.radiosity.as_ref().unwrap();
+    let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let direct = common::texels(&r.direct);
     let floor = e.patch_of[0] as f32; // the floor's upper side
@@ -535,7 +535,7 @@ fn disc_to_disc(r1: f64, r2: f64, h: f64) -> f64 {
 fn measured_disc_form_factor(res: u32) -> f64 {
     let (s, o) = discs(res, 0.5, 0.5);
     let out = solve(&s, o);
-    let r = out.state.radiosity.as_ref().unwrap();
+    let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let direct = common::texels(&r.direct);
     let residual = common::texels(&r.residual);
@@ -645,7 +645,7 @@ material = "wall"
 /// Over the elements of diffuse patches: the sums of direct x area,
 /// radiosity x area and residual x area (red channel).
 fn box_sums(out: &RenderOutput) -> (f64, f64, f64) {
-    let r = out.state.radiosity.as_ref().unwrap();
+    let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let (direct, b, residual) = (
         common::texels(&r.direct),
@@ -735,7 +735,7 @@ intensity = [1.0, 1.0, 1.0]
                 ..RadiosityOptions::default()
             },
         );
-        let report = out.radiosity.as_ref().unwrap();
+        let report = out.radiosity().unwrap();
         assert!(report.converged);
         let (_, b, residual) = box_sums(&out);
         (b + residual * 0.5 / (1.0 - 0.5), report.shots)
@@ -778,8 +778,8 @@ fn adaptive_subdivision_splits_where_its_twin_finds_discontinuities() {
         ..RadiosityOptions::default()
     };
     let mut out = solve(&s, o.clone());
-    let report = out.radiosity.clone().unwrap();
-    let r = out.state.radiosity.as_mut().unwrap();
+    let report = out.radiosity().cloned().unwrap();
+    let r = &mut out.radiosity_run_mut().unwrap().radiosity;
     let b = common::texels(&r.radiosity);
     let live: Vec<usize> = (0..r.elements.tiles.len())
         .filter(|&t| {
@@ -834,9 +834,9 @@ fn split_tiles_take_the_shot_as_a_finer_uniform_atlas_does() {
     let s = scene(&light_over_floor(0.5));
     let run = |o: RadiosityOptions| {
         let out = solve(&s, o);
-        let r = out.state.radiosity.as_ref().unwrap();
+        let r = &out.radiosity_run().unwrap().radiosity;
         let direct = common::texels(&r.direct);
-        (out.radiosity.clone().unwrap(), direct, out)
+        (out.radiosity().cloned().unwrap(), direct, out)
     };
     let (report, da, adaptive) = run(RadiosityOptions {
         resolution: 8,
@@ -853,8 +853,8 @@ fn split_tiles_take_the_shot_as_a_finer_uniform_atlas_does() {
         subdivide: 0,
         ..RadiosityOptions::default()
     });
-    let a = &adaptive.state.radiosity.as_ref().unwrap().elements;
-    let u = &uniform.state.radiosity.as_ref().unwrap().elements;
+    let a = &adaptive.radiosity_run().unwrap().radiosity.elements;
+    let u = &uniform.radiosity_run().unwrap().radiosity.elements;
     let floor = a.patch_of[0] as u32;
     let (mut compared, mut worst) = (0, 0f32);
     for (t, tile) in a.tiles.iter().enumerate() {

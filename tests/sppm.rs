@@ -9,19 +9,19 @@ use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::reference::sppm::{update, PixelState, VisiblePoint};
 use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::sppm::{render_sppm, Sppm, SppmOptions};
-use photonmap::render::{GlobalIllumination, Image, RenderOptions};
+use photonmap::render::{Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::{load_scene_str, Material, Scene};
 use photonmap::timing::Timings;
 
 fn options(scene: &Scene, w: u32, h: u32, seed: u32, build: BuildMethod) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height, o.seed) = (w, h, seed);
-    o.global = Some(GlobalIllumination {
+    o.method = Method::PhotonMap(PhotonMapOptions {
         photons: PhotonConfig {
             build,
             ..PhotonConfig::default()
         },
-        ..GlobalIllumination::default()
+        ..PhotonMapOptions::default()
     });
     o
 }

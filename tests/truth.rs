@@ -45,7 +45,7 @@ fn ring_has_no_light_on_the_floor_its_wall_shades() {
     );
     // The paper's estimate without a leak test shows the band, so this can fail.
     let mut leaky = options.clone();
-    leaky.global.as_mut().unwrap().estimate.leak =
+    leaky.photon_map_mut().unwrap().estimate.leak =
         photonmap::render::radiance_estimate::LeakTest::None;
     let (lit_leaky, _) = lit_where_dark(&leaky);
     eprintln!("RING, no leak test: {lit_leaky} of {dark} lit");

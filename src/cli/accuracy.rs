@@ -18,7 +18,7 @@ use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
 use photonmap::render::{
     render, AdaptiveOptions, DifferentialsOptions, EstimateMode, FinalGatherOptions, IgiOptions,
-    Image, Kernel, RadiosityOptions,
+    Image, Kernel, Method, RadiosityOptions, WithCausticMap, WithPhotons,
 };
 use photonmap::scene::{embedded, Light, Scene};
 
@@ -454,7 +454,7 @@ fn render_config(
     s.render.shadow_rays = c.shadow_rays;
     let mut o = reference_options(&s, scale, seed);
     o.spp = c.spp;
-    let gi = o.global.as_mut().expect("global illumination");
+    let gi = o.photon_map_mut().expect("global illumination");
     gi.photons.build = c.build;
     gi.photons.grid = c.grid;
     gi.estimate.leak = c.leak;
@@ -468,9 +468,13 @@ fn render_config(
         ..FinalGatherOptions::default()
     });
     gi.adaptive = c.adaptive.then(AdaptiveOptions::default);
-    gi.igi = c.igi.clone();
-    gi.differentials = c.differentials.clone();
-    gi.radiosity = c.radiosity.clone();
+    let map = gi.clone();
+    o.method = match (&c.igi, &c.differentials, &c.radiosity) {
+        (Some(i), _, _) => Method::Igi(WithCausticMap::from_map(map, i.clone())),
+        (_, Some(d), _) => Method::Differentials(WithPhotons::from_map(map, d.clone())),
+        (_, _, Some(r)) => Method::Radiosity(WithCausticMap::from_map(map, r.clone())),
+        _ => Method::PhotonMap(map),
+    };
     let wall = std::time::Instant::now();
     let image = if c.method == "sppm" {
         let sppm = SppmOptions {

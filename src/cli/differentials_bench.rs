@@ -23,7 +23,8 @@ use photonmap::gpu::{Gpu, Platform};
 use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
 use photonmap::render::{
-    render, DifferentialsOptions, DifferentialsReport, Image, RenderOptions, RenderOutput,
+    render, DifferentialsOptions, DifferentialsReport, Image, Method, RenderOptions, RenderOutput,
+    WithPhotons,
 };
 use photonmap::scene::Scene;
 
@@ -114,12 +115,9 @@ impl Bench<'_> {
 
     /// The bench's options with photon differentials `d`.
     fn with_differentials(&self, d: DifferentialsOptions) -> RenderOptions {
-        let mut o = self.options();
-        o.global
-            .as_mut()
-            .expect("global illumination")
-            .differentials = Some(d);
-        o
+        let o = self.options();
+        let map = o.method.photon_map().cloned().unwrap_or_default();
+        o.with_method(Method::Differentials(WithPhotons::from_map(map, d)))
     }
 
     fn row(&mut self, label: &str, o: &RenderOptions) -> Result<(Row, RenderOutput)> {
@@ -166,8 +164,9 @@ impl Bench<'_> {
         let file = format!("{:02}_{}.png", self.rendered, super::igi_bench::slug(label));
         self.rendered += 1;
         write_atomically(&self.dir.join(file), &r.image.png_bytes()?)?;
-        let pd = r.differentials.as_ref();
-        let stats = r.footprint_estimates.first();
+        let pd = r.differentials();
+        let pd = pd.as_ref();
+        let stats = r.footprint_estimates().first();
         let row = Row {
             label: label.into(),
             method: if pd.is_some() {
@@ -238,7 +237,7 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
         &bench.with_differentials(DifferentialsOptions::default()),
     )?;
     let auto = out
-        .differentials
+        .differentials()
         .as_ref()
         .expect("a differentials render reports its map")
         .clone();

@@ -157,8 +157,7 @@ fn scene_rows(
             EstimateMode::Tiled { tile: 16 },
         );
         let gi = options
-            .global
-            .as_mut()
+            .photon_map_mut()
             .expect("Table 1 renders global light");
         (v.apply)(&mut gi.estimate);
         let mut times = Vec::new();
@@ -172,7 +171,7 @@ fn scene_rows(
                 a.runs
             ));
             let out = render(gpu, scene, &options, &mut ())?;
-            let stats = out.estimate.clone().unwrap_or_default();
+            let stats = out.estimate().cloned().unwrap_or_default();
             let total: f64 = out.timings.stages.iter().map(|s| s.wall_seconds).sum();
             times.push((stats.wall_seconds, total - stats.wall_seconds));
             last = Some((out.image, stats));
@@ -181,12 +180,11 @@ fn scene_rows(
         if !a.no_lanes {
             say(&format!("{}: {} search, profiled run", scene.name, v.label));
             let gi = options
-                .global
-                .as_mut()
+                .photon_map_mut()
                 .expect("Table 1 renders global light");
             gi.estimate.profile_lanes = true;
             let out = render(gpu, scene, &options, &mut ())?;
-            stats.work.lanes = out.estimate.and_then(|s| s.work.lanes);
+            stats.work.lanes = out.estimate().and_then(|s| s.work.lanes.clone());
         }
         times.sort_by(|x, y| x.0.total_cmp(&y.0));
         let (median, others) = times[times.len() / 2];

@@ -15,7 +15,7 @@ use serde::Serialize;
 use photonmap::gpu::Platform;
 use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
-use photonmap::render::{render, IgiOptions, Image, RenderOptions};
+use photonmap::render::{render, IgiOptions, Image, Method, RenderOptions, WithCausticMap};
 use photonmap::scene::{embedded, Scene};
 
 use super::accuracy::default_reference;
@@ -158,8 +158,9 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
     let all = rows(a.vpl_paths);
     for (i, (label, igi)) in all.iter().enumerate() {
         progress(&format!("{label} ({}/{})", i + 1, all.len()));
-        let mut o: RenderOptions = reference_options(&scene, scale, 7);
-        o.global.as_mut().expect("global illumination").igi = Some(igi.clone());
+        let o: RenderOptions = reference_options(&scene, scale, 7);
+        let map = o.method.photon_map().cloned().unwrap_or_default();
+        let o = o.with_method(Method::Igi(WithCausticMap::from_map(map, igi.clone())));
         let r = render(&gpu, &scene, &o, &mut ())?;
         let mut parts = [0.0f64; 5];
         for s in &r.timings.stages {
@@ -181,7 +182,7 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
         out.push(IgiRow {
             label: label.to_string(),
             options: igi.clone(),
-            vpls: r.vpls.as_ref().map_or(0, |v| v.vpls),
+            vpls: r.vpls().map_or(0, |v| v.vpls),
             seconds: r.timings.wall_seconds,
             direct: parts[0],
             specular: parts[1],

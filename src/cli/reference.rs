@@ -17,7 +17,7 @@ use photonmap::image::write_atomically;
 use photonmap::metrics::rmse;
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{Sppm, SppmOptions};
-use photonmap::render::{GlobalIllumination, Image, RenderOptions};
+use photonmap::render::{Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::Scene;
 use photonmap::timing::Timings;
 
@@ -133,10 +133,9 @@ pub fn reference_options(scene: &Scene, scale: u32, seed: u32) -> RenderOptions 
     o.width = (scene.camera.width / scale).max(1);
     o.height = (scene.camera.height / scale).max(1);
     o.seed = seed;
-    let mut gi = GlobalIllumination::default();
-    gi.estimate.leak = LeakTest::Visibility;
-    o.global = Some(gi);
-    o
+    let mut map = PhotonMapOptions::default();
+    map.estimate.leak = LeakTest::Visibility;
+    o.with_method(Method::PhotonMap(map))
 }
 
 pub fn make_reference(

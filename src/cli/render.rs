@@ -12,8 +12,8 @@ use photonmap::image::{check_writable, write_all_atomically, write_atomically};
 use photonmap::provenance::Provenance;
 use photonmap::render::sppm::SppmOptions;
 use photonmap::render::{
-    self, AdaptiveOptions, EstimatePass, FinalGatherOptions, GlobalIllumination, Image, PassPlan,
-    Progress, RenderObserver, RenderOptions, StopReason,
+    self, AdaptiveOptions, EstimatePass, FinalGatherOptions, Image, PassPlan, PhotonMapOptions,
+    Progress, RenderObserver, RenderOptions, StopReason, WithCausticMap, WithPhotons,
 };
 use photonmap::scene::Scene;
 
@@ -246,29 +246,140 @@ impl RenderArgs {
         }
     }
 
-    fn options(&self, scene: &Scene) -> RenderOptions {
-        let mut options = RenderOptions::for_scene(scene);
+    fn options(&self, scene: &Scene) -> Result<RenderOptions> {
+        let mut options = RenderOptions::for_scene(scene).with_method(self.method()?);
         options.seed = self.seed;
         options.spp = self.spp;
         options.width = self.width.unwrap_or(options.width);
         options.height = self.height.unwrap_or(options.height);
-        options.global = (!self.direct_only).then(|| GlobalIllumination {
-            photons: (&self.photons).into(),
-            estimate: (&self.estimate).into(),
-            final_gather: self.final_gather.map(|rays| FinalGatherOptions {
-                rays,
-                k: self.gather_k,
-                leak: self.gather_leak_test,
-            }),
-            adaptive: self.adaptive.then_some(AdaptiveOptions {
-                threshold: self.adaptive_threshold,
-            }),
-            igi: (self.method == Method::Igi).then(|| (&self.igi).into()),
-            differentials: (self.method == Method::Differentials)
-                .then(|| (&self.differentials).into()),
-            radiosity: (self.method == Method::Radiosity).then(|| (&self.radiosity).into()),
+        Ok(options)
+    }
+
+    /// The method with its options: the one place where switches that do
+    /// not go together are refused.
+    fn method(&self) -> Result<render::Method> {
+        if self.method == Method::Sppm {
+            self.check_sppm_switches()?;
+        } else {
+            self.check_method_switches()?;
+        }
+        let photons = (&self.photons).into();
+        let estimate = (&self.estimate).into();
+        let adaptive = self.adaptive.then_some(AdaptiveOptions {
+            threshold: self.adaptive_threshold,
         });
-        options
+        Ok(match self.method {
+            _ if self.direct_only => render::Method::DirectOnly,
+            Method::Paper => render::Method::PhotonMap(PhotonMapOptions {
+                photons,
+                estimate,
+                final_gather: self.final_gather.map(|rays| FinalGatherOptions {
+                    rays,
+                    k: self.gather_k,
+                    leak: self.gather_leak_test,
+                }),
+                adaptive,
+            }),
+            Method::Igi => render::Method::Igi(WithCausticMap {
+                photons,
+                estimate,
+                method: (&self.igi).into(),
+            }),
+            Method::Differentials => render::Method::Differentials(WithPhotons {
+                photons,
+                method: (&self.differentials).into(),
+            }),
+            Method::Radiosity => render::Method::Radiosity(WithCausticMap {
+                photons,
+                estimate,
+                method: (&self.radiosity).into(),
+            }),
+            Method::Sppm => render::Method::Sppm(WithPhotons {
+                photons,
+                method: SppmOptions {
+                    adaptive,
+                    leak: self.estimate.leak_test,
+                    grid: self.photons.grid,
+                    ..(&self.sppm).into()
+                },
+            }),
+        })
+    }
+
+    /// `--method sppm` renders one view with its own eye samples and photons.
+    fn check_sppm_switches(&self) -> Result<()> {
+        if self.camera_path.is_some()
+            || self.direct_only
+            || self.reference_software.is_some()
+            || self.spp > 1
+            || self.final_gather.is_some()
+            || self.igi.any_given()
+            || self.differentials.any_given()
+            || self.radiosity.any_given()
+        {
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor)");
+        }
+        Ok(())
+    }
+
+    /// Refuses each method's switches without it, and what it cannot combine with.
+    fn check_method_switches(&self) -> Result<()> {
+        // Each method's own switches, and what its image (no one-map estimate)
+        // cannot take.
+        let one_map_only = self.final_gather.is_some()
+            || self.adaptive
+            || self.reference_software.is_some()
+            || self.snapshots.is_some()
+            || self.direct_only;
+        let methods = [
+            (
+                Method::Igi,
+                self.igi.any_given(),
+                "--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi",
+                "--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate",
+            ),
+            (
+                Method::Differentials,
+                self.differentials.any_given(),
+                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials",
+                "--method differentials replaces the kNN estimate with footprints",
+            ),
+            (
+                Method::Radiosity,
+                self.radiosity.any_given(),
+                "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient and --form-factor are radiosity's: add --method radiosity",
+                "--method radiosity computes the diffuse interreflection itself",
+            ),
+        ];
+        for (method, given, theirs, cannot) in methods {
+            if self.method != method && given {
+                bail!("{theirs}");
+            }
+            if self.method == method && one_map_only {
+                bail!("{cannot}: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
+            }
+        }
+        if self.method == Method::Differentials {
+            if let Some(s) = self
+                .photons
+                .build_switch_given()
+                .or(self.estimate.switch_given())
+            {
+                bail!("{s} sets the kNN-grid's map or estimate, which --method differentials does not build: drop it");
+            }
+        }
+        if self.sppm.adaptive_pilot.is_some() {
+            bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
+        }
+        if (self.final_gather.is_some() || self.adaptive)
+            && (self.snapshots.is_some() || self.reference_software.is_some())
+        {
+            // Snapshots show one estimate's running image, and the software
+            // reference one map's: neither is the image final gather or the
+            // pyramid composes.
+            bail!("--snapshots and --reference-software show the one-map estimate: drop them with --final-gather or --adaptive");
+        }
+        Ok(())
     }
 }
 
@@ -285,23 +396,12 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     if args.method == Method::Sppm {
         return run_sppm(args, platform);
     }
-    check_method_switches(args)?;
-    if args.sppm.adaptive_pilot.is_some() {
-        bail!("--adaptive-pilot is adaptive SPPM's (--method sppm --adaptive); the one-shot estimate plans each eye sample's pyramid from its own coarse levels");
-    }
-    if args.final_gather.is_some() || args.adaptive {
-        // Snapshots show one estimate's running image, and the software
-        // reference one map's: neither is the image final gather or the
-        // pyramid composes.
-        if args.snapshots.is_some() || args.reference_software.is_some() {
-            bail!("--snapshots and --reference-software show the one-map estimate: drop them with --final-gather or --adaptive");
-        }
-    }
+    args.method()?;
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
     let scene = &loaded.scene;
     warn_far_from_origin(scene, args.quiet);
-    let options = args.options(scene);
+    let options = args.options(scene)?;
     let cameras = match &args.camera_path {
         Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera, scene.origin)?,
         None => vec![scene.camera.clone()],
@@ -326,30 +426,35 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     observer.finish()?;
     let written = write_images(&out.image, outputs.images(), &provenance)?;
     if let Some(path) = &args.reference_software {
-        let leak = options.global.as_ref().map(|g| g.estimate.leak);
+        let leak = options.method.estimate().map(|e| e.leak);
         if !args.quiet && leak.is_some_and(|l| l != LeakTest::None) {
             eprintln!("note: the software reference is the paper's estimate, with no leak test; add --leak-test none to compare like with like");
         }
         write_software_reference(&out, scene, path, args.quiet)?;
     }
     if args.json {
+        let photon_map = options.method.photon_map();
+        let igi = match &options.method {
+            render::Method::Igi(o) => Some(&o.method),
+            _ => None,
+        };
         super::print_json(&Report {
             provenance: &provenance,
             outputs: written.clone(),
             figures: serde_json::json!({
                 "method": method,
                 "timings": out.timings,
-                "estimates": out.estimates,
-                "final_gather": options.global.as_ref().and_then(|g| g.final_gather.clone()),
-                "gathers": out.gathers,
-                "adaptive": options.global.as_ref().and_then(|g| g.adaptive.clone()),
-                "adaptive_samples": out.adaptive,
-                "igi": options.global.as_ref().and_then(|g| g.igi.clone()),
-                "vpls": out.vpls,
-                "igi_samples": out.igi,
-                "differentials": out.differentials,
-                "footprint_samples": out.footprint_estimates,
-                "radiosity": out.radiosity,
+                "estimates": out.estimates(),
+                "final_gather": photon_map.and_then(|o| o.final_gather.clone()),
+                "gathers": out.gathers(),
+                "adaptive": photon_map.and_then(|o| o.adaptive.clone()),
+                "adaptive_samples": out.adaptive(),
+                "igi": igi,
+                "vpls": out.vpls(),
+                "igi_samples": out.igi(),
+                "differentials": out.differentials(),
+                "footprint_samples": out.footprint_estimates(),
+                "radiosity": out.radiosity(),
             }),
         })?;
     }
@@ -358,55 +463,6 @@ pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     }
     if !args.quiet {
         print_summary(&out, &options, &written);
-    }
-    Ok(())
-}
-
-/// Refuses each method's switches without it, and what it cannot combine with.
-fn check_method_switches(args: &RenderArgs) -> Result<()> {
-    // Each method's own switches, and what its image (no one-map estimate)
-    // cannot take.
-    let one_map_only = args.final_gather.is_some()
-        || args.adaptive
-        || args.reference_software.is_some()
-        || args.snapshots.is_some()
-        || args.direct_only;
-    let methods = [
-        (
-            Method::Igi,
-            args.igi.any_given(),
-            "--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi",
-            "--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate",
-        ),
-        (
-            Method::Differentials,
-            args.differentials.any_given(),
-            "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials",
-            "--method differentials replaces the kNN estimate with footprints",
-        ),
-        (
-            Method::Radiosity,
-            args.radiosity.any_given(),
-            "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient and --form-factor are radiosity's: add --method radiosity",
-            "--method radiosity computes the diffuse interreflection itself",
-        ),
-    ];
-    for (method, given, theirs, cannot) in methods {
-        if args.method != method && given {
-            bail!("{theirs}");
-        }
-        if args.method == method && one_map_only {
-            bail!("{cannot}: drop --final-gather, --adaptive, --reference-software, --snapshots and --direct-only");
-        }
-    }
-    if args.method == Method::Differentials {
-        if let Some(s) = args
-            .photons
-            .build_switch_given()
-            .or(args.estimate.switch_given())
-        {
-            bail!("{s} sets the kNN-grid's map or estimate, which --method differentials does not build: drop it");
-        }
     }
     Ok(())
 }
@@ -432,22 +488,12 @@ fn print_explain(lines: &[photonmap::render::ExplainLine]) {
 
 /// `--method sppm`: one view, iterations until --iterations or --time.
 fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
-    if args.camera_path.is_some()
-        || args.direct_only
-        || args.reference_software.is_some()
-        || args.spp > 1
-        || args.final_gather.is_some()
-        || args.igi.any_given()
-        || args.differentials.any_given()
-        || args.radiosity.any_given()
-    {
-        bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor)");
-    }
+    args.method()?;
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
     let scene = &loaded.scene;
     warn_far_from_origin(scene, args.quiet);
-    let options = args.options(scene);
+    let options = args.options(scene)?;
     let gpu = super::gpu(platform)?;
     let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
     if args.adaptive
@@ -462,15 +508,10 @@ fn run_sppm(args: &RenderArgs, platform: Platform) -> Result<()> {
         seconds: args.sppm.time,
     };
     let mut observer = CliObserver::new(args, scene, &outputs, work);
-    let sppm = SppmOptions {
-        adaptive: args.adaptive.then_some(AdaptiveOptions {
-            threshold: args.adaptive_threshold,
-        }),
-        leak: args.estimate.leak_test,
-        grid: args.photons.grid,
-        ..(&args.sppm).into()
+    let render::Method::Sppm(WithPhotons { method: sppm, .. }) = &options.method else {
+        unreachable!("--method sppm gives Method::Sppm");
     };
-    let out = render::sppm::render_sppm(&gpu, scene, &options, &sppm, &mut observer)?;
+    let out = render::sppm::render_sppm(&gpu, scene, &options, sppm, &mut observer)?;
     observer.finish()?;
     let written = write_images(&out.image, outputs.images(), &provenance)?;
     if args.json {
@@ -566,7 +607,7 @@ fn write_software_reference(
     quiet: bool,
 ) -> Result<()> {
     let wall = std::time::Instant::now();
-    let img = render::software::software_image(&out.state, scene)
+    let img = render::software::software_image(out, scene)
         .ok_or_else(|| anyhow!("no photon map to estimate from"))?;
     write_atomically(path, &img.png_bytes()?)?;
     if !quiet {
@@ -585,30 +626,30 @@ fn print_summary(
     written: &[(String, Format)],
 ) {
     eprint!("{}", out.timings.table());
-    if !out.estimates.is_empty() {
-        let passes: u32 = out.estimates.iter().map(|e| e.passes).sum();
-        let draws: u64 = out.estimates.iter().map(|e| e.tile_draws).sum();
-        let e = &out.estimates[0];
+    if !out.estimates().is_empty() {
+        let passes: u32 = out.estimates().iter().map(|e| e.passes).sum();
+        let draws: u64 = out.estimates().iter().map(|e| e.tile_draws).sum();
+        let e = &out.estimates()[0];
         eprintln!(
             "radiance estimate: {passes} passes in {} run{}, {} of {} pixels searched, {draws} tile draws of {} tiles",
-            out.estimates.len(),
-            if out.estimates.len() == 1 { "" } else { "s" },
+            out.estimates().len(),
+            if out.estimates().len() == 1 { "" } else { "s" },
             e.query_pixels,
             options.width as u64 * options.height as u64,
             e.tiles
         );
     }
-    if let Some(g) = out.gathers.first() {
+    if let Some(g) = out.gathers().first() {
         // Totals over every eye sample (and, adaptive, every level).
-        let passes: u32 = out.gathers.iter().map(|g| g.estimate_passes).sum();
-        let batches: u32 = out.gathers.iter().map(|g| g.batches).sum();
-        let hits: u64 = out.gathers.iter().map(|g| g.queries).sum();
+        let passes: u32 = out.gathers().iter().map(|g| g.estimate_passes).sum();
+        let batches: u32 = out.gathers().iter().map(|g| g.batches).sum();
+        let hits: u64 = out.gathers().iter().map(|g| g.queries).sum();
         eprintln!(
             "final gather: {} rays a pixel; {batches} batches, {hits} gather rays reached a diffuse surface, {passes} estimate passes in all",
             g.rays_per_pixel,
         );
     }
-    if let (Some(v), Some(s)) = (&out.vpls, out.igi.first()) {
+    if let (Some(v), Some(s)) = (out.vpls(), out.igi().first()) {
         eprintln!(
             "IGI: {} VPLs from {} light paths (bounding distance {}); {:.1} VPL shadow rays at each of {} shading points; caustics {}",
             v.vpls,
@@ -616,14 +657,14 @@ fn print_summary(
             v.min_distance,
             s.vpls_per_point,
             s.shading_points,
-            if out.photons.is_some() {
+            if out.photons().is_some() {
                 "from the caustic photon map"
             } else {
                 "none (nothing specular in the scene)"
             }
         );
     }
-    if let Some(r) = &out.radiosity {
+    if let Some(r) = out.radiosity() {
         eprintln!(
             "radiosity: {} patches in {} tiles of {} x {} ({} splits{}), {} elements; {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}",
             r.patches,
@@ -637,14 +678,14 @@ fn print_summary(
             r.seconds,
             if r.converged { "converged" } else { "stopped at --max-shots" },
             100.0 * r.unshot_fraction,
-            if out.photons.is_some() {
+            if out.photons().is_some() {
                 "from the caustic photon map"
             } else {
                 "none (nothing specular in the scene)"
             }
         );
     }
-    if let (Some(d), Some(s)) = (&out.differentials, out.footprint_estimates.first()) {
+    if let (Some(d), Some(s)) = (out.differentials(), out.footprint_estimates().first()) {
         let pilot = d.pilot_mean_diffuse_footprints.map_or(String::new(), |m| {
             format!(" (auto: {m:.4} diffuse footprints a hit at s = 1 in the pilot)")
         });
@@ -666,10 +707,10 @@ fn print_summary(
             s.passes,
         );
     }
-    if !out.adaptive.is_empty() {
-        let computed: u64 = out.adaptive.iter().map(|a| a.computed).sum();
-        let all: u64 = out.adaptive.iter().map(|a| a.pixels_with_hits).sum();
-        let levels: Vec<String> = out.adaptive[0]
+    if !out.adaptive().is_empty() {
+        let computed: u64 = out.adaptive().iter().map(|a| a.computed).sum();
+        let all: u64 = out.adaptive().iter().map(|a| a.pixels_with_hits).sum();
+        let levels: Vec<String> = out.adaptive()[0]
             .levels
             .iter()
             .map(|(s, c, i)| format!("stride {s}: {c} computed, {i} interpolated"))

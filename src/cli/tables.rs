@@ -11,7 +11,7 @@ use photonmap::gpu::{Gpu, Platform};
 use photonmap::photon::bench::{bench_size, paper_grid, BuildBenchRow};
 use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::render::software::software_image;
-use photonmap::render::{render, EstimateMode, GlobalIllumination, Image, RenderOptions};
+use photonmap::render::{render, EstimateMode, Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::{embedded, Scene};
 
 use super::render::{SnapshotEvery, SnapshotWriter};
@@ -190,7 +190,7 @@ pub(crate) fn table1_options(
     let mut o = RenderOptions::for_scene(scene);
     o.width = (scene.camera.width / scale).max(1);
     o.height = (scene.camera.height / scale).max(1);
-    let mut gi = GlobalIllumination {
+    let mut gi = PhotonMapOptions {
         photons: PhotonConfig {
             build,
             faithful,
@@ -199,14 +199,13 @@ pub(crate) fn table1_options(
             projection_maps: !faithful,
             ..PhotonConfig::default()
         },
-        ..GlobalIllumination::default()
+        ..PhotonMapOptions::default()
     };
     gi.estimate.mode = mode;
     // The paper's estimate, every photon in the sphere, so the times compare
     // with the paper's (the default leak test costs RING about half again).
     gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
-    o.global = Some(gi);
-    o
+    o.with_method(Method::PhotonMap(gi))
 }
 
 fn stage_seconds(t: &photonmap::render::Timings, stage: &str) -> (f64, f64) {
@@ -675,7 +674,7 @@ impl TablesRun<'_> {
                 row.push(r.image.clone());
                 if build == BuildMethod::Bitonic {
                     (self.progress)(&format!("Figure 7: {name} software reference"));
-                    let sw = software_image(&r.state, scene).context("software reference")?;
+                    let sw = software_image(&r, scene).context("software reference")?;
                     let file = self
                         .out
                         .join("figure7")
@@ -734,7 +733,7 @@ impl TablesRun<'_> {
                 (self.progress)(&format!("Section 3.3: {name} {label}"));
                 let opts = self.table1_options(&scene, BuildMethod::Bitonic, *mode);
                 let r = render(self.gpu, &scene, &opts, &mut ())?;
-                let e = r.estimate.unwrap_or_default();
+                let e = r.estimate().cloned().unwrap_or_default();
                 convergence.push(ConvergenceRow {
                     scene: scene.name.clone(),
                     mode: label.clone(),
@@ -761,7 +760,7 @@ impl TablesRun<'_> {
         );
         // Finer passes than the default's, so that the snapshots show the
         // estimate converging rather than four or five jumps (the same image).
-        if let Some(gi) = opts.global.as_mut() {
+        if let Some(gi) = opts.photon_map_mut() {
             gi.estimate.budget = FIGURE8_BUDGET;
         }
         let mut writer = SnapshotWriter::new(snap_dir.clone(), SnapshotEvery::Passes(1));

@@ -152,16 +152,16 @@ pub enum SoftwareEstimate {
 /// hits and direct light) and the same photons, with the radiance estimate
 /// computed on the CPU.
 pub fn software_image(
-    state: &crate::render::RenderState,
+    out: &crate::render::RenderOutput,
     scene: &crate::scene::Scene,
     estimate: SoftwareEstimate,
 ) -> Option<crate::render::Image> {
     match estimate {
-        SoftwareEstimate::KdTree => kd_tree_image(state, scene),
+        SoftwareEstimate::KdTree => kd_tree_image(out, scene),
         SoftwareEstimate::KnnGrid => {
-            let map = CpuPhotonMap::from_gpu(state.map.as_ref()?);
+            let map = CpuPhotonMap::from_gpu(out.map()?);
             let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
-            Some(software_image_with(state, scene, &|x| {
+            Some(software_image_with(&out.state.direct, scene, &|x| {
                 knn_grid(&map, x, k, max_r)
             }))
         }

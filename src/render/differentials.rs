@@ -29,12 +29,14 @@ use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
 use crate::layout::FOOTPRINT_BUDGET;
 use crate::photon::differentials::{
-    trace_differentials, DifferentialFrames, FootprintMap, FootprintOptions,
+    trace_differentials, DifferentialFrames, FootprintBuilder, FootprintMap, FootprintOptions,
 };
-use crate::photon::{PhotonFrames, PhotonTracer, TraceReport};
+use crate::photon::{PhotonConfig, PhotonFrames, PhotonTracer, TraceReport};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
+use super::observer::{Progress, RenderObserver};
+use super::sample::{FrameMethod, SampleFrame};
 use super::{DirectLight, Image, Timings};
 
 /// The density-estimation kernel over a footprint's ellipse.
@@ -321,4 +323,196 @@ pub fn smoothing_for(k: u32, pilot_mean_all: f64, pilot_mean_diffuse: f64) -> Op
     let caustic = (pilot_mean_all - pilot_mean_diffuse).max(0.0);
     let target = (k as f64 - caustic).max(1.0);
     (pilot_mean_diffuse > 0.0).then(|| (target / pilot_mean_diffuse).sqrt() as f32)
+}
+
+/// What the photon-differentials map was made of.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct DifferentialsReport {
+    pub trace: TraceReport,
+    pub frames_traced: u32,
+    pub footprints: u32,
+    /// Footprints of photons reflected diffusely before (the others: caustics).
+    pub diffuse_footprints: u32,
+    pub degenerate_footprints: u32,
+    /// The share of the stored power those carry (lost to the estimate).
+    pub degenerate_power_fraction: f64,
+    /// s in use, and (auto) the pilot's mean footprints a hit at s = 1, all
+    /// and diffuse.
+    pub smoothing: f32,
+    pub pilot_mean_footprints: Option<f64>,
+    pub pilot_mean_diffuse_footprints: Option<f64>,
+    pub caustic_smoothing: f32,
+    pub max_radius: f32,
+    pub kernel: Kernel,
+    pub leaf_size: u32,
+    pub auto_leaf_size: u32,
+    pub leaves: u32,
+    pub total_footprint_area: f64,
+    pub surface_area: f64,
+    pub delta: f32,
+}
+
+/// Photon differentials' GPU state: the photons, the map (made on the first
+/// eye sample, after the pilot when s is automatic) and the estimate.
+pub struct DifferentialsRun {
+    pub photons: DifferentialPhotons,
+    pub map: Option<FootprintMap>,
+    pub estimate: FootprintEstimate,
+    builder: FootprintBuilder,
+    options: DifferentialsOptions,
+    /// The pilot's mean footprints a hit: all, and diffuse.
+    pilot_mean: Option<(f64, f64)>,
+    /// Each eye sample's estimate.
+    pub stats: Vec<FootprintStats>,
+}
+
+impl DifferentialsRun {
+    /// Traces the photons with their differentials; the map waits for the
+    /// first eye sample's hits.
+    pub fn prepare(
+        gpu: &Gpu,
+        f: (&Scene, &SceneTextures),
+        (photons, o): (&PhotonConfig, &DifferentialsOptions),
+        (w, h, seed): (u32, u32, u32),
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Self> {
+        let (scene, textures) = f;
+        observer.progress(&Progress::stage("photons", 0, 1));
+        o.check()?;
+        let tracer = PhotonTracer::with_config(gpu, photons.trace())?;
+        let photons = DifferentialPhotons::trace(gpu, scene, textures, &tracer, seed, timings)?;
+        Ok(Self {
+            photons,
+            map: None,
+            estimate: FootprintEstimate::new(gpu, w, h, o.kernel)?,
+            builder: FootprintBuilder::new(gpu)?,
+            options: o.clone(),
+            pilot_mean: None,
+            stats: Vec::new(),
+        })
+    }
+
+    /// The map, built on first use: after a pilot at s = 1 over these first
+    /// hits when s is automatic ("smoothing pilot").
+    fn ensure_map(&mut self, f: &SampleFrame<'_>, timings: &mut Timings) -> Result<()> {
+        if self.map.is_none() {
+            let smoothing = match self.options.smoothing {
+                Some(s) => s,
+                None => {
+                    let t0 = std::time::Instant::now();
+                    let mut pilot_timings = Timings::default();
+                    let options = self.options.footprint_options(f.scene, 1.0);
+                    let pilot = self.builder.build(
+                        f.scene,
+                        &self.photons.frames,
+                        &self.photons.differentials,
+                        &options,
+                        &mut pilot_timings,
+                    )?;
+                    if pilot.diffuse == 0 {
+                        // Caustics only: s touches no footprint, the pilot is the map.
+                        timings.add_both(
+                            "footprint map",
+                            pilot_timings.gpu_total(),
+                            t0.elapsed().as_secs_f64(),
+                            pilot_timings.stages.iter().map(|s| s.passes).sum(),
+                        );
+                        self.map = Some(pilot);
+                        return Ok(());
+                    }
+                    let stats = self.estimate.run(
+                        f.textures,
+                        f.direct,
+                        &pilot,
+                        &mut pilot_timings,
+                        &mut |_, _| {},
+                    )?;
+                    timings.add_both(
+                        "smoothing pilot",
+                        0.0,
+                        t0.elapsed().as_secs_f64(),
+                        pilot_timings.stages.iter().map(|s| s.passes).sum(),
+                    );
+                    self.pilot_mean = Some((stats.mean_footprints, stats.mean_diffuse_footprints));
+                    smoothing_for(
+                        f.scene.photon_map.k,
+                        stats.mean_footprints,
+                        stats.mean_diffuse_footprints,
+                    )
+                    .unwrap_or(1.0)
+                }
+            };
+            let options = self.options.footprint_options(f.scene, smoothing);
+            let t0 = std::time::Instant::now();
+            let mut stages = Timings::default();
+            let map = self.builder.build(
+                f.scene,
+                &self.photons.frames,
+                &self.photons.differentials,
+                &options,
+                &mut stages,
+            )?;
+            timings.add_both(
+                "footprint map",
+                stages.gpu_total(),
+                t0.elapsed().as_secs_f64(),
+                stages.stages.iter().map(|s| s.passes).sum(),
+            );
+            self.map = Some(map);
+        }
+        Ok(())
+    }
+
+    pub fn report(&self) -> Option<DifferentialsReport> {
+        let m = self.map.as_ref()?;
+        Some(DifferentialsReport {
+            trace: self.photons.trace.clone(),
+            frames_traced: self.photons.frames.frames,
+            footprints: m.count,
+            diffuse_footprints: m.diffuse,
+            degenerate_footprints: m.degenerate,
+            degenerate_power_fraction: m.degenerate_power_fraction,
+            smoothing: m.options.smoothing,
+            pilot_mean_footprints: self.pilot_mean.map(|m| m.0),
+            pilot_mean_diffuse_footprints: self.pilot_mean.map(|m| m.1),
+            caustic_smoothing: m.options.caustic_smoothing,
+            max_radius: m.options.max_radius,
+            kernel: self.options.kernel,
+            leaf_size: m.leaf_size,
+            auto_leaf_size: m.auto_leaf_size,
+            leaves: m.leaves,
+            total_footprint_area: m.total_area,
+            surface_area: m.surface_area,
+            delta: m.delta,
+        })
+    }
+}
+
+impl FrameMethod for DifferentialsRun {
+    /// The direct light plus the footprints' light at the first hits.
+    fn sample(
+        &mut self,
+        f: &SampleFrame<'_>,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Image> {
+        let mut image = f.direct.read_radiance();
+        self.ensure_map(f, timings)?;
+        let map = self.map.as_ref().expect("ensure_map made it");
+        let at = f.at;
+        let stats =
+            self.estimate
+                .run(f.textures, f.direct, map, timings, &mut |walking, hits| {
+                    observer.progress(&Progress::at(
+                        "footprint estimate",
+                        hits - walking,
+                        hits,
+                        at,
+                    ))
+                })?;
+        self.stats.push(stats);
+        image.add(&self.estimate.read_indirect());
+        Ok(image)
+    }
 }

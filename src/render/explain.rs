@@ -3,7 +3,10 @@
 
 use crate::scene::Scene;
 
-use super::{adaptive, EstimateMode, RenderOptions, RenderOutput};
+use super::adaptive;
+use super::options::{Method, RenderOptions};
+use super::output::RenderOutput;
+use super::radiance_estimate::EstimateMode;
 
 /// One line of `--explain`: a stage's passes, run or skipped, and why.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -47,35 +50,35 @@ impl RenderOutput {
     pub fn explain(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
         let mut lines = self.ray_tracing_lines(scene);
         // Final gather's maps are made from two views of the scene.
-        let views = options
-            .global
-            .as_ref()
-            .filter(|g| g.final_gather.is_some())
+        let method = &options.method;
+        let views = method
+            .photon_map()
+            .filter(|o| o.final_gather.is_some())
             .and_then(|_| super::final_gather::map_scenes(scene).ok());
-        match (&options.global, &self.photons) {
-            (Some(gi), Some(p)) => {
+        match (method.estimate(), self.photons()) {
+            (Some(estimate), Some(p)) => {
                 let caustic = views.as_ref().map_or(scene, |v| &v.0);
                 lines.extend(self.photon_lines(caustic, p));
                 let (k, r) = (scene.photon_map.k, scene.photon_map.max_radius);
                 let pixels = options.width as u64 * options.height as u64;
-                let many = self.estimates.len() > 1;
-                for (i, s) in self.estimates.iter().enumerate() {
+                let many = self.estimates().len() > 1;
+                for (i, s) in self.estimates().iter().enumerate() {
                     lines.push(line(
                         "radiance estimate",
                         s.passes as usize,
                         true,
                         format!(
                             "kNN-grid, k = {k}, max radius {r}, {} steps per pixel per pass, {}; {} of {pixels} pixels have a diffuse hit, {} tile draws{}",
-                            gi.estimate.budget,
-                            gi.estimate.mode,
+                            estimate.budget,
+                            estimate.mode,
                             s.query_pixels,
                             s.tile_draws,
-                            if many { format!(" (run {} of {})", i + 1, self.estimates.len()) } else { String::new() }
+                            if many { format!(" (run {} of {})", i + 1, self.estimates().len()) } else { String::new() }
                         ),
                     ));
                 }
             }
-            (Some(gi), None) if gi.differentials.is_some() => {
+            (_, None) if matches!(method, Method::Differentials(_)) => {
                 lines.push(line(
                     "photons, kNN map, kNN estimate",
                     0,
@@ -83,19 +86,19 @@ impl RenderOutput {
                     "skipped: photon differentials give every photon a footprint and sum the footprints at a hit (below)".into(),
                 ));
             }
-            (Some(gi), None) if gi.radiosity.is_some() => lines.push(line(
+            (_, None) if matches!(method, Method::Radiosity(_)) => lines.push(line(
                 "caustic map, estimate",
                 0,
                 false,
                 "skipped: radiosity takes caustics from a caustic photon map, and the scene has no mirror or glass to make them".into(),
             )),
-            (Some(gi), None) if gi.igi.is_some() => lines.push(line(
+            (_, None) if matches!(method, Method::Igi(_)) => lines.push(line(
                 "caustic map, estimate",
                 0,
                 false,
                 "skipped: IGI takes caustics from a caustic photon map, and the scene has no mirror or glass to make them".into(),
             )),
-            (Some(gi), None) if gi.final_gather.is_some() => lines.push(line(
+            (_, None) if method.photon_map().is_some_and(|o| o.final_gather.is_some()) => lines.push(line(
                 "caustic map, estimate",
                 0,
                 false,
@@ -116,13 +119,12 @@ impl RenderOutput {
     /// Final gather and adaptive sampling (section 4.5), when chosen.
     fn section_4_5_lines(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
         let mut lines = Vec::new();
-        let Some(gi) = &options.global else {
-            return lines;
-        };
-        if let (Some(fg), Some(p)) = (&gi.final_gather, &self.gather_photons) {
+        let photon_map = options.method.photon_map();
+        let final_gather = photon_map.and_then(|o| o.final_gather.as_ref());
+        if let (Some(fg), Some(p)) = (final_gather, self.gather_photons()) {
             lines.extend(self.photon_lines(scene, p));
-            let passes: u32 = self.gathers.iter().map(|g| g.estimate_passes).sum();
-            let queries: u64 = self.gathers.iter().map(|g| g.queries).sum();
+            let passes: u32 = self.gathers().iter().map(|g| g.estimate_passes).sum();
+            let queries: u64 = self.gathers().iter().map(|g| g.queries).sum();
             lines.push(line(
                 "final gather",
                 passes as usize,
@@ -133,8 +135,9 @@ impl RenderOutput {
                 ),
             ));
         }
-        if let (Some(o), Some(v)) = (&gi.igi, &self.vpls) {
-            let passes: u32 = self.igi.iter().map(|s| s.passes).sum();
+        if let (Method::Igi(o), Some(v)) = (&options.method, self.vpls()) {
+            let o = &o.method;
+            let passes: u32 = self.igi().iter().map(|s| s.passes).sum();
             lines.push(line(
                 "IGI VPLs",
                 0,
@@ -166,13 +169,13 @@ impl RenderOutput {
                 ),
             ));
         }
-        lines.extend(self.method_lines(gi));
-        if let Some(a) = &gi.adaptive {
-            let computed: u64 = self.adaptive.iter().map(|s| s.computed).sum();
-            let all: u64 = self.adaptive.iter().map(|s| s.pixels_with_hits).sum();
+        lines.extend(self.method_lines(&options.method));
+        if let Some(a) = photon_map.and_then(|o| o.adaptive.as_ref()) {
+            let computed: u64 = self.adaptive().iter().map(|s| s.computed).sum();
+            let all: u64 = self.adaptive().iter().map(|s| s.pixels_with_hits).sum();
             lines.push(line(
                 "adaptive sampling",
-                3 * adaptive::STRIDES.len() * self.adaptive.len(),
+                3 * adaptive::STRIDES.len() * self.adaptive().len(),
                 true,
                 format!(
                     "global light computed at {computed} of {all} pixels with a diffuse hit, interpolated at the rest (strides 8, 4, 2, 1, each a plan, pack and store pass; threshold {}); each level's estimate above runs on its packed pixels",
@@ -184,9 +187,10 @@ impl RenderOutput {
     }
 
     /// Radiosity's and photon differentials' lines, when chosen.
-    fn method_lines(&self, gi: &super::GlobalIllumination) -> Vec<ExplainLine> {
+    fn method_lines(&self, method: &Method) -> Vec<ExplainLine> {
         let mut lines = Vec::new();
-        if let (Some(o), Some(r)) = (&gi.radiosity, &self.radiosity) {
+        if let (Method::Radiosity(o), Some(r)) = (method, self.radiosity()) {
+            let o = &o.method;
             lines.push(line(
                 "radiosity",
                 0,
@@ -206,10 +210,11 @@ impl RenderOutput {
                 ),
             ));
         }
-        if let (Some(o), Some(d)) = (&gi.differentials, &self.differentials) {
-            let passes: u32 = self.footprint_estimates.iter().map(|s| s.passes).sum();
+        if let (Method::Differentials(o), Some(d)) = (method, self.differentials()) {
+            let o = &o.method;
+            let passes: u32 = self.footprint_estimates().iter().map(|s| s.passes).sum();
             let k: f64 = self
-                .footprint_estimates
+                .footprint_estimates()
                 .first()
                 .map_or(0.0, |s| s.mean_footprints);
             lines.push(line(
@@ -260,7 +265,7 @@ impl RenderOutput {
 
     fn ray_tracing_lines(&self, scene: &Scene) -> Vec<ExplainLine> {
         let p = &self.plan;
-        let views = (self.estimates.len() as u32 / p.spp).max(1);
+        let views = (self.estimates().len() as u32 / p.spp).max(1);
         let runs = (p.spp * views) as usize;
         vec![
             line(

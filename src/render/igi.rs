@@ -27,11 +27,16 @@
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::layout::{PRIMITIVE_BOX_ROW, VPL_BATCH};
-use crate::photon::{BitonicBuild, Grid, PhotonTracer, RandomSource, TraceConfig};
+use crate::photon::{BitonicBuild, Grid, PhotonConfig, PhotonTracer, RandomSource, TraceConfig};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
-use super::{DirectLight, Image, Timings};
+use super::direct::DirectLight;
+use super::observer::{Progress, RenderObserver};
+use super::photon_map::MapEstimate;
+use super::radiance_estimate::EstimateOptions;
+use super::sample::{FrameMethod, SampleFrame};
+use super::{Image, Timings};
 
 /// How IGI runs.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -441,4 +446,74 @@ fn primitive_boxes(gpu: &Gpu, scene: &Scene) -> Result<Texture> {
         data[8 * i + 4..8 * i + 7].copy_from_slice(&hi.to_array());
     }
     Texture::from_f32(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
+}
+
+/// IGI through a render: the caustic map, the VPLs, the gather's textures
+/// and each eye sample's gather.
+pub struct IgiRun {
+    pub caustics: Option<MapEstimate>,
+    pub vpls: Vpls,
+    pub igi: Igi,
+    pub report: VplReport,
+    pub stats: Vec<IgiStats>,
+}
+
+impl IgiRun {
+    /// The caustic map, then the VPLs.
+    pub fn prepare(
+        gpu: &Gpu,
+        f: (&Scene, &SceneTextures),
+        (photons, estimate, o): (&PhotonConfig, &EstimateOptions, &IgiOptions),
+        (w, h, seed): (u32, u32, u32),
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Self> {
+        let (scene, textures) = f;
+        observer.progress(&Progress::stage("photons", 0, 1));
+        let caustics = MapEstimate::caustics(gpu, f, (photons, estimate), (w, h, seed), timings)?;
+        let igi = Igi::new(gpu, scene, w, h, o)?;
+        observer.progress(&Progress::stage("VPLs", 0, 1));
+        let vpl_seed = crate::random::pcg_hash(seed ^ crate::layout::VPL_STREAM);
+        let bounds = (o.vpl_paths, o.vpl_bounces);
+        let vpls = Vpls::trace(gpu, scene, textures, bounds, vpl_seed, timings)?;
+        let report = VplReport {
+            paths: vpls.paths,
+            vpls: vpls.count,
+            frames_traced: vpls.frames_traced,
+            min_distance: o.min_distance_for(scene),
+        };
+        Ok(Self {
+            caustics,
+            vpls,
+            igi,
+            report,
+            stats: Vec::new(),
+        })
+    }
+}
+
+impl FrameMethod for IgiRun {
+    /// The caustic estimate with the direct light, plus the VPLs' light.
+    fn sample(
+        &mut self,
+        f: &SampleFrame<'_>,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Image> {
+        let mut image = MapEstimate::image_or_direct(self.caustics.as_mut(), f, timings, observer)?;
+        let at = f.at;
+        let stats = self.igi.run(
+            f.textures,
+            f.direct,
+            &self.vpls,
+            f.camera_position,
+            timings,
+            &mut |done, total| {
+                observer.progress(&Progress::at("VPL gather", done as u64, total as u64, at))
+            },
+        )?;
+        self.stats.push(stats);
+        image.add(&self.igi.read_indirect());
+        Ok(image)
+    }
 }

@@ -5,7 +5,14 @@
 use crate::gpu::Result;
 use crate::image::Image;
 
-use super::At;
+/// Where in the frame a pass is: view and eye sample.
+#[derive(Clone, Copy, Debug)]
+pub struct At {
+    pub view: usize,
+    pub views: usize,
+    pub sample: u32,
+    pub samples: u32,
+}
 
 /// Progress of one stage: `done` of `total` units, at a view and eye sample.
 #[derive(Clone, Copy, Debug)]

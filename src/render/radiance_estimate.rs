@@ -81,6 +81,20 @@ pub struct EstimateOptions {
     pub profile_lanes: bool,
 }
 
+impl EstimateOptions {
+    /// These options as the photon config constrains them: under
+    /// `--faithful`, the paper's float addressing and the paper's walk.
+    pub fn under(&self, photons: &crate::photon::PhotonConfig) -> EstimateOptions {
+        let faithful = photons.faithful;
+        EstimateOptions {
+            float_addressing: faithful,
+            cull: self.cull && !faithful,
+            runs: self.runs && !faithful,
+            ..self.clone()
+        }
+    }
+}
+
 impl Default for EstimateOptions {
     fn default() -> Self {
         Self {

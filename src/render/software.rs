@@ -7,7 +7,7 @@ use glam::Vec3;
 use crate::photon::{Grid, PhotonMap};
 use crate::scene::{Material, Scene};
 
-use super::{Image, RenderState};
+use super::{DirectLight, Image, RenderOutput};
 
 /// A photon map read back from the GPU: per cell, its photons in the GPU's order.
 pub struct CpuPhotonMap {
@@ -249,12 +249,12 @@ impl Ord for OrdF32 {
 }
 
 /// The software column with Jensen's kd-tree: exactly the k nearest photons.
-pub fn software_image(state: &RenderState, scene: &Scene) -> Option<Image> {
-    let map = CpuPhotonMap::from_gpu(state.map.as_ref()?);
+pub fn software_image(out: &RenderOutput, scene: &Scene) -> Option<Image> {
+    let map = CpuPhotonMap::from_gpu(out.map()?);
     let photons: Vec<(Vec3, Vec3)> = map.photons().copied().collect();
     let tree = KdTree::new(&photons);
     let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
-    Some(software_image_with(state, scene, &|x| {
+    Some(software_image_with(&out.state.direct, scene, &|x| {
         tree.k_nearest(x, k as usize, max_r)
     }))
 }
@@ -263,15 +263,15 @@ pub fn software_image(state: &RenderState, scene: &Scene) -> Option<Image> {
 /// GPU's direct light plus throughput x albedo/pi x the search's irradiance.
 /// Two threads of rows.
 pub fn software_image_with(
-    state: &RenderState,
+    direct_light: &DirectLight,
     scene: &Scene,
     search: &(dyn Fn(Vec3) -> KnnResult + Sync),
 ) -> Image {
-    let (w, h) = (state.direct.radiance.width, state.direct.radiance.height);
-    let direct = state.direct.radiance.read_f32();
-    let pos = state.direct.diffuse_position.read_f32();
-    let normal = state.direct.diffuse_normal.read_f32();
-    let through = state.direct.diffuse_throughput.read_f32();
+    let (w, h) = (direct_light.radiance.width, direct_light.radiance.height);
+    let direct = direct_light.radiance.read_f32();
+    let pos = direct_light.diffuse_position.read_f32();
+    let normal = direct_light.diffuse_normal.read_f32();
+    let through = direct_light.diffuse_throughput.read_f32();
     let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
     let mut rgba = vec![0f32; (w * h * 4) as usize];
     let shade = |i: usize| -> [f32; 3] {

@@ -38,11 +38,19 @@
 //!    glass or a mirror is in neither.
 
 mod elements;
+mod options;
+pub mod run;
+mod subdivide;
 
 pub use elements::{
     block_outline, element_point, full_tree, onto_surface, tessellate, Elements, Node, Patch, Tile,
     CURVED_SEGMENTS, MAX_ATLAS_TEXELS,
 };
+pub use options::{
+    ConvergencePoint, FormFactor, RadiosityOptions, RadiosityReport, MAX_SUBDIVIDE, SPLIT_FLOOR,
+    SPLIT_SHARE,
+};
+pub use run::RadiosityRun;
 
 use glam::Vec3;
 
@@ -56,160 +64,6 @@ use crate::scene::pack::SceneTextures;
 use crate::scene::{Light, Scene};
 
 use super::{DirectLight, Image, Timings};
-
-/// How the radiosity solution runs.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct RadiosityOptions {
-    /// Elements per side of each tile.
-    pub resolution: u32,
-    /// Shooters per side of a shooting tile (substructuring; divides `resolution`).
-    pub substructure: u32,
-    /// Texels per side of each item buffer.
-    pub item_buffer: u32,
-    /// Shots at most.
-    pub max_shots: u32,
-    /// Converged once no tile holds this fraction of the emitted power unshot.
-    pub convergence: f32,
-    /// Quadtree depth at most (0: one uniform tile a patch).
-    pub subdivide: u32,
-    /// The split test's relative second difference (`discontinuity.frag`).
-    pub gradient: f32,
-    /// How a sub-element shooter's form factor is computed.
-    pub form_factor: FormFactor,
-}
-
-/// A shooter's form factor to a receiving element's centre.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum FormFactor {
-    /// Lambert's exact point-to-polygon form factor to the sub-element's
-    /// outline (a curved one's chord polygon: the same boundary, so the same
-    /// form factor from wherever all of it is seen).
-    Polygon,
-    /// The chapter's oriented disc, A cos cos / (pi d^2 + A): exact on the
-    /// disc's axis, short of the true value near the shooter.
-    Disc,
-}
-
-impl Default for RadiosityOptions {
-    /// 16 x 16 elements a tile (the chapter's leaf tiles), 4 x 4 shooters a
-    /// tile, 256^2 item buffers, and a tile shoots while it holds 0.01% of
-    /// the emitted power (a priori; the unshot total is reported). Tiles
-    /// split once (depth 1) where the second difference exceeds a quarter of
-    /// the local radiosity: against SPPM, depth 1 beat uniform tiles on
-    /// CORNELL BOX and the mesh scene, and beat depth 2 on the mesh scene,
-    /// which on CORNELL BOX took twice the solve for 0.3% less error (README).
-    fn default() -> Self {
-        Self {
-            resolution: 16,
-            substructure: 4,
-            item_buffer: 256,
-            max_shots: 10_000,
-            convergence: 1e-4,
-            subdivide: 1,
-            gradient: 0.25,
-            form_factor: FormFactor::Polygon,
-        }
-    }
-}
-
-impl RadiosityOptions {
-    pub fn check(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::InvalidOption(what));
-        if !(2..=256).contains(&self.resolution) {
-            return bad(format!(
-                "--elements {}: the allowed range is 2..=256",
-                self.resolution
-            ));
-        }
-        if self.substructure == 0 || !self.resolution.is_multiple_of(self.substructure) {
-            return bad(format!(
-                "--substructure {}: give a divisor of --elements ({})",
-                self.substructure, self.resolution
-            ));
-        }
-        if self.substructure > 8 {
-            return bad(format!(
-                "--substructure {}: at most 8 (64 item buffers a shot)",
-                self.substructure
-            ));
-        }
-        if !(16..=2048).contains(&self.item_buffer) {
-            return bad(format!(
-                "--item-buffer {}: the allowed range is 16..=2048",
-                self.item_buffer
-            ));
-        }
-        if !(self.convergence > 0.0 && self.convergence < 1.0) {
-            return bad(format!(
-                "--convergence {}: the allowed range is (0, 1)",
-                self.convergence
-            ));
-        }
-        if self.subdivide > MAX_SUBDIVIDE {
-            return bad(format!(
-                "--subdivide {}: the allowed range is 0..={MAX_SUBDIVIDE}",
-                self.subdivide
-            ));
-        }
-        if !(self.gradient > 0.0 && self.gradient.is_finite()) {
-            return bad(format!(
-                "--gradient {}: give a positive number",
-                self.gradient
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// Quadtree depth at most (a tile at depth 6 is 1/64 of its patch a side).
-pub const MAX_SUBDIVIDE: u32 = 6;
-
-/// The split test's absolute floor, as a fraction of the scene's mean
-/// irradiance (emitted power over receiving area): dim corners do not split
-/// on differences far below what the image shows.
-pub const SPLIT_FLOOR: f32 = 1e-2;
-
-/// Adaptive subdivision tests a tile after a shot only when the shot brings
-/// it this share of its radiosity power or more (ours; the chapter tests
-/// every leaf after every reconstruction): after the first shots, which lay
-/// down the shadows, most shots add little to most tiles, and testing every
-/// tile every shot cost a mesh scene nine tenths of its solve.
-pub const SPLIT_SHARE: f32 = 0.05;
-
-/// The convergence of a solution: after each recorded shot, the unshot
-/// power as a fraction of all emitted.
-#[derive(Clone, Debug, Default, serde::Serialize)]
-pub struct ConvergencePoint {
-    pub shot: u32,
-    pub seconds: f64,
-    pub unshot_fraction: f64,
-}
-
-/// What a solution did.
-#[derive(Clone, Debug, Default, serde::Serialize)]
-pub struct RadiosityReport {
-    pub patches: usize,
-    /// Elements of live tiles at the end.
-    pub elements: usize,
-    pub element_resolution: u32,
-    /// Live tiles at the end, and splits made.
-    pub tiles: usize,
-    pub splits: usize,
-    /// Split tests (one occlusion query a tile) and the seconds they and the
-    /// splits' passes took.
-    pub split_tests: usize,
-    pub subdivision_seconds: f64,
-    /// True when a split found the atlas full (MAX_ATLAS_TEXELS).
-    pub atlas_full: bool,
-    /// The split test's absolute floor (SPLIT_FLOOR x the mean irradiance).
-    pub split_floor: f32,
-    pub shots: u32,
-    pub converged: bool,
-    pub unshot_fraction: f64,
-    pub seconds: f64,
-    pub convergence: Vec<ConvergencePoint>,
-}
 
 /// A shooter as the shoot pass reads it.
 #[derive(Clone, Debug)]
@@ -762,150 +616,6 @@ impl Radiosity {
                 (self.options.resolution / self.options.substructure) as i32,
             )
             .draw_region(&self.shot_target, &DrawState::PLAIN, region)
-    }
-
-    /// Adaptive subdivision after a shot: split test, split, inherit, shoot
-    /// again at the children, and test them in turn.
-    fn refine(
-        &mut self,
-        scene: &Scene,
-        shooters: usize,
-        floor: f32,
-        report: &mut RadiosityReport,
-    ) -> Result<()> {
-        let max_depth = self.options.subdivide;
-        // Only tiles this shot changes by SPLIT_SHARE of their radiosity
-        // power or more: later shots add little to what is already there.
-        let powers = self.tile_powers()?;
-        let e = &self.elements;
-        let mut candidates: Vec<usize> = (0..e.tiles.len())
-            .filter(|&t| {
-                let tile = e.tiles[t];
-                tile.alive
-                    && tile.depth < max_depth
-                    && !e.patches[tile.patch as usize].emitter
-                    && powers[t][2] > 0.0
-                    && powers[t][2] >= SPLIT_SHARE * (powers[t][1] + powers[t][2])
-            })
-            .collect();
-        while !candidates.is_empty() && !report.atlas_full {
-            let counts = self.discontinuities(&candidates, floor)?;
-            report.split_tests += candidates.len();
-            let mut split = Vec::new();
-            for (&t, &count) in candidates.iter().zip(&counts) {
-                if count <= u64::from(self.elements.res / 2) {
-                    continue;
-                }
-                match self.elements.split(scene, t) {
-                    Some(children) => split.push((t, children)),
-                    None => {
-                        report.atlas_full = true;
-                        break;
-                    }
-                }
-            }
-            report.splits += split.len();
-            for (parent, children) in &split {
-                self.adopt(*parent, children)?;
-            }
-            self.upload_nodes()?;
-            self.gpu.texture_barrier();
-            candidates = Vec::new();
-            for (_, children) in &split {
-                for &c in children {
-                    self.shot_pass(shooters, self.elements.tile_region(c))?;
-                    if self.elements.tiles[c].depth < max_depth {
-                        candidates.push(c);
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// The split test's fragment count for each tile (an occlusion query a tile).
-    pub fn discontinuities(&mut self, tiles: &[usize], floor: f32) -> Result<Vec<u64>> {
-        while self.queries.len() < tiles.len() {
-            self.queries.push(Query::occlusion(&self.gpu)?);
-        }
-        self.gpu.texture_barrier();
-        let state = DrawState {
-            color_writes: false,
-            ..DrawState::PLAIN
-        };
-        for (&t, q) in tiles.iter().zip(&self.queries) {
-            let (x, y) = self.elements.tile_base(t);
-            q.begin();
-            let drawn = self
-                .programs
-                .discontinuity
-                .bind()
-                .texture("u_radiosity", &self.radiosity)
-                .texture("u_shot", &self.shot)
-                .texture("u_element_position", &self.position)
-                .ivec2("u_tile_base", [x as i32, y as i32])
-                .int("u_res", self.elements.res as i32)
-                .float("u_gradient", self.options.gradient)
-                .float("u_floor", floor)
-                .draw_region(&self.residual_target, &state, self.elements.tile_region(t));
-            q.end();
-            drawn?;
-        }
-        Ok(self.queries[..tiles.len()]
-            .iter()
-            .map(Query::count)
-            .collect())
-    }
-
-    /// A split's records on the GPU: the children's elements and their
-    /// inherited radiosity, residual and direct part; the parent retired.
-    fn adopt(&self, parent: usize, children: &[usize]) -> Result<()> {
-        let e = &self.elements;
-        let upload = |t: usize| -> Result<()> {
-            let (x, y) = e.tile_base(t);
-            let region = [x, y, e.res, e.res];
-            self.position
-                .upload_region(region, &e.tile_records(t, &e.position))?;
-            self.normal
-                .upload_region(region, &e.tile_records(t, &e.normal))?;
-            self.albedo
-                .upload_region(region, &e.tile_records(t, &e.albedo))
-        };
-        let (px, py) = e.tile_base(parent);
-        let parent_tile = e.tiles[parent];
-        self.gpu.texture_barrier();
-        for &c in children {
-            upload(c)?;
-            let tile = e.tiles[c];
-            let (cx, cy) = e.tile_base(c);
-            let quadrant = [
-                (tile.origin[0] - 2 * parent_tile.origin[0]) / e.res,
-                (tile.origin[1] - 2 * parent_tile.origin[1]) / e.res,
-            ];
-            self.programs
-                .inherit
-                .bind()
-                .texture("u_radiosity", &self.radiosity)
-                .texture("u_residual", &self.residual)
-                .texture("u_direct", &self.direct)
-                .ivec2("u_child_base", [cx as i32, cy as i32])
-                .ivec2("u_parent_base", [px as i32, py as i32])
-                .ivec2("u_quadrant", [quadrant[0] as i32, quadrant[1] as i32])
-                .int("u_res", e.res as i32)
-                .draw_region(&self.atlas_target, &DrawState::PLAIN, e.tile_region(c))?;
-        }
-        self.gpu.texture_barrier();
-        self.zero_region(&self.atlas_target, parent)?;
-        upload(parent)
-    }
-
-    /// Zero over tile t's region of `target`'s textures.
-    fn zero_region(&self, target: &Target, tile: usize) -> Result<()> {
-        self.programs.zero.bind().draw_region(
-            target,
-            &DrawState::PLAIN,
-            self.elements.tile_region(tile),
-        )
     }
 
     /// The indirect light at `direct`'s first hits, left in `indirect`.

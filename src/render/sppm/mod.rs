@@ -25,109 +25,26 @@ use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 use crate::timing::Timings;
 
-use super::adaptive::{AdaptiveOptions, AdaptiveStats};
-use super::radiance_estimate::LeakTest;
-pub use super::sppm_adaptive::SppmState;
-use super::sppm_adaptive::{default_pilot, SppmAdaptive};
-use super::{
-    trace_eye_paths, At, DirectLight, EstimatePass, ExplainLine, EyeSample, Image, PassPlan,
-    Progress, RayTracer, RenderObserver, RenderOptions, StopReason,
+pub mod options;
+mod run;
+
+pub use options::{
+    DirectLighting, SppmOptions, SppmStart, DEFAULT_SPPM_LEAK, DEFAULT_START_PHOTONS,
+    DEFAULT_START_PIXELS,
 };
+pub use run::{render_sppm, SppmOutput};
 
-/// Where direct light comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum DirectLighting {
-    /// Shadow rays at each visible point (the paper's split; exact for point lights).
-    ShadowRays,
-    /// Photons stored at their first hit too, and no shadow rays.
-    Photons,
-}
-
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct SppmOptions {
-    /// Iterations to run (the render also stops at `seconds`, if given).
-    pub iterations: u32,
-    pub seconds: Option<f64>,
-    /// The fraction of new photons kept (Hachisuka and Jensen's alpha).
-    pub alpha: f32,
-    /// Photons emitted per iteration (the same every iteration).
-    pub photons_per_iteration: u32,
-    /// First radius of every pixel; None: each pixel's own, as `start` says.
-    pub initial_radius: Option<f32>,
-    /// How each pixel's first radius is chosen when `initial_radius` is None.
-    pub start: SppmStart,
-    /// The leak tests of the gather (None: `DEFAULT_SPPM_LEAK`).
-    pub leak: Option<LeakTest>,
-    /// The grid's storage (None: hashed, or uniform under `--faithful`).
-    pub grid: Option<GridKind>,
-    /// Photon bounces (Russian roulette ends most photons long before).
-    pub max_bounces: u32,
-    pub direct: DirectLighting,
-    /// Shadow rays per area light per iteration.
-    pub shadow_rays: u32,
-    /// Adaptive sampling (`sppm_adaptive.rs`): after the pilot, the gather
-    /// runs only where the pyramid's plan computes.
-    pub adaptive: Option<AdaptiveOptions>,
-    /// Iterations at every pixel before the plan (default: an eighth).
-    pub adaptive_pilot: Option<u32>,
-}
-
-impl Default for SppmOptions {
-    fn default() -> Self {
-        Self {
-            iterations: 64,
-            seconds: None,
-            alpha: 0.7,
-            photons_per_iteration: 1 << 14,
-            initial_radius: None,
-            start: SppmStart::DEFAULT,
-            leak: None,
-            grid: None,
-            max_bounces: 32,
-            direct: DirectLighting::ShadowRays,
-            shadow_rays: 1,
-            adaptive: None,
-            adaptive_pilot: None,
-        }
-    }
-}
-
-/// How each pixel's first radius is chosen (at the first iteration, at its
-/// visible point; `glsl/render/sppm_start.frag`): the smallest of the scene's
-/// max_radius and the bounds given.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct SppmStart {
-    /// At most this many pixel footprints: the width of a pixel's cone at
-    /// the point.
-    pub pixels: Option<f32>,
-    /// At most the radius that holds this many of the first iteration's
-    /// photons (progressive photon mapping's kNN start).
-    pub photons: Option<u32>,
-}
-
-impl SppmStart {
-    pub const DEFAULT: SppmStart = SppmStart {
-        pixels: Some(DEFAULT_START_PIXELS),
-        photons: DEFAULT_START_PHOTONS,
-    };
-}
-
-/// The first radius in pixel footprints by default. Chosen against the
-/// independent truth at equal time (README, "The truth: SPPM").
-pub const DEFAULT_START_PIXELS: f32 = 4.0;
-
-/// The kNN bound on the first radius by default: bright caustics start
-/// smaller than 4 footprints. Chosen against the independent truth at equal
-/// iterations (docs, methods/sppm.md): 16 against no bound gives RING 0.034
-/// against 0.048 relative RMSE, GLASS BALL 0.051-0.053 against 0.055-0.056,
-/// CORNELL BOX 0.051-0.052 against 0.051-0.052.
-pub const DEFAULT_START_PHOTONS: Option<u32> = Some(16);
-
-/// The gather's leak test by default: none. The leak vanishes as the radii
-/// shrink, and the visibility test's shadow ray per photon cost more error
-/// at equal time than it removed (README, "The truth: SPPM").
-pub const DEFAULT_SPPM_LEAK: LeakTest = LeakTest::None;
+use crate::image::Image;
+use crate::render::adaptive::AdaptiveStats;
+use crate::render::direct::DirectLight;
+use crate::render::eye_paths::{trace_eye_paths, EyeSample};
+use crate::render::observer::{At, RenderObserver};
+use crate::render::options::RenderOptions;
+use crate::render::plan::PassPlan;
+use crate::render::radiance_estimate::LeakTest;
+use crate::render::ray_trace::RayTracer;
+pub use crate::render::sppm_adaptive::SppmState;
+use crate::render::sppm_adaptive::{default_pilot, SppmAdaptive};
 
 /// Cells per grid at most, by build: the sorted map's cell table, and stencil
 /// routing's m x m slots a cell.
@@ -193,8 +110,7 @@ impl Sppm {
         options: &RenderOptions,
         sppm: &SppmOptions,
     ) -> Result<Self> {
-        let global = options.global.clone().unwrap_or_default();
-        let mut config = global.photons;
+        let mut config = options.method.photons().cloned().unwrap_or_default();
         let leak = sppm.leak.unwrap_or(DEFAULT_SPPM_LEAK);
         // A hash table's size follows the photons, not the cells, so small
         // radii cost no larger cell table.
@@ -645,192 +561,4 @@ fn sppm_scene(scene: &Scene, o: &SppmOptions) -> Result<Scene> {
     s.render.shadow_rays = o.shadow_rays.max(1);
     s.photon_map.store_direct = o.direct == DirectLighting::Photons;
     Ok(s)
-}
-
-/// What a progressive render did.
-pub struct SppmOutput {
-    pub image: Image,
-    /// Whether the iterations or the time ran out.
-    pub stopped_by: StopReason,
-    pub timings: Timings,
-    pub iterations: u32,
-    pub photons_emitted: u64,
-    pub initial_radius: f32,
-    /// The largest radius among pixels that gathered photons, at the end.
-    pub final_largest_radius: f32,
-    pub explain: Vec<ExplainLine>,
-    /// Adaptive sampling: the pilot's length and the plan's counts (None
-    /// when not adaptive, or stopped before the plan).
-    pub adaptive: Option<(u32, AdaptiveStats)>,
-}
-
-/// Renders `scene` by SPPM: iterations until `sppm.iterations` or
-/// `sppm.seconds`, whichever comes first. The observer sees each iteration as
-/// an estimate pass (snapshots), and the final image.
-pub fn render_sppm(
-    gpu: &Gpu,
-    scene: &Scene,
-    options: &RenderOptions,
-    sppm: &SppmOptions,
-    observer: &mut dyn RenderObserver,
-) -> Result<SppmOutput> {
-    let mut run = Sppm::new(gpu, scene, options, sppm)?;
-    let mut timings = Timings::default();
-    let wall = std::time::Instant::now();
-    let mut observed = 0.0;
-    let mut stopped_by = StopReason::Iterations;
-    while run.iteration < sppm.iterations {
-        crate::interrupt::check()?;
-        if sppm
-            .seconds
-            .is_some_and(|s| run.iteration > 0 && wall.elapsed().as_secs_f64() - observed >= s)
-        {
-            stopped_by = StopReason::Time;
-            break;
-        }
-        run.iterate(&mut timings, observer)?;
-        let t0 = std::time::Instant::now();
-        observer.progress(&Progress::stage(
-            "SPPM iterations",
-            run.iteration as u64,
-            sppm.iterations as u64,
-        ));
-        observer.estimate_pass(&EstimatePass {
-            stopped_by: None,
-            at: At {
-                view: 0,
-                views: 1,
-                sample: 0,
-                samples: 1,
-            },
-            pass: run.iteration - 1,
-            searching: 0,
-            query_pixels: 0,
-            seconds: wall.elapsed().as_secs_f64() - observed,
-            finished: false,
-            image: &|| run.image(),
-        })?;
-        observed += t0.elapsed().as_secs_f64();
-    }
-    let image = run.image()?;
-    timings.wall_seconds = wall.elapsed().as_secs_f64();
-    observer.estimate_pass(&EstimatePass {
-        at: At {
-            view: 0,
-            views: 1,
-            sample: 0,
-            samples: 1,
-        },
-        pass: run.iteration,
-        searching: 0,
-        query_pixels: 0,
-        seconds: timings.wall_seconds - observed,
-        finished: true,
-        stopped_by: Some(stopped_by),
-        image: &|| Ok(image.clone()),
-    })?;
-    observer.frame(0, &image)?;
-    let final_largest_radius = run.largest_radius()?;
-    let explain = explain(&run, sppm);
-    let adaptive = run
-        .adaptive_stats()
-        .map(|s| (run.adaptive.as_ref().expect("adaptive").pilot, s.clone()));
-    Ok(SppmOutput {
-        stopped_by,
-        adaptive,
-        image,
-        timings,
-        iterations: run.iteration,
-        photons_emitted: run.iteration as u64 * sppm.photons_per_iteration as u64,
-        initial_radius: run.initial_radius,
-        final_largest_radius,
-        explain,
-    })
-}
-
-fn explain(run: &Sppm, o: &SppmOptions) -> Vec<ExplainLine> {
-    let line = |stage: &str, passes: usize, why: String| ExplainLine {
-        stage: stage.into(),
-        passes,
-        ran: true,
-        why,
-    };
-    let i = run.iteration as usize;
-    let s = &run.scene;
-    let mut lines = vec![
-        line(
-            "eye paths",
-            i * run.plan.passes_per_sample() as usize,
-            format!(
-                "one jittered eye path per pixel per iteration, {} specular depths, {}",
-                run.plan.depths,
-                match o.direct {
-                    DirectLighting::ShadowRays => format!(
-                        "{} shadow ray(s) per area light at the visible point",
-                        o.shadow_rays.max(1)
-                    ),
-                    DirectLighting::Photons => "no shadow rays: photons carry direct light".into(),
-                }
-            ),
-        ),
-        line(
-            "trace photons",
-            i * (s.photon_map.max_bounces as usize + 1),
-            format!(
-                "{} photons emitted per iteration, {} bounces, every frame traced (no read-back), stored from their {} hit",
-                o.photons_per_iteration,
-                s.photon_map.max_bounces,
-                if s.photon_map.store_direct { "first" } else { "second" }
-            ),
-        ),
-    ];
-    if s.photon_map.caustics_only {
-        lines.push(line(
-            "caustics only",
-            0,
-            "the scene stores caustic photons only (caustics_only = true): SPPM converges to direct light plus caustics, which is the whole image only where, as in RING, no light reaches a diffuse surface by another diffuse one".into(),
-        ));
-    }
-    if let Some(g) = &run.grid {
-        lines.push(line(
-            "build map",
-            i,
-            format!(
-                "every iteration, over the whole scene: {} x {} x {} cells of about {:.4} (the largest radius that has gathered photons, read back after iterations 1, 2, 4, ... and every 64th)",
-                g.resolution[0], g.resolution[1], g.resolution[2], run.cell
-            ),
-        ));
-    }
-    if let Some(a) = &run.adaptive {
-        lines.push(match (&a.planned, run.adaptive_stats()) {
-            (Some(p), Some(s)) => line(
-                "adaptive plan",
-                12,
-                format!(
-                    "after a pilot of {} iterations at every pixel, the pyramid (strides 8, 4, 2, 1, threshold {}) on the pilot's photon half: {} pixels interpolated, {} go on gathering ({:.1}% of the image), packed into {} rows",
-                    a.pilot,
-                    a.options.threshold,
-                    s.interpolated,
-                    p.computed.len(),
-                    100.0 * p.computed.len() as f64 / (run.image.width * run.image.height) as f64,
-                    p.rows
-                ),
-            ),
-            _ => ExplainLine {
-                stage: "adaptive plan".into(),
-                passes: 0,
-                ran: false,
-                why: format!("the render stopped within its pilot of {} iterations", a.pilot),
-            },
-        });
-    }
-    lines.push(line(
-        "gather + update",
-        i,
-        format!(
-            "each pixel gathers photons arriving on its visible side within its own radius (first {}, alpha {}), in one pass, in place",
-            run.initial_radius, o.alpha
-        ),
-    ));
-    lines
 }

@@ -1,0 +1,102 @@
+//! One arm per frame method: what `Method`'s options become once the
+//! method is prepared, and what it leaves behind after the last sample. To
+//! add a method, write its module (options, a run type with `prepare`, and
+//! `FrameMethod`), then one arm here and one in `Method`; the compiler lists
+//! every match still to extend.
+
+use crate::error::Error;
+use crate::gpu::{Gpu, Result};
+use crate::image::Image;
+use crate::scene::pack::SceneTextures;
+use crate::scene::Scene;
+use crate::timing::Timings;
+
+use super::differentials::DifferentialsRun;
+use super::igi::IgiRun;
+use super::observer::RenderObserver;
+use super::options::{Method, RenderOptions};
+use super::photon_map::PhotonMapRun;
+use super::radiosity::RadiosityRun;
+use super::sample::{FrameMethod, SampleFrame};
+
+/// A frame method's state: its maps, textures and per-sample reports.
+pub enum MethodRun {
+    DirectOnly,
+    PhotonMap(PhotonMapRun),
+    Igi(IgiRun),
+    Differentials(DifferentialsRun),
+    Radiosity(RadiosityRun),
+}
+
+impl MethodRun {
+    /// Prepares `options.method` before the first eye sample: photons,
+    /// maps, VPLs, the radiosity solution.
+    pub fn prepare(
+        gpu: &Gpu,
+        scene: &Scene,
+        textures: &SceneTextures,
+        options: &RenderOptions,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Self> {
+        let frame = (options.width, options.height, options.seed);
+        let f = (scene, textures);
+        Ok(match &options.method {
+            Method::DirectOnly => MethodRun::DirectOnly,
+            Method::PhotonMap(o) => {
+                MethodRun::PhotonMap(PhotonMapRun::prepare(gpu, f, o, frame, timings, observer)?)
+            }
+            Method::Igi(o) => MethodRun::Igi(IgiRun::prepare(
+                gpu,
+                f,
+                (&o.photons, &o.estimate, &o.method),
+                frame,
+                timings,
+                observer,
+            )?),
+            Method::Differentials(o) => MethodRun::Differentials(DifferentialsRun::prepare(
+                gpu,
+                f,
+                (&o.photons, &o.method),
+                frame,
+                timings,
+                observer,
+            )?),
+            Method::Radiosity(o) => MethodRun::Radiosity(RadiosityRun::prepare(
+                gpu,
+                f,
+                (&o.photons, &o.estimate, &o.method),
+                frame,
+                timings,
+                observer,
+            )?),
+            Method::Sppm(_) => return Err(Error::InvalidOption(
+                "SPPM is progressive, not a frame method: render it with render::sppm::render_sppm"
+                    .into(),
+            )),
+        })
+    }
+
+    fn frame_method(&mut self) -> Option<&mut dyn FrameMethod> {
+        match self {
+            MethodRun::DirectOnly => None,
+            MethodRun::PhotonMap(m) => Some(m),
+            MethodRun::Igi(m) => Some(m),
+            MethodRun::Differentials(m) => Some(m),
+            MethodRun::Radiosity(m) => Some(m),
+        }
+    }
+
+    /// One eye sample's image.
+    pub fn sample(
+        &mut self,
+        f: &SampleFrame<'_>,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Image> {
+        match self.frame_method() {
+            None => Ok(f.direct.read_radiance()),
+            Some(m) => m.sample(f, timings, observer),
+        }
+    }
+}

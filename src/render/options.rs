@@ -1,0 +1,171 @@
+//! What a render is asked to do: the frame's size, seed and samples, and one
+//! `Method`, whose arm carries that method's options and nothing else, so an
+//! illegal combination (IGI with final gather, say) cannot be written down.
+
+use crate::photon::PhotonConfig;
+use crate::scene::Scene;
+
+use super::differentials::DifferentialsOptions;
+use super::igi::IgiOptions;
+use super::photon_map::PhotonMapOptions;
+use super::radiance_estimate::EstimateOptions;
+use super::radiosity::RadiosityOptions;
+use super::sppm::options::SppmOptions;
+
+/// How one render runs (what the scene file does not fix).
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    pub seed: u32,
+    pub width: u32,
+    pub height: u32,
+    /// Shadow samples per area light drawn in one pass (bounds work per
+    /// pass); 0 chooses by image size (`PassPlan::new`).
+    pub shadow_batch: u32,
+    /// Eye samples per pixel: 1 (the paper) shoots through the pixel centre;
+    /// more are stratified, jittered and box-filtered.
+    pub spp: u32,
+    /// The light beyond direct light and specular paths, and how it is made.
+    pub method: Method,
+}
+
+/// The global-illumination method of a render, with its options.
+#[derive(Clone, Debug)]
+pub enum Method {
+    /// Direct light and specular paths only: no photons, no estimate.
+    DirectOnly,
+    /// The paper's photon map visualised at the first diffuse hits, with
+    /// section 4.5's final gather and adaptive sampling as options.
+    PhotonMap(PhotonMapOptions),
+    /// Instant global illumination: VPLs for the diffuse interreflection,
+    /// a caustic photon map for the caustics.
+    Igi(WithCausticMap<IgiOptions>),
+    /// Photon differentials: footprints in a BVH instead of the kNN-grid,
+    /// one map for every photon.
+    Differentials(WithPhotons<DifferentialsOptions>),
+    /// Progressive refinement radiosity for the diffuse interreflection, a
+    /// caustic photon map for the caustics.
+    Radiosity(WithCausticMap<RadiosityOptions>),
+    /// Stochastic progressive photon mapping: iterations of eye paths and
+    /// photons, each pixel's radius shrinking; converges to the exact image.
+    Sppm(WithPhotons<SppmOptions>),
+}
+
+/// A method's own options beside those of the caustic photon map it
+/// visualises at the first hits.
+#[derive(Clone, Debug, Default)]
+pub struct WithCausticMap<T> {
+    pub photons: PhotonConfig,
+    pub estimate: EstimateOptions,
+    pub method: T,
+}
+
+/// A method's own options beside those of the photons it traces.
+#[derive(Clone, Debug, Default)]
+pub struct WithPhotons<T> {
+    pub photons: PhotonConfig,
+    pub method: T,
+}
+
+impl<T> WithPhotons<T> {
+    /// The photon map's photons for `method`.
+    pub fn from_map(map: PhotonMapOptions, method: T) -> Self {
+        Self {
+            photons: map.photons,
+            method,
+        }
+    }
+}
+
+impl<T> WithCausticMap<T> {
+    /// The photon map's photons and estimate as `method`'s caustic map.
+    pub fn from_map(map: PhotonMapOptions, method: T) -> Self {
+        Self {
+            photons: map.photons,
+            estimate: map.estimate,
+            method,
+        }
+    }
+
+    /// The estimate's options as the photon config constrains them.
+    pub fn estimate_options(&self) -> EstimateOptions {
+        self.estimate.under(&self.photons)
+    }
+}
+
+impl Method {
+    /// The method's name as provenance and reports spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::DirectOnly => "direct-only",
+            Method::PhotonMap(o) if o.final_gather.is_some() => "final-gather",
+            Method::PhotonMap(_) => "paper",
+            Method::Igi(_) => "igi",
+            Method::Differentials(_) => "differentials",
+            Method::Radiosity(_) => "radiosity",
+            Method::Sppm(_) => "sppm",
+        }
+    }
+
+    /// The photon tracer's configuration, where the method traces photons.
+    pub fn photons(&self) -> Option<&PhotonConfig> {
+        match self {
+            Method::DirectOnly => None,
+            Method::PhotonMap(o) => Some(&o.photons),
+            Method::Igi(o) => Some(&o.photons),
+            Method::Differentials(o) => Some(&o.photons),
+            Method::Radiosity(o) => Some(&o.photons),
+            Method::Sppm(o) => Some(&o.photons),
+        }
+    }
+
+    /// The kNN-grid estimate's options, where the method runs one.
+    pub fn estimate(&self) -> Option<&EstimateOptions> {
+        match self {
+            Method::DirectOnly | Method::Differentials(_) | Method::Sppm(_) => None,
+            Method::PhotonMap(o) => Some(&o.estimate),
+            Method::Igi(o) => Some(&o.estimate),
+            Method::Radiosity(o) => Some(&o.estimate),
+        }
+    }
+
+    /// The photon-map method's options, if this is it.
+    pub fn photon_map(&self) -> Option<&PhotonMapOptions> {
+        match self {
+            Method::PhotonMap(o) => Some(o),
+            _ => None,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// The scene's size, seed 1, one sample, the paper's photon map.
+    pub fn for_scene(scene: &Scene) -> Self {
+        Self {
+            seed: 1,
+            width: scene.camera.width,
+            height: scene.camera.height,
+            shadow_batch: 0,
+            spp: 1,
+            method: Method::PhotonMap(PhotonMapOptions::default()),
+        }
+    }
+
+    pub fn direct_only(mut self) -> Self {
+        self.method = Method::DirectOnly;
+        self
+    }
+
+    /// The photon-map method's options, if it is the one chosen.
+    pub fn photon_map_mut(&mut self) -> Option<&mut PhotonMapOptions> {
+        match &mut self.method {
+            Method::PhotonMap(o) => Some(o),
+            _ => None,
+        }
+    }
+
+    /// The same frame with another method.
+    pub fn with_method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+}

@@ -1,0 +1,202 @@
+//! An SPPM render from start to finish: iterations until their number or
+//! the time runs out, the observer told of each, and the `--explain` lines.
+
+use crate::gpu::{Gpu, Result};
+use crate::image::Image;
+use crate::render::adaptive::AdaptiveStats;
+use crate::render::explain::ExplainLine;
+use crate::render::observer::{At, EstimatePass, Progress, RenderObserver, StopReason};
+use crate::render::options::RenderOptions;
+use crate::scene::Scene;
+use crate::timing::Timings;
+
+use super::options::{DirectLighting, SppmOptions};
+use super::Sppm;
+
+/// What a progressive render did.
+pub struct SppmOutput {
+    pub image: Image,
+    /// Whether the iterations or the time ran out.
+    pub stopped_by: StopReason,
+    pub timings: Timings,
+    pub iterations: u32,
+    pub photons_emitted: u64,
+    pub initial_radius: f32,
+    /// The largest radius among pixels that gathered photons, at the end.
+    pub final_largest_radius: f32,
+    pub explain: Vec<ExplainLine>,
+    /// Adaptive sampling: the pilot's length and the plan's counts (None
+    /// when not adaptive, or stopped before the plan).
+    pub adaptive: Option<(u32, AdaptiveStats)>,
+}
+
+/// Renders `scene` by SPPM: iterations until `sppm.iterations` or
+/// `sppm.seconds`, whichever comes first. The observer sees each iteration as
+/// an estimate pass (snapshots), and the final image.
+pub fn render_sppm(
+    gpu: &Gpu,
+    scene: &Scene,
+    options: &RenderOptions,
+    sppm: &SppmOptions,
+    observer: &mut dyn RenderObserver,
+) -> Result<SppmOutput> {
+    let mut run = Sppm::new(gpu, scene, options, sppm)?;
+    let mut timings = Timings::default();
+    let wall = std::time::Instant::now();
+    let mut observed = 0.0;
+    let mut stopped_by = StopReason::Iterations;
+    while run.iteration < sppm.iterations {
+        crate::interrupt::check()?;
+        if sppm
+            .seconds
+            .is_some_and(|s| run.iteration > 0 && wall.elapsed().as_secs_f64() - observed >= s)
+        {
+            stopped_by = StopReason::Time;
+            break;
+        }
+        run.iterate(&mut timings, observer)?;
+        let t0 = std::time::Instant::now();
+        observer.progress(&Progress::stage(
+            "SPPM iterations",
+            run.iteration as u64,
+            sppm.iterations as u64,
+        ));
+        observer.estimate_pass(&EstimatePass {
+            stopped_by: None,
+            at: At {
+                view: 0,
+                views: 1,
+                sample: 0,
+                samples: 1,
+            },
+            pass: run.iteration - 1,
+            searching: 0,
+            query_pixels: 0,
+            seconds: wall.elapsed().as_secs_f64() - observed,
+            finished: false,
+            image: &|| run.image(),
+        })?;
+        observed += t0.elapsed().as_secs_f64();
+    }
+    let image = run.image()?;
+    timings.wall_seconds = wall.elapsed().as_secs_f64();
+    observer.estimate_pass(&EstimatePass {
+        at: At {
+            view: 0,
+            views: 1,
+            sample: 0,
+            samples: 1,
+        },
+        pass: run.iteration,
+        searching: 0,
+        query_pixels: 0,
+        seconds: timings.wall_seconds - observed,
+        finished: true,
+        stopped_by: Some(stopped_by),
+        image: &|| Ok(image.clone()),
+    })?;
+    observer.frame(0, &image)?;
+    let final_largest_radius = run.largest_radius()?;
+    let explain = explain(&run, sppm);
+    let adaptive = run
+        .adaptive_stats()
+        .map(|s| (run.adaptive.as_ref().expect("adaptive").pilot, s.clone()));
+    Ok(SppmOutput {
+        stopped_by,
+        adaptive,
+        image,
+        timings,
+        iterations: run.iteration,
+        photons_emitted: run.iteration as u64 * sppm.photons_per_iteration as u64,
+        initial_radius: run.initial_radius,
+        final_largest_radius,
+        explain,
+    })
+}
+
+fn explain(run: &Sppm, o: &SppmOptions) -> Vec<ExplainLine> {
+    let line = |stage: &str, passes: usize, why: String| ExplainLine {
+        stage: stage.into(),
+        passes,
+        ran: true,
+        why,
+    };
+    let i = run.iteration as usize;
+    let s = &run.scene;
+    let mut lines = vec![
+        line(
+            "eye paths",
+            i * run.plan.passes_per_sample() as usize,
+            format!(
+                "one jittered eye path per pixel per iteration, {} specular depths, {}",
+                run.plan.depths,
+                match o.direct {
+                    DirectLighting::ShadowRays => format!(
+                        "{} shadow ray(s) per area light at the visible point",
+                        o.shadow_rays.max(1)
+                    ),
+                    DirectLighting::Photons => "no shadow rays: photons carry direct light".into(),
+                }
+            ),
+        ),
+        line(
+            "trace photons",
+            i * (s.photon_map.max_bounces as usize + 1),
+            format!(
+                "{} photons emitted per iteration, {} bounces, every frame traced (no read-back), stored from their {} hit",
+                o.photons_per_iteration,
+                s.photon_map.max_bounces,
+                if s.photon_map.store_direct { "first" } else { "second" }
+            ),
+        ),
+    ];
+    if s.photon_map.caustics_only {
+        lines.push(line(
+            "caustics only",
+            0,
+            "the scene stores caustic photons only (caustics_only = true): SPPM converges to direct light plus caustics, which is the whole image only where, as in RING, no light reaches a diffuse surface by another diffuse one".into(),
+        ));
+    }
+    if let Some(g) = &run.grid {
+        lines.push(line(
+            "build map",
+            i,
+            format!(
+                "every iteration, over the whole scene: {} x {} x {} cells of about {:.4} (the largest radius that has gathered photons, read back after iterations 1, 2, 4, ... and every 64th)",
+                g.resolution[0], g.resolution[1], g.resolution[2], run.cell
+            ),
+        ));
+    }
+    if let Some(a) = &run.adaptive {
+        lines.push(match (&a.planned, run.adaptive_stats()) {
+            (Some(p), Some(s)) => line(
+                "adaptive plan",
+                12,
+                format!(
+                    "after a pilot of {} iterations at every pixel, the pyramid (strides 8, 4, 2, 1, threshold {}) on the pilot's photon half: {} pixels interpolated, {} go on gathering ({:.1}% of the image), packed into {} rows",
+                    a.pilot,
+                    a.options.threshold,
+                    s.interpolated,
+                    p.computed.len(),
+                    100.0 * p.computed.len() as f64 / (run.image.width * run.image.height) as f64,
+                    p.rows
+                ),
+            ),
+            _ => ExplainLine {
+                stage: "adaptive plan".into(),
+                passes: 0,
+                ran: false,
+                why: format!("the render stopped within its pilot of {} iterations", a.pilot),
+            },
+        });
+    }
+    lines.push(line(
+        "gather + update",
+        i,
+        format!(
+            "each pixel gathers photons arriving on its visible side within its own radius (first {}, alpha {}), in one pass, in place",
+            run.initial_radius, o.alpha
+        ),
+    ));
+    lines
+}
