@@ -87,6 +87,14 @@ pub enum Error {
     /// A parameter outside its allowed range, or options that exclude each other.
     #[error("{0}")]
     InvalidOption(String),
+    /// An option outside its allowed range, named by its field
+    /// (`igi.vpl_paths`); the command line names it by its flag instead.
+    #[error("{option} = {value}: {allowed}")]
+    OutOfRange {
+        option: &'static str,
+        value: String,
+        allowed: String,
+    },
     /// The paper's float addressing refuses what floats cannot address exactly.
     #[error("GL: --faithful float addressing is exact only below 2^24 = {limit} texels; this sort has {texels}: use fewer photons or drop --faithful")]
     FloatAddressLimit { texels: u64, limit: u64 },
@@ -120,5 +128,21 @@ pub fn signal_name(signal: i32) -> &'static str {
         2 => "SIGINT",
         15 => "SIGTERM",
         _ => "a signal",
+    }
+}
+
+impl Error {
+    /// `option` (a field path, `igi.vpl_paths`) is `value`, outside what is
+    /// `allowed` (a range, or what to give instead).
+    pub fn out_of_range(
+        option: &'static str,
+        value: impl std::fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Error::OutOfRange {
+            option,
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
     }
 }

@@ -544,3 +544,24 @@ impl SceneArgs {
         Ok(LoadedScene { scene, provenance })
     }
 }
+
+/// The flag that sets a library option, by the option's field path: the
+/// field's name in kebab case, where the flag does not say otherwise.
+pub fn flag_of(option: &str) -> String {
+    let renamed = match option {
+        "igi.min_distance" => Some("--vpl-min-distance"),
+        "differentials.max_radius" => Some("--footprint-max-radius"),
+        "radiosity.resolution" => Some("--elements"),
+        "sppm.initial_radius" => Some("--radius"),
+        "sppm.start.photons" => Some("--start-photons"),
+        "sppm.start.pixels" => Some("--start-pixels"),
+        _ => None,
+    };
+    renamed.map_or_else(
+        || {
+            let field = option.rsplit('.').next().unwrap_or(option);
+            format!("--{}", field.replace('_', "-"))
+        },
+        str::to_string,
+    )
+}

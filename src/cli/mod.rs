@@ -103,7 +103,19 @@ pub fn out_dir(kind: &str) -> std::path::PathBuf {
 /// The exit of a command that failed: its error and every cause, on stderr;
 /// 128 + the signal after SIGINT or SIGTERM (130, 143), as shells expect.
 pub fn fail(e: anyhow::Error) -> std::process::ExitCode {
-    eprintln!("error: {e:#}");
+    // As `{e:#}` writes the chain, with options named by their flags.
+    let causes: Vec<String> = e
+        .chain()
+        .map(|c| match c.downcast_ref() {
+            Some(photonmap::error::Error::OutOfRange {
+                option,
+                value,
+                allowed,
+            }) => format!("{} {value}: {allowed}", args::flag_of(option)),
+            _ => c.to_string(),
+        })
+        .collect();
+    eprintln!("error: {}", causes.join(": "));
     let signal = e.chain().find_map(|c| match c.downcast_ref() {
         Some(photonmap::error::Error::Interrupted { signal }) => Some(*signal),
         _ => None,

@@ -78,28 +78,38 @@ impl Default for DifferentialsOptions {
 
 impl DifferentialsOptions {
     pub fn check(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::InvalidOption(what));
         let positive = |v: f32| v > 0.0 && v.is_finite();
         if let Some(s) = self.smoothing {
             if !positive(s) {
-                return bad(format!("--smoothing {s}: give a factor above 0, or auto"));
+                return Err(Error::out_of_range(
+                    "differentials.smoothing",
+                    s,
+                    "give a factor above 0, or auto",
+                ));
             }
         }
         if !positive(self.caustic_smoothing) {
-            return bad(format!(
-                "--caustic-smoothing {}: give a factor above 0",
-                self.caustic_smoothing
+            return Err(Error::out_of_range(
+                "differentials.caustic_smoothing",
+                self.caustic_smoothing,
+                "give a factor above 0",
             ));
         }
         if let Some(r) = self.max_radius {
             if !positive(r) {
-                return bad(format!("--footprint-max-radius {r}: give a radius above 0"));
+                return Err(Error::out_of_range(
+                    "differentials.max_radius",
+                    r,
+                    "give a radius above 0",
+                ));
             }
         }
         if let Some(t) = self.leaf_size {
             if !(1..=1024).contains(&t) {
-                return bad(format!(
-                    "--leaf-size {t}: the allowed range is 1..=1024, or auto"
+                return Err(Error::out_of_range(
+                    "differentials.leaf_size",
+                    t,
+                    "the allowed range is 1..=1024, or auto",
                 ));
             }
         }

@@ -80,35 +80,40 @@ impl IgiOptions {
     }
 
     pub fn check(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::InvalidOption(what));
         if !(1..=1 << 20).contains(&self.vpl_paths) {
-            return bad(format!(
-                "--vpl-paths {}: the allowed range is 1..=1048576",
-                self.vpl_paths
+            return Err(Error::out_of_range(
+                "igi.vpl_paths",
+                self.vpl_paths,
+                "the allowed range is 1..=1048576",
             ));
         }
         if !(1..=64).contains(&self.vpl_bounces) {
-            return bad(format!(
-                "--vpl-bounces {}: the allowed range is 1..=64",
-                self.vpl_bounces
+            return Err(Error::out_of_range(
+                "igi.vpl_bounces",
+                self.vpl_bounces,
+                "the allowed range is 1..=64",
             ));
         }
         if !(1..=8).contains(&self.interleave) {
-            return bad(format!(
-                "--interleave {}: the allowed range is 1..=8 (n x n subsets)",
-                self.interleave
+            return Err(Error::out_of_range(
+                "igi.interleave",
+                self.interleave,
+                "the allowed range is 1..=8 (n x n subsets)",
             ));
         }
         if !(1..=16).contains(&self.downsample) {
-            return bad(format!(
-                "--downsample {}: the allowed range is 1..=16",
-                self.downsample
+            return Err(Error::out_of_range(
+                "igi.downsample",
+                self.downsample,
+                "the allowed range is 1..=16",
             ));
         }
         if let Some(m) = self.min_distance {
             if !(m >= 0.0 && m.is_finite()) {
-                return bad(format!(
-                    "--vpl-min-distance {m}: give a distance of 0 (unbounded) or more"
+                return Err(Error::out_of_range(
+                    "igi.min_distance",
+                    m,
+                    "give a distance of 0 (unbounded) or more",
                 ));
             }
         }

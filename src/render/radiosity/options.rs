@@ -61,47 +61,56 @@ impl Default for RadiosityOptions {
 
 impl RadiosityOptions {
     pub fn check(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::InvalidOption(what));
         if !(2..=256).contains(&self.resolution) {
-            return bad(format!(
-                "--elements {}: the allowed range is 2..=256",
-                self.resolution
+            return Err(Error::out_of_range(
+                "radiosity.resolution",
+                self.resolution,
+                "the allowed range is 2..=256",
             ));
         }
         if self.substructure == 0 || !self.resolution.is_multiple_of(self.substructure) {
-            return bad(format!(
-                "--substructure {}: give a divisor of --elements ({})",
-                self.substructure, self.resolution
+            return Err(Error::out_of_range(
+                "radiosity.substructure",
+                self.substructure,
+                format!(
+                    "give a divisor of the elements a side ({})",
+                    self.resolution
+                ),
             ));
         }
         if self.substructure > 8 {
-            return bad(format!(
-                "--substructure {}: at most 8 (64 item buffers a shot)",
-                self.substructure
+            return Err(Error::out_of_range(
+                "radiosity.substructure",
+                self.substructure,
+                "at most 8 (64 item buffers a shot)",
             ));
         }
         if !(16..=2048).contains(&self.item_buffer) {
-            return bad(format!(
-                "--item-buffer {}: the allowed range is 16..=2048",
-                self.item_buffer
+            return Err(Error::out_of_range(
+                "radiosity.item_buffer",
+                self.item_buffer,
+                "the allowed range is 16..=2048",
             ));
         }
         if !(self.convergence > 0.0 && self.convergence < 1.0) {
-            return bad(format!(
-                "--convergence {}: the allowed range is (0, 1)",
-                self.convergence
+            return Err(Error::out_of_range(
+                "radiosity.convergence",
+                self.convergence,
+                "the allowed range is (0, 1)",
             ));
         }
         if self.subdivide > MAX_SUBDIVIDE {
-            return bad(format!(
-                "--subdivide {}: the allowed range is 0..={MAX_SUBDIVIDE}",
-                self.subdivide
+            return Err(Error::out_of_range(
+                "radiosity.subdivide",
+                self.subdivide,
+                format!("the allowed range is 0..={MAX_SUBDIVIDE}"),
             ));
         }
         if !(self.gradient > 0.0 && self.gradient.is_finite()) {
-            return bad(format!(
-                "--gradient {}: give a positive number",
-                self.gradient
+            return Err(Error::out_of_range(
+                "radiosity.gradient",
+                self.gradient,
+                "give a positive number",
             ));
         }
         Ok(())

@@ -180,9 +180,11 @@ impl Sppm {
             start_defines.push(("START_PHOTONS", "1".to_string()));
         }
         if !(initial_radius > 0.0 && initial_radius.is_finite()) {
-            return Err(Error::InvalidOption(format!(
-                "--radius {initial_radius}: the first radius must be a positive number"
-            )));
+            return Err(Error::out_of_range(
+                "sppm.initial_radius",
+                initial_radius,
+                "the first radius must be a positive number",
+            ));
         }
         let state = SppmState::new(gpu, w, h)?;
         state
@@ -523,8 +525,10 @@ fn pending_start(sppm: &SppmOptions) -> Result<Option<SppmStart>> {
                 photons: Some(0), ..
             },
         ) => {
-            return Err(Error::InvalidOption(
-                "--start-photons 0: the start's radius must hold at least 1 photon".into(),
+            return Err(Error::out_of_range(
+                "sppm.start.photons",
+                "0",
+                "the start's radius must hold at least 1 photon",
             ))
         }
         (
@@ -533,9 +537,11 @@ fn pending_start(sppm: &SppmOptions) -> Result<Option<SppmStart>> {
                 pixels: Some(p), ..
             },
         ) if !(p > 0.0 && p.is_finite()) => {
-            return Err(Error::InvalidOption(format!(
-                "--start-pixels {p}: give a positive number of pixel footprints"
-            )))
+            return Err(Error::out_of_range(
+                "sppm.start.pixels",
+                p,
+                "give a positive number of pixel footprints",
+            ))
         }
         (None, start) => Some(start),
     })
@@ -546,10 +552,11 @@ fn pending_start(sppm: &SppmOptions) -> Result<Option<SppmStart>> {
 /// only when photons carry direct light.
 fn sppm_scene(scene: &Scene, o: &SppmOptions) -> Result<Scene> {
     if !(0.0 < o.alpha && o.alpha < 1.0) {
-        return Err(Error::InvalidOption(format!(
-            "--alpha {}: the allowed range is (0, 1)",
-            o.alpha
-        )));
+        return Err(Error::out_of_range(
+            "sppm.alpha",
+            o.alpha,
+            "the allowed range is (0, 1)",
+        ));
     }
     if o.direct == DirectLighting::Photons && scene.photon_map.caustics_only {
         return Err(Error::InvalidOption(

@@ -1,0 +1,96 @@
+//! What every render writes and prints: provenance, images (all or none),
+//! the software reference, the JSON report and `--explain`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, bail, Result};
+
+use photonmap::image::{write_all_atomically, write_atomically};
+use photonmap::provenance::Provenance;
+use photonmap::render::{self, Image, RenderOptions};
+use photonmap::scene::Scene;
+
+use super::args::Format;
+
+/// What `--json` prints: provenance, the outputs and the run's figures.
+#[derive(serde::Serialize)]
+pub(super) struct Report<'a> {
+    pub(super) provenance: &'a Provenance,
+    pub(super) outputs: Vec<(String, Format)>,
+    #[serde(flatten)]
+    pub(super) figures: serde_json::Value,
+}
+
+pub(super) fn provenance(
+    p: Provenance,
+    gpu: &photonmap::gpu::Gpu,
+    method: &str,
+    o: &RenderOptions,
+) -> Provenance {
+    let mut p = crate::cli::with_driver(p, gpu);
+    p.method = method.into();
+    (p.seed, p.spp, p.width, p.height) = (o.seed, o.spp, o.width, o.height);
+    p
+}
+
+pub(super) fn print_explain(lines: &[photonmap::render::ExplainLine]) {
+    for l in lines {
+        let what = if l.ran { "run " } else { "skip" };
+        eprintln!("{what} {:<34} {:>6} passes  {}", l.stage, l.passes, l.why);
+    }
+}
+
+pub(super) fn warn_far_from_origin(scene: &Scene, quiet: bool) {
+    let ratio = scene.offset_ratio();
+    if ratio > 1000.0 && !quiet {
+        eprintln!(
+            "warning: coordinates reach {ratio:.0} x the scene's size, even with the scene rebased to its centre; 32-bit floats resolve them only to ~{:.0e} of it, so fine detail (sharp caustics) may blur: bring the camera and the scene's parts closer together",
+            ratio * f32::EPSILON
+        );
+    }
+}
+
+/// Writes the final image to every output, all or none; returns what was written.
+pub(super) fn write_images(
+    image: &Image,
+    outputs: &[(PathBuf, Format)],
+    provenance: &Provenance,
+) -> Result<Vec<(String, Format)>> {
+    if image.has_non_finite() {
+        bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
+    }
+    // Encode everything first, so a failure writes nothing.
+    let encoded: Vec<(PathBuf, Vec<u8>)> = outputs
+        .iter()
+        .map(|(p, f)| Ok((p.clone(), f.encode(image, provenance)?)))
+        .collect::<Result<_>>()?;
+    let files: Vec<(&Path, &[u8])> = encoded
+        .iter()
+        .map(|(p, b)| (p.as_path(), b.as_slice()))
+        .collect();
+    write_all_atomically(&files)?;
+    Ok(outputs
+        .iter()
+        .map(|(p, f)| (p.display().to_string(), *f))
+        .collect())
+}
+
+pub(super) fn write_software_reference(
+    out: &render::RenderOutput,
+    scene: &Scene,
+    path: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let wall = std::time::Instant::now();
+    let img = render::software::software_image(out, scene)
+        .ok_or_else(|| anyhow!("no photon map to estimate from"))?;
+    write_atomically(path, &img.png_bytes()?)?;
+    if !quiet {
+        eprintln!(
+            "software reference (kd-tree) in {:.2} s: wrote {}",
+            wall.elapsed().as_secs_f64(),
+            path.display()
+        );
+    }
+    Ok(())
+}
