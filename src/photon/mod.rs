@@ -7,6 +7,7 @@ pub mod bitonic;
 pub mod build;
 pub mod differentials;
 pub mod fit;
+pub mod halton;
 pub mod projection;
 pub mod stencil_routing;
 pub mod trace;
@@ -18,9 +19,10 @@ use crate::scene::Scene;
 
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
 pub use build::{build_map, check_storage, BuiltMap, PhotonConfig};
+pub use halton::{RandomSource, ScrambledHalton, HALTON_DIMENSIONS};
 pub use projection::ProjectionMaps;
 pub use stencil_routing::{LostPower, RoutedPhotonMap, StencilRouting, VertexFeed};
-pub use trace::{PhotonBatch, PhotonFrames, PhotonTracer, RandomSource, TraceConfig, TraceReport};
+pub use trace::{PhotonBatch, PhotonFrames, PhotonTracer, TraceConfig, TraceReport};
 
 /// The grid photons are sorted or routed into.
 #[derive(Clone, Copy, Debug, PartialEq)]
