@@ -31,12 +31,13 @@ use crate::layout::FOOTPRINT_BUDGET;
 use crate::photon::differentials::{
     trace_differentials, DifferentialFrames, FootprintBuilder, FootprintMap, FootprintOptions,
 };
-use crate::photon::{PhotonConfig, PhotonFrames, PhotonTracer, TraceReport};
+use crate::photon::{PhotonFrames, PhotonTracer, TraceReport};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
 use super::observer::{Progress, RenderObserver};
-use super::sample::{FrameMethod, SampleFrame};
+use super::photon_options::WithPhotons;
+use super::sample::{FrameMethod, Prepare, SampleFrame};
 use super::{DirectLight, Image, Timings};
 
 /// The density-estimation kernel over a footprint's ellipse.
@@ -380,18 +381,18 @@ impl DifferentialsRun {
     /// Traces the photons with their differentials; the map waits for the
     /// first eye sample's hits.
     pub fn prepare(
-        gpu: &Gpu,
-        f: (&Scene, &SceneTextures),
-        (photons, o): (&PhotonConfig, &DifferentialsOptions),
-        (w, h, seed): (u32, u32, u32),
+        p: &Prepare<'_>,
+        with: &WithPhotons<DifferentialsOptions>,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let (scene, textures) = f;
+        let (gpu, o) = (p.gpu, &with.method);
+        let (w, h) = (p.width, p.height);
         observer.progress(&Progress::stage("photons", 0, 1));
         o.check()?;
-        let tracer = PhotonTracer::with_config(gpu, photons.trace())?;
-        let photons = DifferentialPhotons::trace(gpu, scene, textures, &tracer, seed, timings)?;
+        let tracer = PhotonTracer::with_config(gpu, with.photons.trace())?;
+        let photons =
+            DifferentialPhotons::trace(gpu, p.scene, p.textures, &tracer, p.seed, timings)?;
         Ok(Self {
             photons,
             map: None,

@@ -27,15 +27,15 @@
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::layout::{PRIMITIVE_BOX_ROW, VPL_BATCH};
-use crate::photon::{BitonicBuild, Grid, PhotonConfig, PhotonTracer, RandomSource, TraceConfig};
+use crate::photon::{BitonicBuild, Grid, PhotonTracer, RandomSource, TraceConfig};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
 use super::direct::DirectLight;
 use super::observer::{Progress, RenderObserver};
 use super::photon_map::MapEstimate;
-use super::radiance_estimate::EstimateOptions;
-use super::sample::{FrameMethod, SampleFrame};
+use super::photon_options::WithCausticMap;
+use super::sample::{FrameMethod, Prepare, SampleFrame};
 use super::{Image, Timings};
 
 /// How IGI runs.
@@ -466,21 +466,18 @@ pub struct IgiRun {
 impl IgiRun {
     /// The caustic map, then the VPLs.
     pub fn prepare(
-        gpu: &Gpu,
-        f: (&Scene, &SceneTextures),
-        (photons, estimate, o): (&PhotonConfig, &EstimateOptions, &IgiOptions),
-        (w, h, seed): (u32, u32, u32),
+        p: &Prepare<'_>,
+        with: &WithCausticMap<IgiOptions>,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let (scene, textures) = f;
-        observer.progress(&Progress::stage("photons", 0, 1));
-        let caustics = MapEstimate::caustics(gpu, f, (photons, estimate), (w, h, seed), timings)?;
-        let igi = Igi::new(gpu, scene, w, h, o)?;
+        let (o, scene) = (&with.method, p.scene);
+        let caustics = MapEstimate::caustics(p, with, timings, observer)?;
+        let igi = Igi::new(p.gpu, scene, p.width, p.height, o)?;
         observer.progress(&Progress::stage("VPLs", 0, 1));
-        let vpl_seed = crate::random::pcg_hash(seed ^ crate::layout::VPL_STREAM);
+        let vpl_seed = crate::random::pcg_hash(p.seed ^ crate::layout::VPL_STREAM);
         let bounds = (o.vpl_paths, o.vpl_bounces);
-        let vpls = Vpls::trace(gpu, scene, textures, bounds, vpl_seed, timings)?;
+        let vpls = Vpls::trace(p.gpu, scene, p.textures, bounds, vpl_seed, timings)?;
         let report = VplReport {
             paths: vpls.paths,
             vpls: vpls.count,

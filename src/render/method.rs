@@ -17,7 +17,7 @@ use super::observer::RenderObserver;
 use super::options::{Method, RenderOptions};
 use super::photon_map::PhotonMapRun;
 use super::radiosity::RadiosityRun;
-use super::sample::{FrameMethod, SampleFrame};
+use super::sample::{FrameMethod, Prepare, SampleFrame};
 
 /// A frame method's state: its maps, textures and per-sample reports.
 pub enum MethodRun {
@@ -39,37 +39,23 @@ impl MethodRun {
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let frame = (options.width, options.height, options.seed);
-        let f = (scene, textures);
+        let p = Prepare {
+            gpu,
+            scene,
+            textures,
+            width: options.width,
+            height: options.height,
+            seed: options.seed,
+        };
+        let (t, obs) = (timings, observer);
         Ok(match &options.method {
             Method::DirectOnly => MethodRun::DirectOnly,
-            Method::PhotonMap(o) => {
-                MethodRun::PhotonMap(PhotonMapRun::prepare(gpu, f, o, frame, timings, observer)?)
+            Method::PhotonMap(o) => MethodRun::PhotonMap(PhotonMapRun::prepare(&p, o, t, obs)?),
+            Method::Igi(o) => MethodRun::Igi(IgiRun::prepare(&p, o, t, obs)?),
+            Method::Differentials(o) => {
+                MethodRun::Differentials(DifferentialsRun::prepare(&p, o, t, obs)?)
             }
-            Method::Igi(o) => MethodRun::Igi(IgiRun::prepare(
-                gpu,
-                f,
-                (&o.photons, &o.estimate, &o.method),
-                frame,
-                timings,
-                observer,
-            )?),
-            Method::Differentials(o) => MethodRun::Differentials(DifferentialsRun::prepare(
-                gpu,
-                f,
-                (&o.photons, &o.method),
-                frame,
-                timings,
-                observer,
-            )?),
-            Method::Radiosity(o) => MethodRun::Radiosity(RadiosityRun::prepare(
-                gpu,
-                f,
-                (&o.photons, &o.estimate, &o.method),
-                frame,
-                timings,
-                observer,
-            )?),
+            Method::Radiosity(o) => MethodRun::Radiosity(RadiosityRun::prepare(&p, o, t, obs)?),
             Method::Sppm(_) => return Err(Error::InvalidOption(
                 "SPPM is progressive, not a frame method: render it with render::sppm::render_sppm"
                     .into(),

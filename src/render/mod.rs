@@ -16,6 +16,7 @@ pub mod observer;
 pub mod options;
 pub mod output;
 pub mod photon_map;
+pub mod photon_options;
 pub mod plan;
 pub mod radiance_estimate;
 pub mod radiosity;
@@ -42,9 +43,10 @@ pub use frame::{render, render_views};
 pub use igi::{Igi, IgiOptions, IgiRun, IgiStats, VplReport, Vpls};
 pub use method::MethodRun;
 pub use observer::{At, EstimatePass, Progress, RenderObserver, StopReason};
-pub use options::{Method, RenderOptions, WithCausticMap, WithPhotons};
+pub use options::{Method, RenderOptions};
 pub use output::{FrameState, RenderOutput};
-pub use photon_map::{MapEstimate, PhotonMapOptions, PhotonMapRun, PhotonReport};
+pub use photon_map::{MapEstimate, PhotonMapRun, PhotonReport};
+pub use photon_options::{PhotonMapOptions, WithCausticMap, WithPhotons};
 pub use plan::PassPlan;
 pub use radiance_estimate::{
     EstimateMode, EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate,

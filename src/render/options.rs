@@ -7,7 +7,7 @@ use crate::scene::Scene;
 
 use super::differentials::DifferentialsOptions;
 use super::igi::IgiOptions;
-use super::photon_map::PhotonMapOptions;
+use super::photon_options::{PhotonMapOptions, WithCausticMap, WithPhotons};
 use super::radiance_estimate::EstimateOptions;
 use super::radiosity::RadiosityOptions;
 use super::sppm::options::SppmOptions;
@@ -48,48 +48,6 @@ pub enum Method {
     /// Stochastic progressive photon mapping: iterations of eye paths and
     /// photons, each pixel's radius shrinking; converges to the exact image.
     Sppm(WithPhotons<SppmOptions>),
-}
-
-/// A method's own options beside those of the caustic photon map it
-/// visualises at the first hits.
-#[derive(Clone, Debug, Default)]
-pub struct WithCausticMap<T> {
-    pub photons: PhotonConfig,
-    pub estimate: EstimateOptions,
-    pub method: T,
-}
-
-/// A method's own options beside those of the photons it traces.
-#[derive(Clone, Debug, Default)]
-pub struct WithPhotons<T> {
-    pub photons: PhotonConfig,
-    pub method: T,
-}
-
-impl<T> WithPhotons<T> {
-    /// The photon map's photons for `method`.
-    pub fn from_map(map: PhotonMapOptions, method: T) -> Self {
-        Self {
-            photons: map.photons,
-            method,
-        }
-    }
-}
-
-impl<T> WithCausticMap<T> {
-    /// The photon map's photons and estimate as `method`'s caustic map.
-    pub fn from_map(map: PhotonMapOptions, method: T) -> Self {
-        Self {
-            photons: map.photons,
-            estimate: map.estimate,
-            method,
-        }
-    }
-
-    /// The estimate's options as the photon config constrains them.
-    pub fn estimate_options(&self) -> EstimateOptions {
-        self.estimate.under(&self.photons)
-    }
 }
 
 impl Method {

@@ -16,28 +16,9 @@ use super::adaptive::{self, Adaptive, AdaptiveOptions, AdaptiveStats};
 use super::direct::DirectLight;
 use super::final_gather::{self, FinalGather, FinalGatherOptions, GatherStats};
 use super::observer::{At, EstimatePass, Progress, RenderObserver};
+use super::photon_options::{PhotonMapOptions, WithCausticMap};
 use super::radiance_estimate::{EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate};
-use super::sample::{FrameMethod, SampleFrame};
-
-/// The paper's photon map and its section 4.5 options.
-#[derive(Clone, Debug, Default)]
-pub struct PhotonMapOptions {
-    pub photons: PhotonConfig,
-    pub estimate: EstimateOptions,
-    /// Final gather: a caustic map at the first hits and a global map at the
-    /// gather rays' hits, instead of the one map visualised directly.
-    pub final_gather: Option<FinalGatherOptions>,
-    /// Adaptive sampling: global light computed on a pyramid of pixel
-    /// lattices and interpolated where it is smooth.
-    pub adaptive: Option<AdaptiveOptions>,
-}
-
-impl PhotonMapOptions {
-    /// The estimate's options as the photon config constrains them.
-    pub fn estimate_options(&self) -> EstimateOptions {
-        self.estimate.under(&self.photons)
-    }
-}
+use super::sample::{FrameMethod, Prepare, SampleFrame};
 
 /// The photon stage's report: `BuiltMap` without its map.
 #[derive(Clone, Debug)]
@@ -93,22 +74,28 @@ impl MapEstimate {
     /// A caustic map (IGI's and radiosity's): the paths from an emitter
     /// through mirrors or glass onto a diffuse surface, which their own
     /// diffuse light cannot carry; none in a scene with nothing specular.
-    pub fn caustics(
-        gpu: &Gpu,
-        f: (&Scene, &SceneTextures),
-        (photons, estimate): (&PhotonConfig, &EstimateOptions),
-        (w, h, seed): (u32, u32, u32),
+    pub fn caustics<T>(
+        p: &Prepare<'_>,
+        o: &WithCausticMap<T>,
         timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
     ) -> Result<Option<Self>> {
-        let (scene, textures) = f;
-        if !scene.has_specular() {
+        observer.progress(&Progress::stage("photons", 0, 1));
+        if !p.scene.has_specular() {
             return Ok(None);
         }
-        let mut caustic = scene.clone();
+        let mut caustic = p.scene.clone();
         caustic.photon_map.caustics_only = true;
         caustic.photon_map.store_direct = false;
-        let built = photon::build_map(gpu, &caustic, textures, photons, seed, timings)?;
-        Ok(Some(Self::new(gpu, (w, h), built, photons, estimate)?))
+        let built = photon::build_map(p.gpu, &caustic, p.textures, &o.photons, p.seed, timings)?;
+        let size = (p.width, p.height);
+        Ok(Some(Self::new(
+            p.gpu,
+            size,
+            built,
+            &o.photons,
+            &o.estimate,
+        )?))
     }
 
     /// The estimate at `queries`, its image read back unless `packed`.
@@ -178,14 +165,13 @@ pub struct PhotonMapRun {
 impl PhotonMapRun {
     /// Traces the photons and builds the map (or final gather's two).
     pub fn prepare(
-        gpu: &Gpu,
-        f: (&Scene, &SceneTextures),
+        p: &Prepare<'_>,
         o: &PhotonMapOptions,
-        (w, h, seed): (u32, u32, u32),
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let (scene, textures) = f;
+        let (gpu, scene, textures, seed) = (p.gpu, p.scene, p.textures, p.seed);
+        let (w, h) = (p.width, p.height);
         observer.progress(&Progress::stage("photons", 0, 1));
         let (first, gather) = match &o.final_gather {
             None => {

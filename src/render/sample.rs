@@ -3,7 +3,7 @@
 //! constructor: photons, VPLs, elements), then asked for each eye sample's
 //! image at that sample's first hits.
 
-use crate::gpu::Result;
+use crate::gpu::{Gpu, Result};
 use crate::image::Image;
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
@@ -11,6 +11,18 @@ use crate::timing::Timings;
 
 use super::direct::DirectLight;
 use super::observer::{At, RenderObserver};
+
+/// What a method is prepared with: the GPU, the scene and its textures,
+/// the image's size and the render's seed.
+#[derive(Clone, Copy)]
+pub struct Prepare<'a> {
+    pub gpu: &'a Gpu,
+    pub scene: &'a Scene,
+    pub textures: &'a SceneTextures,
+    pub width: u32,
+    pub height: u32,
+    pub seed: u32,
+}
 
 /// One eye sample's first hits, ready for the method.
 #[derive(Clone, Copy)]

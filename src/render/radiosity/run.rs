@@ -1,18 +1,15 @@
 //! Radiosity through a render: the caustic map and the solution, made once,
 //! then each eye sample's lookup at its first hits.
 
-use crate::gpu::{Gpu, Result};
+use crate::gpu::Result;
 use crate::image::Image;
-use crate::photon::PhotonConfig;
-use crate::scene::pack::SceneTextures;
-use crate::scene::Scene;
 use crate::timing::Timings;
 
 use super::{Radiosity, RadiosityOptions, RadiosityReport};
 use crate::render::observer::{Progress, RenderObserver};
 use crate::render::photon_map::MapEstimate;
-use crate::render::radiance_estimate::EstimateOptions;
-use crate::render::sample::{FrameMethod, SampleFrame};
+use crate::render::photon_options::WithCausticMap;
+use crate::render::sample::{FrameMethod, Prepare, SampleFrame};
 
 /// The caustic map, the solution's atlas and passes, and its report.
 pub struct RadiosityRun {
@@ -24,18 +21,14 @@ pub struct RadiosityRun {
 impl RadiosityRun {
     /// The caustic map, then the solution to convergence or its shot limit.
     pub fn prepare(
-        gpu: &Gpu,
-        f: (&Scene, &SceneTextures),
-        (photons, estimate, o): (&PhotonConfig, &EstimateOptions, &RadiosityOptions),
-        (w, h, seed): (u32, u32, u32),
+        p: &Prepare<'_>,
+        with: &WithCausticMap<RadiosityOptions>,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let (scene, textures) = f;
-        observer.progress(&Progress::stage("photons", 0, 1));
-        let caustics = MapEstimate::caustics(gpu, f, (photons, estimate), (w, h, seed), timings)?;
-        let mut radiosity = Radiosity::new(gpu, scene, w, h, o)?;
-        let report = radiosity.solve(scene, textures, timings, &mut |_shot, unshot| {
+        let caustics = MapEstimate::caustics(p, with, timings, observer)?;
+        let mut radiosity = Radiosity::new(p.gpu, p.scene, p.width, p.height, &with.method)?;
+        let report = radiosity.solve(p.scene, p.textures, timings, &mut |_shot, unshot| {
             observer.progress(&Progress::stage(
                 "radiosity",
                 ((1.0 - unshot) * 1000.0) as u64,
