@@ -4,8 +4,8 @@
 //!
 //! Dependencies run one way: render -> photon -> scene -> gpu, and every one
 //! of them may use the leaf modules (error, layout, random, sampling, timing,
-//! image). `stress` sits above render. `reference` holds the plain-Rust twins
-//! of the kernels; only tests import it.
+//! image). `stress` sits above render. `twins` holds the plain-Rust twins of
+//! the kernels, built only for tests (the `twins` feature).
 #![deny(unsafe_code)]
 
 pub mod error;
@@ -17,12 +17,16 @@ pub mod metrics;
 pub mod photon;
 pub mod provenance;
 pub mod random;
-pub mod reference;
 pub mod regress;
 pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod stress;
 pub mod timing;
+/// Plain-Rust twins of the GPU kernels, compiled only with the `twins`
+/// feature, which the package's own tests enable (a dev-dependency on itself),
+/// so production code cannot name them.
+#[cfg(feature = "twins")]
+pub mod twins;
 
 pub use error::{Error, Result};

@@ -6,13 +6,13 @@ mod common;
 
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, PhotonConfig};
-use photonmap::reference::adaptive::{adaptive_light, FirstHits};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::{
     render, AdaptiveOptions, EstimateOptions, FinalGatherOptions, Image, Method, PhotonMapOptions,
     RenderOptions, RenderOutput,
 };
 use photonmap::scene::load_scene_str;
+use photonmap::twins::adaptive::{adaptive_light, FirstHits};
 
 fn options(w: u32, h: u32, gather: bool, adaptive: bool, build: BuildMethod) -> RenderOptions {
     let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
@@ -125,9 +125,9 @@ fn adaptive_final_gather_on_stencil_routing_equals_its_cpu_twin() {
 /// twin's fill of those pixels on the GPU's plan.
 #[test]
 fn adaptive_sppm_computes_what_full_sppm_does_and_fills_as_its_twin() {
-    use photonmap::reference::adaptive::{adaptive_pyramid, fill_planned};
     use photonmap::render::sppm::{Sppm, SppmOptions};
     use photonmap::timing::Timings;
+    use photonmap::twins::adaptive::{adaptive_pyramid, fill_planned};
     let gpu = common::gpu();
     let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
     let (w, h, pilot, iterations) = (48u32, 40u32, 2u32, 6u32);

@@ -10,12 +10,12 @@ use common::Rng;
 use glam::{DVec3, Vec3};
 use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};
 use photonmap::photon::trace::PhotonTracer;
-use photonmap::reference::bvh as twin;
-use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
 use photonmap::scene::bvh::{self, FlatBvh};
 use photonmap::scene::generate::{displaced_sphere, IndexedMesh};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
+use photonmap::twins::bvh as twin;
+use photonmap::twins::intersect::{boundary_margin, intersect_geometry};
 
 /// Runs glsl/test/intersect_twin.frag in `mode` (2: closest hit, w = the
 /// primitive; 3: occluded up to the direction's w) over the scene's BVH.

@@ -10,13 +10,13 @@ mod common;
 
 use glam::{Vec3, Vec4};
 use photonmap::photon::differentials::light_measures;
-use photonmap::reference::differentials::{self as twin, Footprint};
-use photonmap::reference::photon::PhotonRecord;
 use photonmap::render::{
     render, DifferentialsOptions, DifferentialsRun, Kernel, Method, RenderOptions, RenderOutput,
     WithPhotons,
 };
 use photonmap::scene::{load_scene_str, Material, Scene};
+use photonmap::twins::differentials::{self as twin, Footprint};
+use photonmap::twins::photon::PhotonRecord;
 
 fn scene(text: &str) -> Scene {
     load_scene_str(text, std::path::Path::new("d.toml")).unwrap()

@@ -6,13 +6,13 @@ mod common;
 
 use glam::Vec3;
 use photonmap::photon::PhotonConfig;
-use photonmap::reference::final_gather::{gather_ray, gathered_radiance, GatherHit};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::{
     render, EstimateOptions, FinalGatherOptions, Method, PhotonMapOptions, RenderOptions,
 };
 use photonmap::scene::{load_scene_str, Material, Scene};
+use photonmap::twins::final_gather::{gather_ray, gathered_radiance, GatherHit};
 
 fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);

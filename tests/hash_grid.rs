@@ -10,11 +10,11 @@ use photonmap::photon::{
     hash_bucket, BuildMethod, Grid, GridKind, GridStorage, PhotonConfig, PhotonMap, StencilRouting,
     VertexFeed,
 };
-use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
-use photonmap::reference::photon::route_hashed;
 use photonmap::render::{render, Method, PhotonMapOptions, RenderOptions, RenderOutput};
 use photonmap::scene::Scene;
 use photonmap::timing::Timings;
+use photonmap::twins::knn::{knn_grid, CpuPhotonMap};
+use photonmap::twins::photon::route_hashed;
 
 fn render_with(
     scene: &Scene,

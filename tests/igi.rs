@@ -7,9 +7,9 @@
 mod common;
 
 use glam::Vec3;
-use photonmap::reference::igi::{incident, Vpl};
 use photonmap::render::{render, IgiOptions, Method, RenderOptions, RenderOutput, WithCausticMap};
 use photonmap::scene::{load_scene_str, Material, Scene};
+use photonmap::twins::igi::{incident, Vpl};
 
 fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
@@ -337,7 +337,7 @@ fn igi_converges_to_the_path_tracer_as_vpls_grow() {
         std::path::Path::new("two_light_box.toml"),
     )
     .unwrap();
-    let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
+    let pt = photonmap::twins::path_trace::path_trace(&scene, 32, 32, 1024, 11);
     let mut chi = Vec::new();
     for paths in [64u32, 4096] {
         let runs: Vec<photonmap::render::Image> = [1u32, 2]

@@ -7,9 +7,9 @@ use common::Rng;
 
 use glam::{DVec3, Vec3};
 use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};
-use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
+use photonmap::twins::intersect::{boundary_margin, intersect_geometry};
 
 fn one_shape_scene(g: Geometry) -> Scene {
     let light_at = match g {

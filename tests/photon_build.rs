@@ -11,8 +11,8 @@ use photonmap::photon::bitonic::{
     fused_plan, pass_count, sort_texture_size, BitonicBuild, INVALID_KEY,
 };
 use photonmap::photon::{Grid, GridStorage, StencilRouting, VertexFeed};
-use photonmap::reference::photon::route;
 use photonmap::render::Timings;
+use photonmap::twins::photon::route;
 
 /// Sorts on the GPU in RG32I (what the build uses) or RGBA32I.
 fn sort_on_gpu(

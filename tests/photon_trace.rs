@@ -5,9 +5,9 @@ mod common;
 
 use glam::{Vec3, Vec4};
 use photonmap::photon::{PhotonTracer, RandomSource, TraceConfig};
-use photonmap::reference::photon::{trace_photons, PhotonRecord};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{load_scene_str, Scene};
+use photonmap::twins::photon::{trace_photons, PhotonRecord};
 
 fn records(frames: &photonmap::photon::PhotonFrames) -> Vec<PhotonRecord> {
     let (p, w, i, o) = (
@@ -347,9 +347,9 @@ fn bounces_stop_when_no_photon_is_left_and_the_image_does_not_change() {
 fn projection_maps_keep_every_direction_that_reaches_a_specular_shape() {
     use photonmap::photon::projection::emission_direction;
     use photonmap::photon::ProjectionMaps;
-    use photonmap::reference::intersect::intersect_geometry;
-    use photonmap::reference::random::{rng_init, rng_next};
     use photonmap::scene::Light;
+    use photonmap::twins::intersect::intersect_geometry;
+    use photonmap::twins::random::{rng_init, rng_next};
     for name in ["glass_ball", "ring", "cornell_box"] {
         let mut scene = common::paper_scene(name);
         scene.photon_map.caustics_only = true;

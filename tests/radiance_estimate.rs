@@ -5,11 +5,11 @@ mod common;
 
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, Grid, PhotonConfig, PhotonFrames, PhotonMap};
-use photonmap::reference::knn::{knn_grid, CpuPhotonMap};
 use photonmap::render::{
     render, EstimateMode, Method, PhotonMapOptions, RenderOptions, RenderOutput,
 };
 use photonmap::scene::Scene;
+use photonmap::twins::knn::{knn_grid, CpuPhotonMap};
 
 fn render_gi(
     scene: &Scene,
@@ -259,7 +259,7 @@ intensity = [0.0, 0.0, 0.0]
     let n = 40_000usize;
     let total_power = 8.0f32;
     let mut state = 12345u32;
-    let mut next = || photonmap::reference::random::rng_next(&mut state);
+    let mut next = || photonmap::twins::random::rng_next(&mut state);
     let width = 256u32;
     let frame_height = (n as u32).div_ceil(width);
     let texels = (width * frame_height) as usize;
@@ -331,7 +331,7 @@ intensity = [0.0, 0.0, 0.0]
 
 #[test]
 fn the_software_reference_agrees_with_the_gpu() {
-    use photonmap::reference::knn::{software_image, SoftwareEstimate};
+    use photonmap::twins::knn::{software_image, SoftwareEstimate};
     let scene = common::paper_scene("cornell_box");
     let out = render_gi(
         &scene,
@@ -400,8 +400,8 @@ fn faithful_mode_renders_the_same_image() {
 /// run with the same tests, pixel for pixel.
 #[test]
 fn gpu_leak_tests_equal_their_cpu_twins() {
-    use photonmap::reference::knn::{knn_grid_filtered, photon_visible};
     use photonmap::render::radiance_estimate::LeakTest;
+    use photonmap::twins::knn::{knn_grid_filtered, photon_visible};
     let gpu = common::gpu();
     for (name, w, h) in [("ring", 64, 48), ("cornell_box", 48, 48)] {
         let scene = common::paper_scene(name);
@@ -456,7 +456,7 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
 /// photons its CPU twin does, and the others examine fewer.
 #[test]
 fn culled_searches_end_in_the_paper_search_s_state_bit_for_bit() {
-    use photonmap::reference::knn::knn_grid_counted;
+    use photonmap::twins::knn::knn_grid_counted;
     for (name, w, h) in [
         ("glass_ball", 64, 48),
         ("cornell_box", 48, 48),

@@ -18,14 +18,14 @@ mod common;
 
 use glam::{Vec2, Vec3};
 use photonmap::layout::LUMINANCE;
-use photonmap::reference::radiosity::{discontinuities, received, sub_shooters, Shooter};
-use photonmap::reference::ray_trace::closest_hit;
 use photonmap::render::radiosity::{block_outline, onto_surface, FormFactor};
 use photonmap::render::{
     render, Method, RadiosityOptions, RenderOptions, RenderOutput, WithCausticMap,
 };
 use photonmap::sampling::basis_around;
 use photonmap::scene::{load_scene_str, Scene};
+use photonmap::twins::radiosity::{discontinuities, received, sub_shooters, Shooter};
+use photonmap::twins::ray_trace::closest_hit;
 
 /// The shooters moved onto the first shape's surface, as the GPU's are.
 fn on_surface(shooters: Vec<Shooter>, s: &Scene) -> Vec<Shooter> {

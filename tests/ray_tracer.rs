@@ -5,9 +5,9 @@
 mod common;
 
 use glam::Vec3;
-use photonmap::reference::ray_trace::{expected_moments, eye_ray_at};
 use photonmap::render::{render, Image, RenderOptions};
 use photonmap::scene::{load_scene_str, Scene};
+use photonmap::twins::ray_trace::{expected_moments, eye_ray_at};
 
 /// GLASS BALL's geometry under a point light, so direct light is deterministic
 /// and all the randomness left is the reflect-or-refract choice.
@@ -370,8 +370,8 @@ fn direct_renders(scene: &Scene, seeds: std::ops::Range<u32>) -> Vec<Image> {
 /// flips a shadow ray at an edge.
 #[test]
 fn direct_light_from_emissive_triangles_equals_its_twin_sample_for_sample() {
-    use photonmap::reference::ray_trace::direct_light_sampled;
     use photonmap::scene::pack::PackedScene;
+    use photonmap::twins::ray_trace::direct_light_sampled;
     let scene = triangle_lights_scene(1.0);
     let packed = PackedScene::new(&scene);
     let (w, h) = (scene.camera.width, scene.camera.height);
@@ -412,7 +412,7 @@ fn direct_light_from_emissive_triangles_equals_its_twin_sample_for_sample() {
 /// seeds' spread says nothing of its error.
 #[test]
 fn direct_light_from_emissive_triangles_converges_to_the_twin_quadrature() {
-    use photonmap::reference::ray_trace::expected_radiance;
+    use photonmap::twins::ray_trace::expected_radiance;
     let (scene, brighter) = (triangle_lights_scene(1.0), triangle_lights_scene(1.1));
     let n = 64;
     let images = direct_renders(&scene, 1..n + 1);

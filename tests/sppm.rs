@@ -6,12 +6,12 @@ mod common;
 
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, PhotonConfig};
-use photonmap::reference::sppm::{update, PixelState, VisiblePoint};
 use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::sppm::{render_sppm, Sppm, SppmOptions};
 use photonmap::render::{Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::{load_scene_str, Material, Scene};
 use photonmap::timing::Timings;
+use photonmap::twins::sppm::{update, PixelState, VisiblePoint};
 
 fn options(scene: &Scene, w: u32, h: u32, seed: u32, build: BuildMethod) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
@@ -88,12 +88,7 @@ fn the_gather_and_update_kernel_equals_its_cpu_twin() {
             };
             let accept = |vp: &VisiblePoint, p: Vec3| {
                 leak == LeakTest::None
-                    || photonmap::reference::knn::photon_visible(
-                        run.scene(),
-                        vp.position,
-                        vp.normal,
-                        p,
-                    )
+                    || photonmap::twins::knn::photon_visible(run.scene(), vp.position, vp.normal, p)
             };
             let cpu = update(
                 &map,
@@ -242,7 +237,7 @@ radiance = [1.0, 1.0, 1.0]
     let mut expected = 0.0;
     for y in 0..32 {
         for x in 0..32 {
-            let (origin, d) = photonmap::reference::ray_trace::eye_ray(&scene, 32, 32, x, y);
+            let (origin, d) = photonmap::twins::ray_trace::eye_ray(&scene, 32, 32, x, y);
             let t = -origin.y / d.y;
             let p = origin + t * d;
             expected += 0.5 * plane_irradiance(p.x as f64, p.z as f64, 10.0, 1.0, 1.0)
@@ -282,7 +277,7 @@ fn sppm_agrees_with_an_independent_path_tracer() {
     )
     .unwrap();
     let t0 = std::time::Instant::now();
-    let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
+    let pt = photonmap::twins::path_trace::path_trace(&scene, 32, 32, 1024, 11);
     let pt_seconds = t0.elapsed().as_secs_f64();
     let o = SppmOptions {
         iterations: 128,

@@ -4,7 +4,9 @@
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::scene::pack::SceneTextures;
 
-use super::{HitBuffers, Image};
+use super::plan::PassPlan;
+use super::ray_trace::HitBuffers;
+use super::Image;
 
 pub struct DirectLight {
     /// Accumulated radiance per pixel (linear RGB).
@@ -60,7 +62,7 @@ impl DirectLight {
         &self,
         scene: &SceneTextures,
         hits: &HitBuffers,
-        plan: &super::PassPlan,
+        plan: &PassPlan,
         samples: std::ops::Range<u32>,
         depth: u32,
         seed: u32,
@@ -86,8 +88,8 @@ impl DirectLight {
     }
 
     /// The first diffuse hits, as the radiance estimate's queries.
-    pub fn queries(&self) -> super::radiance_estimate::QueryPoints<'_> {
-        super::radiance_estimate::QueryPoints {
+    pub fn queries(&self) -> QueryPoints<'_> {
+        QueryPoints {
             position: &self.diffuse_position,
             normal: &self.diffuse_normal,
             pixel: None,
@@ -101,4 +103,17 @@ impl DirectLight {
             &self.radiance.read_f32(),
         )
     }
+}
+
+/// The points a search serves: positions (w = 1 where a query exists) and
+/// normals facing the incoming ray (w = material + 1), the same size as the
+/// estimate. An eye sample's first diffuse hits (`DirectLight::queries`), or
+/// final gather's hits.
+#[derive(Clone, Copy)]
+pub struct QueryPoints<'a> {
+    pub position: &'a Texture,
+    pub normal: &'a Texture,
+    /// Packed queries (adaptive sampling): each texel's pixel index (R32I),
+    /// so that what a query draws at random is its pixel's. None: in place.
+    pub pixel: Option<&'a Texture>,
 }

@@ -53,7 +53,14 @@ pub fn trace_eye_paths(
     };
     if plan.fused {
         timed("eye paths (fused)", &|| {
-            tracer.eye_paths_fused(textures, direct, eye.camera, plan, eye.sample, eye.seed)
+            tracer.eye_paths_fused(
+                textures,
+                &direct.target,
+                eye.camera,
+                plan,
+                eye.sample,
+                eye.seed,
+            )
         })?;
         return gpu.check("ray tracing");
     }

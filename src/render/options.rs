@@ -8,6 +8,7 @@ use crate::scene::Scene;
 use super::differentials::DifferentialsOptions;
 use super::igi::IgiOptions;
 use super::photon_options::{PhotonMapOptions, WithCausticMap, WithPhotons};
+use super::plan::FrameSize;
 use super::radiance_estimate::EstimateOptions;
 use super::radiosity::RadiosityOptions;
 use super::sppm::options::SppmOptions;
@@ -125,5 +126,16 @@ impl RenderOptions {
     pub fn with_method(mut self, method: Method) -> Self {
         self.method = method;
         self
+    }
+}
+
+impl From<&RenderOptions> for FrameSize {
+    fn from(o: &RenderOptions) -> Self {
+        FrameSize {
+            width: o.width,
+            height: o.height,
+            spp: o.spp,
+            shadow_batch: o.shadow_batch,
+        }
     }
 }

@@ -4,8 +4,6 @@
 
 use crate::scene::{Light, Scene};
 
-use super::RenderOptions;
-
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassPlan {
     pub width: u32,
@@ -34,11 +32,22 @@ pub struct PassPlan {
     pub fused: bool,
 }
 
+/// What of a render's options the plan depends on.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameSize {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    /// Shadow samples per area light a pass (0: chosen by image size).
+    pub shadow_batch: u32,
+}
+
 /// Shadow rays one pass draws at most, when the batch is chosen by image size.
 pub const SHADOW_RAYS_PER_PASS: u64 = 1 << 23;
 
 impl PassPlan {
-    pub fn new(scene: &Scene, options: &RenderOptions) -> Self {
+    pub fn new(scene: &Scene, frame: impl Into<FrameSize>) -> Self {
+        let options = frame.into();
         let specular = scene.has_specular();
         let has_area = scene
             .lights

@@ -7,6 +7,7 @@ use crate::gpu::{Bindings, DrawState, Gpu, Program, Query, Result, Target, TexFo
 use crate::photon::PhotonMap;
 use crate::scene::pack::SceneTextures;
 
+pub use super::direct::QueryPoints;
 use super::search_work::{LaneUse, SearchWork};
 use super::{DirectLight, Image};
 
@@ -125,19 +126,6 @@ pub struct EstimateStats {
     pub wall_seconds: f64,
     /// Steps, photons examined and cells opened (and lane use, if profiled).
     pub work: SearchWork,
-}
-
-/// The points a search serves: positions (w = 1 where a query exists) and
-/// normals facing the incoming ray (w = material + 1), the same size as the
-/// estimate. An eye sample's first diffuse hits (`DirectLight::queries`), or
-/// final gather's hits.
-#[derive(Clone, Copy)]
-pub struct QueryPoints<'a> {
-    pub position: &'a Texture,
-    pub normal: &'a Texture,
-    /// Packed queries (adaptive sampling): each texel's pixel index (R32I),
-    /// so that what a query draws at random is its pixel's. None: in place.
-    pub pixel: Option<&'a Texture>,
 }
 
 /// Seen after every pass: for progress and snapshots.

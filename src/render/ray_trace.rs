@@ -6,7 +6,7 @@ use crate::gpu::{Bindings, DrawState, Gpu, Program, Result, Target, TexFormat, T
 use crate::scene::pack::SceneTextures;
 use crate::scene::Camera;
 
-use super::{DirectLight, PassPlan};
+use super::plan::PassPlan;
 
 /// Per-pixel rays: origin (w = active), unit direction, throughput.
 pub struct RayBuffers {
@@ -107,13 +107,13 @@ impl RayTracer {
         })
     }
 
-    /// Every pixel's whole eye path in one pass, into `direct`'s radiance and
-    /// first-diffuse-hit records: what `eye_rays`, then per depth
+    /// Every pixel's whole eye path in one pass, into `direct` (a
+    /// `DirectLight`'s target: radiance and first-diffuse-hit records): what `eye_rays`, then per depth
     /// `intersect`, `DirectLight::shade` and `specular`, compute.
     pub fn eye_paths_fused(
         &self,
         scene: &SceneTextures,
-        direct: &DirectLight,
+        direct: &Target,
         camera: &Camera,
         plan: &PassPlan,
         sample: u32,
@@ -128,7 +128,7 @@ impl RayTracer {
             .int("u_shadow_rays", plan.shadow_rays as i32)
             .int("u_strata_x", nx as i32)
             .int("u_light_sampling", plan.light_sampling as i32)
-            .draw_fullscreen(&direct.target, &DrawState::PLAIN)
+            .draw_fullscreen(direct, &DrawState::PLAIN)
     }
 
     /// One ray per pixel: through its centre with one sample per pixel (the

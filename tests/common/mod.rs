@@ -385,7 +385,7 @@ radiance = [6.0, 6.0, 6.0]
 /// expectation) and the tracer's own variance. Returns (blocks, chi^2/n,
 /// largest relative difference).
 pub fn blocks_against_path_tracer(
-    pt: &photonmap::reference::path_trace::PathTraced,
+    pt: &photonmap::twins::path_trace::PathTraced,
     runs: [&photonmap::render::Image; 2],
 ) -> (usize, f64, f64) {
     let block = |f: &dyn Fn(usize) -> f64, bx: usize, by: usize| {

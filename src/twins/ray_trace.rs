@@ -10,9 +10,9 @@ use crate::scene::{triangle_area, Geometry, Light, Material, Scene, Shape};
 use crate::scene::pack::PackedScene;
 
 use super::intersect::intersect_geometry;
-use super::photon::sample_light_triangle;
+use super::light::sample_light_triangle;
 use super::random::{rng_init, rng_next};
-use super::shading::{facing_shading_normal, specular_about};
+use super::shading::{facing_shading_normal, fresnel_dielectric, specular_about};
 
 /// Closest hit: (shape index, t, point, geometric normal).
 pub fn closest_hit(scene: &Scene, o: Vec3, d: Vec3) -> Option<(usize, f32, Vec3, Vec3)> {
@@ -71,18 +71,6 @@ pub fn occluded(scene: &Scene, o: Vec3, d: Vec3, t_max: f32) -> bool {
         .shapes
         .iter()
         .any(|s| intersect_geometry(&s.geometry, o, d).is_some_and(|h| h.0 < t_max))
-}
-
-/// Fresnel reflectance (glsl/common/fresnel.glsl) and the transmitted cosine.
-pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> (f32, f32) {
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
-    if sin2_t >= 1.0 {
-        return (1.0, 0.0);
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    (0.5 * (rs * rs + rp * rp), cos_t)
 }
 
 /// Expected radiance along a ray: direct light (area lights by a `grid` x `grid`
@@ -306,7 +294,7 @@ pub fn eye_ray_at(scene: &Scene, width: u32, height: u32, fx: f32, fy: f32) -> (
 /// the radiance the pass adds over all `shadow_rays` samples per area light
 /// (path throughput 1). Area lights are the parallelogram's stratified
 /// point, or a `Triangles` light's triangle picked by area and a uniform
-/// point in it (`photon::sample_light_triangle`, the twin of the shader's).
+/// point in it (`light::sample_light_triangle`, the twin of the shader's).
 pub fn direct_light_sampled(
     scene: &Scene,
     packed: &PackedScene,

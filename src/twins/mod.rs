@@ -1,4 +1,5 @@
-//! Plain-Rust twins of the GPU kernels, for tests and the paper's software column.
+//! Plain-Rust twins of the GPU kernels, which tests compare each kernel with;
+//! compiled only with the `twins` feature (the package's own tests enable it).
 
 pub mod adaptive;
 pub mod bvh;
@@ -7,6 +8,7 @@ pub mod final_gather;
 pub mod igi;
 pub mod intersect;
 pub mod knn;
+pub mod light;
 pub mod path_trace;
 pub mod photon;
 pub mod radiosity;

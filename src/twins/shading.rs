@@ -6,8 +6,6 @@ use glam::Vec3;
 
 use crate::scene::{Geometry, Shape};
 
-use super::ray_trace::fresnel_dielectric;
-
 /// The shading normal at p of `shape`, whose unit geometric normal is n:
 /// its vertex normals interpolated by p's barycentric weights, on n's side;
 /// n without vertex normals, or where the interpolation points the other way.
@@ -44,6 +42,18 @@ pub fn facing_shading_normal(shape: &Shape, p: Vec3, n: Vec3, d: Vec3) -> Vec3 {
     } else {
         -s
     }
+}
+
+/// Fresnel reflectance (glsl/common/fresnel.glsl) and the transmitted cosine.
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> (f32, f32) {
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    if sin2_t >= 1.0 {
+        return (1.0, 0.0);
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    (0.5 * (rs * rs + rp * rp), cos_t)
 }
 
 fn reflect(d: Vec3, n: Vec3) -> Vec3 {

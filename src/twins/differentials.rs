@@ -12,8 +12,7 @@ use crate::scene::pack::PackedScene;
 use crate::scene::{Geometry, Light, Material, Scene};
 
 use super::photon::{basis_around, primitive_normal, PhotonRecord};
-use super::ray_trace::fresnel_dielectric;
-use super::shading::{shading_normal, specular_shaded};
+use super::shading::{fresnel_dielectric, shading_normal, specular_shaded};
 
 /// Two positional and two directional differentials (units of Delta).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -9,6 +9,7 @@ use crate::scene::pack::PackedScene;
 use crate::scene::{Material, Scene};
 
 use super::intersect::intersect_geometry;
+use super::light::sample_light_triangle;
 use super::random::{rng_init, rng_next};
 use super::ray_trace::{closest_hit, offset_scale};
 use super::shading::{
@@ -137,42 +138,6 @@ pub fn emit(
         incoming: Vec4::new(0.0, 0.0, 0.0, 1.0),
         outgoing: d.extend(leaving),
     }
-}
-
-/// glsl/common/scene.glsl `sample_light_triangle`: a point of the
-/// LIGHT_TRIANGLES light l uniform over its area (u1 picks the triangle by
-/// area and is reused within it), its triangle's unit normal, its primitive.
-pub fn sample_light_triangle(
-    packed: &PackedScene,
-    l: usize,
-    u1: f32,
-    u2: f32,
-) -> (Vec3, Vec3, usize) {
-    let range = Vec4::from(packed.lights[l * 6 + 1]);
-    let first = range.x as usize;
-    let cdf = |k: usize| packed.light_triangles[first + k][0];
-    let (mut lo, mut hi) = (0i32, range.y as i32 - 1);
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        if u1 < cdf(mid as usize) {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    let k = lo as usize;
-    let below = if k > 0 { cdf(k - 1) } else { 0.0 };
-    let u = ((u1 - below) / (cdf(k) - below)).clamp(0.0, 1.0);
-    let prim = packed.light_triangles[first + k][1] as usize;
-    let vertex = |i: usize| Vec4::from(packed.primitives[prim * 4 + i]).truncate();
-    let (a, b, c) = (vertex(1), vertex(2), vertex(3));
-    let normal = (b - a).cross(c - a).normalize();
-    let s = u.sqrt();
-    (
-        (1.0 - s) * a + (u2 * s) * b + (s - u2 * s) * c,
-        normal,
-        prim,
-    )
 }
 
 /// glsl/photon/bounce.glsl: bounce `bounce` of a photon whose last record is `last`.
