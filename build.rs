@@ -26,7 +26,10 @@ fn collect(dir: &Path, root: &Path, extensions: &[&str], out: &mut Vec<PathBuf>)
 }
 
 fn table(name: &str, folder: &str, extensions: &[&str]) -> String {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
+    // The package's folder as this run is given it: `env!` would bake in the
+    // folder the build script was compiled in, which a copied target/ keeps.
+    let manifest_dir = std::env::var("CARGO_MANIFEST_DIR").unwrap();
+    let root = Path::new(&manifest_dir).join(folder);
     println!("cargo:rerun-if-changed={folder}");
     let mut files = Vec::new();
     collect(&root, &root, extensions, &mut files);
