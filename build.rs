@@ -2,7 +2,9 @@
 //! the binary as (path, source) pairs: a shader or scene added to its folder
 //! is compiled in, and into the tests that check them all, with no list to
 //! keep by hand. The embedded scenes let the installed binary render the paper
-//! scenes by name and run the stress suite from any folder.
+//! scenes by name and run the stress suite from any folder; the test scenes
+//! of scenes/tests/ are embedded the same way (`scene::embedded` keeps them
+//! out of the listing).
 use std::path::{Path, PathBuf};
 
 fn collect(dir: &Path, root: &Path, extensions: &[&str], out: &mut Vec<PathBuf>) {

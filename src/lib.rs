@@ -26,3 +26,8 @@ pub mod stress;
 pub mod timing;
 
 pub use error::{Error, Result};
+
+// The fuzz harness (tests/fuzz/harness.rs), shared with the cargo-fuzz crate,
+// names this library `photonmap`; the loader's unit tests include it.
+#[cfg(test)]
+extern crate self as photonmap;

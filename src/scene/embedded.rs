@@ -1,6 +1,9 @@
 //! The scenes of scenes/, compiled into the binary: `photonmap render ring`
 //! renders a paper scene by name from any folder, `photonmap scenes` lists
 //! them, and the stress suite and `tables` never look for the source tree.
+//! The test scenes of scenes/tests/ are compiled in too and load by name
+//! (`tests/furnace` or `tests/furnace.toml`), but are not listed: they are
+//! fixtures of the tests and the stress suite, not scenes to render.
 
 use std::path::Path;
 
@@ -11,13 +14,18 @@ include!(concat!(env!("OUT_DIR"), "/scene_sources.rs"));
 /// The three scenes of the paper, by the names they are embedded under.
 pub const PAPER_SCENES: [&str; 3] = ["glass_ball", "ring", "cornell_box"];
 
+/// The folder under scenes/ whose scenes are the tests' (`tests/<name>`).
+const TEST_SCENES: &str = "tests/";
+
 /// Names of the embedded scenes (paths under scenes/ without `.toml`), in
-/// order: `glass_ball`, `variants/furnace_64_bounces`, ...
+/// order: `glass_ball`, `variants/furnace_64_bounces`, ...; not the test
+/// scenes of scenes/tests/.
 pub fn names() -> impl Iterator<Item = &'static str> {
     SCENE_SOURCES
         .iter()
         // Camera paths live beside the scenes but are not scenes.
         .filter(|(path, text)| path.ends_with(".toml") && text.contains("[camera]"))
+        .filter(|(path, _)| !path.starts_with(TEST_SCENES))
         .map(|(path, _)| path.trim_end_matches(".toml"))
 }
 
@@ -101,4 +109,23 @@ pub fn load_with_overrides(
     let (text, path) = text_for(arg)?;
     let scene = super::load_scene_str_with_overrides(&text, &path, overrides)?;
     Ok((scene, text))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn test_scenes_load_by_name_but_are_not_listed() {
+        let fixture = "tests/one_sphere";
+        assert!(source(fixture).is_some());
+        assert_eq!(source("tests/one_sphere.toml"), source(fixture));
+        assert_eq!(load(fixture).unwrap().name, "t");
+        let listed: Vec<&str> = names().collect();
+        assert!(
+            listed.iter().all(|n| !n.starts_with(TEST_SCENES)),
+            "{listed:?}"
+        );
+        assert!(listed.contains(&"glass_ball"), "{listed:?}");
+    }
 }

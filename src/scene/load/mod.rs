@@ -51,6 +51,8 @@ mod mesh;
 mod overrides;
 mod sections;
 mod table;
+#[cfg(test)]
+mod tests;
 
 pub use crate::error::SceneError;
 pub(super) use context::line_of;
