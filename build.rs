@@ -2,7 +2,9 @@
 //! the binary as (path, source) pairs: a shader or scene added to its folder
 //! is compiled in, and into the tests that check them all, with no list to
 //! keep by hand. The embedded scenes let the installed binary render the paper
-//! scenes by name and run the stress suite from any folder.
+//! scenes by name and run the stress suite from any folder; the test scenes
+//! of scenes/tests/ are embedded the same way (`scene::embedded` keeps them
+//! out of the listing).
 use std::path::{Path, PathBuf};
 
 fn collect(dir: &Path, root: &Path, extensions: &[&str], out: &mut Vec<PathBuf>) {
@@ -26,7 +28,10 @@ fn collect(dir: &Path, root: &Path, extensions: &[&str], out: &mut Vec<PathBuf>)
 }
 
 fn table(name: &str, folder: &str, extensions: &[&str]) -> String {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
+    // The package's folder as this run is given it: `env!` would bake in the
+    // folder the build script was compiled in, which a copied target/ keeps.
+    let manifest_dir = std::env::var("CARGO_MANIFEST_DIR").unwrap();
+    let root = Path::new(&manifest_dir).join(folder);
     println!("cargo:rerun-if-changed={folder}");
     let mut files = Vec::new();
     collect(&root, &root, extensions, &mut files);

@@ -30,3 +30,8 @@ pub mod timing;
 pub mod twins;
 
 pub use error::{Error, Result};
+
+// The fuzz harness (tests/fuzz/harness.rs), shared with the cargo-fuzz crate,
+// names this library `photonmap`; the loader's unit tests include it.
+#[cfg(test)]
+extern crate self as photonmap;

@@ -1,9 +1,10 @@
 //! What the fuzz targets for `--set` overrides, camera paths and OBJ + MTL do
 //! with their bytes, shared by the cargo-fuzz targets (tests/fuzz/fuzz_targets/)
-//! and by tests/fuzz_loading.rs, which replays their corpora and mutates their
-//! seeds on every `cargo test`. Each loads its input the way the program does
-//! and returns whether it was accepted (None: not a valid input at all, such
-//! as bytes that are not UTF-8); an error is fine, a panic is the bug.
+//! and by the loader's unit tests (src/scene/load/tests/fuzz.rs), which replay
+//! their corpora and mutate their seeds on every `cargo test`. Each loads its
+//! input the way the program does and returns whether it was accepted (None:
+//! not a valid input at all, such as bytes that are not UTF-8); an error is
+//! fine, a panic is the bug.
 
 #![allow(dead_code)]
 

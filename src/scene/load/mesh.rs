@@ -20,8 +20,19 @@ use glam::Vec3;
 
 use super::super::defaults::{DEFAULT_MESH_SCALE, DEFAULT_MESH_TRANSLATE};
 use super::super::obj::{self, ObjMesh, ObjTriangle};
-use super::{Coord, Model, SceneError, Table};
+use super::super::rebase::Coord;
+use super::table::Table;
+use crate::error::SceneError;
 use crate::scene::{Geometry, Light, Material, Shape};
+
+/// What the shapes add to as they are read: meshes bring materials (their
+/// MTL files') and lights (their emissive triangles).
+pub(super) struct Model {
+    pub(super) materials: Vec<Material>,
+    pub(super) names: BTreeMap<String, usize>,
+    pub(super) shapes: Vec<Shape>,
+    pub(super) lights: Vec<Light>,
+}
 
 /// Reads the mesh shape `t` into `model`.
 pub(super) fn read_mesh(t: &Table, model: &mut Model) -> Result<(), SceneError> {

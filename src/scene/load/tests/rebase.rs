@@ -4,15 +4,21 @@
 //! the camera at the local origin; camera paths follow their scene; the
 //! limit on coordinates holds for the moved values. No GPU needed.
 
-mod common;
-
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use photonmap::scene::camera_path::load_camera_path;
-use photonmap::scene::{
+
+use super::fixture;
+use crate::scene::camera_path::load_camera_path;
+use crate::scene::{
     embedded, load_scene_str, load_scene_str_translated, Geometry, Light, Rebase, Scene,
 };
+use moved_text::moved_scene_text;
+
+/// Scene text moved by editing it, shared with the integration tests.
+#[allow(dead_code)]
+#[path = "../../../../tests/common/moved_text.rs"]
+mod moved_text;
 
 /// Every point of a scene, in order, as the renderer gets them (local, f32).
 fn points(s: &Scene) -> Vec<Vec3> {
@@ -98,7 +104,7 @@ fn every_embedded_scene_moved_far_loads_as_the_original() {
 fn a_file_moved_in_its_text_loads_as_the_translated_one() {
     let text = embedded::source("glass_ball").unwrap();
     let t = DVec3::new(1e6, -1e6, 1e6);
-    let (moved_text, n) = common::moved_scene_text(text, t);
+    let (moved_text, n) = moved_scene_text(text, t);
     assert_eq!(n, 7);
     let edited = load_scene_str(&moved_text, Path::new("moved.toml")).unwrap();
     let translated =
@@ -125,11 +131,11 @@ fn rebasing_to_the_camera_puts_it_at_the_local_origin() {
 
 #[test]
 fn a_camera_path_follows_its_scene() {
-    let d = std::env::temp_dir().join(format!("photonmap-rebase-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let temp = tempfile::tempdir().unwrap();
+    let d = temp.path();
     let path = "frames = 3\n[[key]]\nposition = [0.0, 2.0, 5.5]\nlook_at = [0.0, 0.6, 0.0]\n[[key]]\nposition = [3.0, 1.5, 3.0]\nlook_at = [0.0, 0.4, 0.0]\n";
     let t = DVec3::new(1e6, -1e6, 1e6);
-    let (moved_path, n) = common::moved_scene_text(path, t);
+    let (moved_path, n) = moved_scene_text(path, t);
     assert_eq!(n, 4);
     std::fs::write(d.join("near.toml"), path).unwrap();
     std::fs::write(d.join("far.toml"), moved_path).unwrap();
@@ -142,19 +148,18 @@ fn a_camera_path_follows_its_scene() {
     for (x, y) in a.iter().zip(&b) {
         assert_eq!((x.position, x.look_at), (y.position, y.look_at));
     }
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn a_mesh_is_placed_in_f64() {
-    let d = std::env::temp_dir().join(format!("photonmap-rebase-mesh-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let temp = tempfile::tempdir().unwrap();
+    let d = temp.path();
     std::fs::write(
         d.join("tri.obj"),
         "v 0.1 0.2 0.3\nv 1.7 0.2 0.3\nv 0.1 1.3 0.9\nf 1 2 3\n",
     )
     .unwrap();
-    let text = "[camera]\nposition = [0.0, 1.0, 4.0]\nlook_at = [0.0, 0.5, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nw = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"tri.obj\"\nscale = 0.7\ntranslate = [0.3, -0.2, 0.1]\nmaterial = \"w\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
+    let text = fixture("placed_mesh");
     let file = d.join("mesh.toml");
     let near = load_scene_str(text, &file).unwrap();
     let t = DVec3::new(1e6, -1e6, 1e6);
@@ -163,7 +168,6 @@ fn a_mesh_is_placed_in_f64() {
     // Placed in f32 at 1e6, the vertices would be off by up to 0.03.
     let ulps = ulps_apart(&far, &near, Vec3::ZERO);
     assert!(ulps <= 1.0, "{ulps} ulps");
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]

@@ -3,12 +3,12 @@
 //! lights, vertex normals, and errors that name the OBJ or MTL file and
 //! line as well as the scene's `file` field.
 
-mod common;
-
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::Vec3;
-use photonmap::scene::{load_scene, Geometry, Light, Material, Scene, SceneError};
+
+use super::paper_scene;
+use crate::scene::{load_scene, Geometry, Light, Material, Scene, SceneError};
 
 /// A scene whose one shape is `mesh.obj` (with `extra` lines in its
 /// [[shape]]), with a point light unless `light` is false.
@@ -29,15 +29,18 @@ fn scene_text(extra: &str, light: bool) -> String {
 /// The line of `file = "mesh.obj"` in `scene_text`.
 const FILE_LINE: usize = 12;
 
-fn tempdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("photonmap-obj-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// Writes the files in a fresh folder and loads the scene.
+fn load(files: &[(&str, &str)], extra: &str, light: bool) -> Result<Scene, SceneError> {
+    load_in(tempfile::tempdir().unwrap().path(), files, extra, light)
 }
 
-/// Writes the files and loads the scene.
-fn load(name: &str, files: &[(&str, &str)], extra: &str, light: bool) -> Result<Scene, SceneError> {
-    let dir = tempdir(name);
+/// Writes the files in `dir` and loads the scene.
+fn load_in(
+    dir: &Path,
+    files: &[(&str, &str)],
+    extra: &str,
+    light: bool,
+) -> Result<Scene, SceneError> {
     for (file, text) in files {
         std::fs::write(dir.join(file), text).unwrap();
     }
@@ -48,25 +51,16 @@ fn load(name: &str, files: &[(&str, &str)], extra: &str, light: bool) -> Result<
 
 /// Expects an error at the scene's `file` field whose message starts with
 /// `<dir>/<file>:<line>:` and contains `says`.
-fn expect_error(
-    name: &str,
-    files: &[(&str, &str)],
-    extra: &str,
-    file: &str,
-    line: usize,
-    says: &str,
-) {
-    let e = load(name, files, extra, true).expect_err("should fail");
+fn expect_error(files: &[(&str, &str)], extra: &str, file: &str, line: usize, says: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let e = load_in(dir.path(), files, extra, true).expect_err("should fail");
     assert_eq!(
         (e.line, e.field.as_str()),
         (FILE_LINE, "shape[0].file"),
         "{e}"
     );
     let kind = if file.ends_with(".mtl") { "MTL" } else { "OBJ" };
-    let at = format!(
-        "{kind} file {}:{line}: ",
-        tempdir(name).join(file).display()
-    );
+    let at = format!("{kind} file {}:{line}: ", dir.path().join(file).display());
     assert!(
         e.message.starts_with(&at),
         "{e}\n(expected it to start with {at})"
@@ -149,7 +143,7 @@ fn material_at(scene: &Scene, y: f32) -> Material {
 #[test]
 fn mtl_materials_map_as_the_readme_says() {
     let obj = every_material_obj();
-    let s = load("map", &[("mesh.obj", &obj), ("m.mtl", MTL)], "", true).unwrap();
+    let s = load(&[("mesh.obj", &obj), ("m.mtl", MTL)], "", true).unwrap();
     let rgb = Vec3::new;
     assert_eq!(
         material_at(&s, 0.0),
@@ -223,9 +217,10 @@ fn mtl_materials_map_as_the_readme_says() {
     // Each MTL material is a scene material named <file>:<name>: another
     // shape can use it by that name.
     let reuse = "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 9.0, 0.0]\nradius = 0.5\nmaterial = \"mesh.obj:glass4\"";
-    let s = load("map_named", &[("mesh.obj", &obj), ("m.mtl", MTL)], "", true).unwrap();
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path();
+    let s = load_in(dir, &[("mesh.obj", &obj), ("m.mtl", MTL)], "", true).unwrap();
     let before = s.materials.len();
-    let dir = tempdir("map_named");
     let text = scene_text("", true) + reuse + "\n";
     std::fs::write(dir.join("scene2.toml"), text).unwrap();
     let s2 = load_scene(&dir.join("scene2.toml")).unwrap();
@@ -246,7 +241,7 @@ fn mtl_materials_map_as_the_readme_says() {
 fn a_material_on_the_shape_overrides_every_mtl_material() {
     let obj = every_material_obj();
     let files = [("mesh.obj", obj.as_str()), ("m.mtl", MTL)];
-    let s = load("override", &files, "material = \"grey\"", true).unwrap();
+    let s = load(&files, "material = \"grey\"", true).unwrap();
     assert_eq!(s.shapes.len(), 16);
     assert!(
         s.shapes.iter().all(|x| x.material == 0),
@@ -254,17 +249,11 @@ fn a_material_on_the_shape_overrides_every_mtl_material() {
     );
     assert_eq!(s.lights.len(), 1, "the lamp's Ke is overridden too");
     // Without the MTL file: the override needs none.
-    let s = load(
-        "override_no_mtl",
-        &[("mesh.obj", obj.as_str())],
-        "material = \"grey\"",
-        true,
-    )
-    .unwrap();
+    let s = load(&[("mesh.obj", obj.as_str())], "material = \"grey\"", true).unwrap();
     assert_eq!(s.shapes.len(), 16);
     // Per object: the named objects take theirs, the rest their MTL's.
     let extra = "object_materials = { obj_plain = \"mirror\", obj_lamp = \"grey\" }";
-    let s = load("per_object", &files, extra, true).unwrap();
+    let s = load(&files, extra, true).unwrap();
     assert_eq!(
         material_at(&s, 0.0),
         Material::Mirror {
@@ -281,7 +270,7 @@ fn a_material_on_the_shape_overrides_every_mtl_material() {
     assert_eq!(s.lights.len(), 1, "obj_lamp no longer emits");
     // An object the OBJ does not have, named at its own line.
     let extra = "object_materials = { obj_none = \"grey\" }";
-    let e = load("per_object_bad", &files, extra, true).unwrap_err();
+    let e = load(&files, extra, true).unwrap_err();
     assert_eq!(
         (e.line, e.field.as_str()),
         (FILE_LINE + 1, "shape[0].object_materials.obj_none"),
@@ -297,7 +286,7 @@ fn a_material_on_the_shape_overrides_every_mtl_material() {
 fn emissive_triangles_light_a_scene_without_any_light() {
     let obj = "mtllib m.mtl\no lamp\nusemtl lamp\nv 0 2 0\nv 0 2 1\nv 1 2 1\nv 1 2 0\nf 1 2 3 4\n\
                o floor\nusemtl plain\nv -5 0 -5\nv 5 0 -5\nv 5 0 5\nv -5 0 5\nf 5 6 7 8\n";
-    let s = load("lamp_only", &[("mesh.obj", obj), ("m.mtl", MTL)], "", false).unwrap();
+    let s = load(&[("mesh.obj", obj), ("m.mtl", MTL)], "", false).unwrap();
     assert_eq!(s.lights.len(), 1);
     // Emitters come after the mesh's other triangles, as one run.
     let Light::Triangles { first, count, .. } = s.lights[0] else {
@@ -306,7 +295,6 @@ fn emissive_triangles_light_a_scene_without_any_light() {
     assert_eq!((first, count), (2, 2));
     // Overridden, it is no light, and a scene with none is refused.
     let e = load(
-        "lamp_overridden",
         &[("mesh.obj", obj), ("m.mtl", MTL)],
         "material = \"grey\"",
         false,
@@ -322,7 +310,7 @@ fn vertex_normals_become_shading_normals() {
     // but its normals up: it is turned around.
     let obj = "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nvn 0 2 0\nvn 0.1 1 0\nvn 0 1 0.1\n\
                f 1//1 3//2 2//3\nf 1//1 2//2 3\nf 1 3 4\n";
-    let s = load("normals", &[("mesh.obj", obj)], "material = \"grey\"", true).unwrap();
+    let s = load(&[("mesh.obj", obj)], "material = \"grey\"", true).unwrap();
     assert_eq!(s.shapes.len(), 3);
     let Some(n) = s.shapes[0].normals else {
         panic!("face 1 has normals")
@@ -354,7 +342,6 @@ fn vertex_normals_become_shading_normals() {
 fn a_face_without_material_names_the_file_and_line() {
     // No MTL at all, and no `material`.
     expect_error(
-        "no_mtl",
         &[("mesh.obj", &format!("{QUAD}g box\nf 1 2 3\n"))],
         "",
         "mesh.obj",
@@ -364,7 +351,6 @@ fn a_face_without_material_names_the_file_and_line() {
     // With an MTL, a face before any usemtl.
     let obj = format!("mtllib m.mtl\n{QUAD}f 1 2 3\nusemtl plain\nf 1 3 4\n");
     expect_error(
-        "before_usemtl",
         &[("mesh.obj", &obj), ("m.mtl", MTL)],
         "",
         "mesh.obj",
@@ -376,18 +362,10 @@ fn a_face_without_material_names_the_file_and_line() {
 #[test]
 fn a_missing_mtl_names_the_obj_file_and_line() {
     let obj = format!("# a comment\nmtllib nowhere.mtl\n{QUAD}usemtl plain\nf 1 2 3\n");
-    expect_error(
-        "missing_mtl",
-        &[("mesh.obj", &obj)],
-        "",
-        "mesh.obj",
-        2,
-        "nowhere.mtl",
-    );
+    expect_error(&[("mesh.obj", &obj)], "", "mesh.obj", 2, "nowhere.mtl");
     // An unknown material name.
     let obj = format!("mtllib m.mtl\n{QUAD}usemtl shiny\nf 1 2 3\n");
     expect_error(
-        "unknown_usemtl",
         &[("mesh.obj", &obj), ("m.mtl", MTL)],
         "",
         "mesh.obj",
@@ -400,7 +378,6 @@ fn a_missing_mtl_names_the_obj_file_and_line() {
 fn bad_face_indices_name_the_file_and_line() {
     let m = "material = \"grey\"";
     expect_error(
-        "index_high",
         &[("mesh.obj", &format!("{QUAD}f 1 2 3\nf 1 2 5\n"))],
         m,
         "mesh.obj",
@@ -408,7 +385,6 @@ fn bad_face_indices_name_the_file_and_line() {
         "vertex 5",
     );
     expect_error(
-        "index_zero",
         &[("mesh.obj", &format!("{QUAD}f 0 1 2\n"))],
         m,
         "mesh.obj",
@@ -416,7 +392,6 @@ fn bad_face_indices_name_the_file_and_line() {
         "vertex 0",
     );
     expect_error(
-        "index_relative",
         &[("mesh.obj", &format!("{QUAD}f -1 -2 -5\n"))],
         m,
         "mesh.obj",
@@ -425,16 +400,8 @@ fn bad_face_indices_name_the_file_and_line() {
     );
     // A normal index beyond the normals given.
     let obj = format!("{QUAD}vn 0 1 0\nf 1//1 2//2 3//1\n");
+    expect_error(&[("mesh.obj", &obj)], m, "mesh.obj", 6, "normal 2");
     expect_error(
-        "normal_index",
-        &[("mesh.obj", &obj)],
-        m,
-        "mesh.obj",
-        6,
-        "normal 2",
-    );
-    expect_error(
-        "two_corners",
         &[("mesh.obj", &format!("{QUAD}f 1 2\n"))],
         m,
         "mesh.obj",
@@ -446,7 +413,7 @@ fn bad_face_indices_name_the_file_and_line() {
 #[test]
 fn bad_numbers_name_the_file_and_line() {
     let m = "material = \"grey\"";
-    for (i, case) in [
+    for (text, line, says) in [
         (
             "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n",
             3,
@@ -475,26 +442,15 @@ fn bad_numbers_name_the_file_and_line() {
             "not a usable normal",
         ),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3.5\n", 4, "not an index"),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let (text, line, says) = case;
-        expect_error(
-            &format!("number_{i}"),
-            &[("mesh.obj", text)],
-            m,
-            "mesh.obj",
-            line,
-            says,
-        );
+    ] {
+        expect_error(&[("mesh.obj", text)], m, "mesh.obj", line, says);
     }
 }
 
 #[test]
 fn bad_mtl_statements_name_the_mtl_file_and_line() {
     let obj = format!("mtllib m.mtl\n{QUAD}usemtl a\nf 1 2 3\n");
-    for (i, (mtl, line, says)) in [
+    for (mtl, line, says) in [
         // tobj itself would panic on a colour of two numbers.
         ("newmtl a\nKd 0.5 0.5\n", 2, "expected 3 numbers"),
         ("newmtl a\n\nKd 0.5 x 0.5\n", 3, "`x` is not a number"),
@@ -505,12 +461,8 @@ fn bad_mtl_statements_name_the_mtl_file_and_line() {
         ("newmtl a\nKe -1 2 0\n", 2, ">= 0"),
         ("newmtl a\nillum x\n", 2, "illum"),
         ("newmtl a\nNs 10\n", 1, "no Kd"),
-    ]
-    .into_iter()
-    .enumerate()
-    {
+    ] {
         expect_error(
-            &format!("mtl_{i}"),
             &[("mesh.obj", &obj), ("m.mtl", mtl)],
             "",
             "m.mtl",
@@ -522,7 +474,7 @@ fn bad_mtl_statements_name_the_mtl_file_and_line() {
 
 #[test]
 fn the_measured_cornell_box_loads_from_its_obj() {
-    let s = common::paper_scene("cornell_box_obj");
+    let s = paper_scene("cornell_box_obj");
     // 5 walls, 4 ceiling panels, 10 block faces: 38 triangles, 2 of them the light.
     assert_eq!(s.shapes.len(), 38);
     assert_eq!(s.lights.len(), 1);
@@ -534,8 +486,7 @@ fn the_measured_cornell_box_loads_from_its_obj() {
     // The published opening: 130 x 105 mm.
     assert!((light.area(&s.shapes) - 130.0 * 105.0).abs() < 1e-2);
     // Loaded by name from elsewhere, through the embedded OBJ and MTL.
-    let e = photonmap::scene::embedded::load("cornell_box_obj").unwrap();
+    let e = crate::scene::embedded::load("cornell_box_obj").unwrap();
     assert_eq!(e.shapes, s.shapes);
     assert_eq!(e.materials, s.materials);
-    let _ = Path::new("");
 }

@@ -7,18 +7,27 @@
 //! The newer inputs (`--set` overrides, camera paths, OBJ with MTL) go
 //! through tests/fuzz/harness.rs, as their cargo-fuzz targets do.
 
-mod common;
-#[path = "fuzz/harness.rs"]
-mod harness;
-
-use common::Rng;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-use photonmap::scene::{load_scene, load_scene_str, Geometry, Light, Scene};
+use super::{fixture, root};
+use crate::scene::{load_scene, load_scene_str, Geometry, Light, Scene, SceneError};
+use rng::Rng;
+
+/// What the cargo-fuzz targets do with their bytes (the crate's library is
+/// `photonmap` there, and here through `extern crate self`).
+#[path = "../../../../tests/fuzz/harness.rs"]
+mod harness;
+
+/// The integration tests' random source.
+#[allow(dead_code)]
+#[path = "../../../../tests/common/rng.rs"]
+mod rng;
 
 /// A scene whose one shape is the mesh `fuzz.obj` beside it.
-const MESH_SCENE: &str = "[camera]\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nvfov = 40.0\nwidth = 8\nheight = 8\n[materials]\nm = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\n[[shape]]\ntype = \"mesh\"\nfile = \"fuzz.obj\"\nmaterial = \"m\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
+fn mesh_scene() -> &'static str {
+    fixture("fuzz_mesh")
+}
 
 const SPECIAL: [&str; 14] = [
     "nan",
@@ -191,9 +200,7 @@ fn assert_sane(scene: &Scene, input: &str) {
 }
 
 fn corpus() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests")
-        .join("fuzz_corpus")
+    root().join("tests").join("fuzz_corpus")
 }
 
 /// PHOTONMAP_FUZZ_SEED varies the mutations between long runs.
@@ -227,101 +234,152 @@ fn files(ext: &str) -> Vec<String> {
     out
 }
 
-#[test]
-fn mutated_scenes_never_panic_and_accepted_ones_are_finite() {
-    let seeds = files("toml");
-    assert!(seeds.len() >= 3);
-    let mut rng = Rng(seed(0x5eed_f00d));
-    let (mut accepted, mut refused) = (0, 0);
-    for _ in 0..iterations() {
-        let input = mutate(&seeds[rng.below(seeds.len())], &mut rng);
-        let result = catch_unwind(AssertUnwindSafe(|| {
-            load_scene_str(&input, Path::new("fuzz.toml"))
-        }));
-        match result {
-            Err(_) => panic!("the loader panicked on:\n{input}"),
-            Ok(Ok(scene)) => {
-                assert_sane(&scene, &input);
-                accepted += 1;
-            }
-            Ok(Err(e)) => {
-                assert!(
-                    e.line > 0 || e.field != "(file)",
-                    "an error without a place: {e}"
-                );
-                refused += 1;
-            }
+/// Loads `n` mutations of `seeds` (each prefixed with a random byte when
+/// `prefix`) through `load`; a panic fails the test, naming `what` and the
+/// input. `accepted` judges each outcome, with the mutated text, outside the
+/// unwinding guard (so that its own assertions fail as themselves).
+/// Returns how many were accepted and refused.
+fn run_mutations<T>(
+    what: &str,
+    seeds: &[String],
+    rng: &mut Rng,
+    n: usize,
+    prefix: bool,
+    load: impl Fn(&[u8]) -> T,
+    mut accepted: impl FnMut(T, &str) -> bool,
+) -> (usize, usize) {
+    let (mut yes, mut no) = (0, 0);
+    for _ in 0..n {
+        let text = mutate(&seeds[rng.below(seeds.len())], rng);
+        let mut input = Vec::new();
+        if prefix {
+            input.push(rng.below(256) as u8);
+        }
+        input.extend_from_slice(text.as_bytes());
+        let outcome = catch_unwind(AssertUnwindSafe(|| load(&input)))
+            .unwrap_or_else(|_| panic!("{what} panicked on:\n{}", String::from_utf8_lossy(&input)));
+        if accepted(outcome, &text) {
+            yes += 1;
+        } else {
+            no += 1;
         }
     }
-    eprintln!("{accepted} mutated scenes accepted, {refused} refused");
+    (yes, no)
+}
+
+/// Says how many mutated `what` were accepted and refused, and requires
+/// some of each.
+fn both_outcomes(what: &str, accepted: usize, refused: usize) {
+    eprintln!("{accepted} mutated {what} accepted, {refused} refused");
     assert!(
         accepted > 0 && refused > 0,
         "the mutations must reach both outcomes"
     );
 }
 
+/// Judges a loader's outcome: a scene it accepts must be sane (`assert_sane`),
+/// and `check_refusal` checks each error. True when accepted.
+fn sane_if_accepted(
+    check_refusal: impl Fn(&SceneError),
+) -> impl Fn(Result<Scene, SceneError>, &str) -> bool {
+    move |result, input| match result {
+        Ok(scene) => {
+            assert_sane(&scene, input);
+            true
+        }
+        Err(e) => {
+            check_refusal(&e);
+            false
+        }
+    }
+}
+
+/// A mutated scene's text (mutations of text stay text).
+fn utf8(input: &[u8]) -> &str {
+    std::str::from_utf8(input).unwrap()
+}
+
+#[test]
+fn mutated_scenes_never_panic_and_accepted_ones_are_finite() {
+    let seeds = files("toml");
+    assert!(seeds.len() >= 3);
+    let mut rng = Rng(seed(0x5eed_f00d));
+    let load = |input: &[u8]| load_scene_str(utf8(input), Path::new("fuzz.toml"));
+    let judge = sane_if_accepted(|e| {
+        assert!(
+            e.line > 0 || e.field != "(file)",
+            "an error without a place: {e}"
+        );
+    });
+    let n = iterations();
+    let (accepted, refused) = run_mutations("the loader", &seeds, &mut rng, n, false, load, judge);
+    both_outcomes("scenes", accepted, refused);
+}
+
 #[test]
 fn mutated_obj_files_never_panic_and_accepted_ones_are_finite() {
     let seeds = files("obj");
     assert!(seeds.len() >= 2);
-    let dir = std::env::temp_dir().join(format!("photonmap-fuzz-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("scene.toml"), MESH_SCENE).unwrap();
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path();
+    std::fs::write(dir.join("scene.toml"), mesh_scene()).unwrap();
     let mut rng = Rng(seed(0x0b1_f00d));
-    let (mut accepted, mut refused) = (0, 0);
-    for _ in 0..iterations() {
-        let input = mutate(&seeds[rng.below(seeds.len())], &mut rng);
-        std::fs::write(dir.join("fuzz.obj"), &input).unwrap();
-        match catch_unwind(AssertUnwindSafe(|| load_scene(&dir.join("scene.toml")))) {
-            Err(_) => panic!("OBJ loading panicked on:\n{input}"),
-            Ok(Ok(scene)) => {
-                assert_sane(&scene, &input);
-                accepted += 1;
-            }
-            Ok(Err(e)) => {
-                assert!(
-                    e.message.contains("OBJ") || e.message.contains("primitives"),
-                    "{e}"
-                );
-                refused += 1;
-            }
-        }
-    }
+    let load = |input: &[u8]| {
+        std::fs::write(dir.join("fuzz.obj"), input).unwrap();
+        load_scene(&dir.join("scene.toml"))
+    };
+    let judge = sane_if_accepted(|e| {
+        assert!(
+            e.message.contains("OBJ") || e.message.contains("primitives"),
+            "{e}"
+        );
+    });
+    let n = iterations();
+    let (accepted, refused) = run_mutations("OBJ loading", &seeds, &mut rng, n, false, load, judge);
     eprintln!("{accepted} mutated OBJ files accepted, {refused} refused");
     assert!(accepted > 0 && refused > 0);
+}
+
+/// The files of one target's cargo-fuzz corpus (tests/fuzz/corpus/<target>/).
+fn corpus_files(target: &str) -> Vec<PathBuf> {
+    let dir = root().join("tests/fuzz/corpus").join(target);
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .collect()
+}
+
+/// Replays one corpus file through `load`; a panic fails the test, naming
+/// `what` and the file.
+fn replay<T>(what: &str, file: &Path, load: impl FnOnce() -> T) -> T {
+    catch_unwind(AssertUnwindSafe(load))
+        .unwrap_or_else(|_| panic!("{what} panicked on {}", file.display()))
 }
 
 /// The cargo-fuzz corpus (tests/fuzz/corpus/, kept minimised) replayed
 /// through the loaders on every test run, without libFuzzer.
 #[test]
 fn the_cargo_fuzz_corpus_loads_without_panics() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus");
     let mut replayed = 0;
-    for entry in std::fs::read_dir(root.join("scene_toml"))
-        .unwrap()
-        .flatten()
-    {
-        let bytes = std::fs::read(entry.path()).unwrap();
+    for file in corpus_files("scene_toml") {
+        let bytes = std::fs::read(&file).unwrap();
         if let Ok(text) = std::str::from_utf8(&bytes) {
-            match catch_unwind(AssertUnwindSafe(|| {
-                load_scene_str(text, Path::new("corpus.toml"))
-            })) {
-                Err(_) => panic!("the loader panicked on {}", entry.path().display()),
-                Ok(Ok(scene)) => assert_sane(&scene, text),
-                Ok(Err(_)) => {}
+            let load = || load_scene_str(text, Path::new("corpus.toml"));
+            if let Ok(scene) = replay("the loader", &file, load) {
+                assert_sane(&scene, text);
             }
         }
         replayed += 1;
     }
-    let dir = std::env::temp_dir().join(format!("photonmap-corpus-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("scene.toml"), MESH_SCENE).unwrap();
-    for entry in std::fs::read_dir(root.join("obj_mesh")).unwrap().flatten() {
-        std::fs::copy(entry.path(), dir.join("fuzz.obj")).unwrap();
-        match catch_unwind(AssertUnwindSafe(|| load_scene(&dir.join("scene.toml")))) {
-            Err(_) => panic!("OBJ loading panicked on {}", entry.path().display()),
-            Ok(Ok(scene)) => assert_sane(&scene, &entry.path().display().to_string()),
-            Ok(Err(_)) => {}
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path();
+    std::fs::write(dir.join("scene.toml"), mesh_scene()).unwrap();
+    for file in corpus_files("obj_mesh") {
+        std::fs::copy(&file, dir.join("fuzz.obj")).unwrap();
+        let load = || load_scene(&dir.join("scene.toml"));
+        if let Ok(scene) = replay("OBJ loading", &file, load) {
+            assert_sane(&scene, &file.display().to_string());
         }
         replayed += 1;
     }
@@ -341,25 +399,10 @@ fn mutate_target(
     let seeds = files(ext);
     assert!(!seeds.is_empty(), "no .{ext} seeds");
     let mut rng = Rng(seed(rng_seed));
-    let (mut accepted, mut refused) = (0, 0);
-    for _ in 0..iterations() / 3 {
-        let text = mutate(&seeds[rng.below(seeds.len())], &mut rng);
-        let mut input = Vec::new();
-        if prefix {
-            input.push(rng.below(256) as u8);
-        }
-        input.extend_from_slice(text.as_bytes());
-        match catch_unwind(AssertUnwindSafe(|| target(&input))) {
-            Err(_) => panic!("{what} panicked on:\n{}", String::from_utf8_lossy(&input)),
-            Ok(Some(true)) => accepted += 1,
-            Ok(_) => refused += 1,
-        }
-    }
-    eprintln!("{accepted} mutated {what} accepted, {refused} refused");
-    assert!(
-        accepted > 0 && refused > 0,
-        "the mutations must reach both outcomes"
-    );
+    let n = iterations() / 3;
+    let judge = |outcome, _: &str| outcome == Some(true);
+    let (accepted, refused) = run_mutations(what, &seeds, &mut rng, n, prefix, target, judge);
+    both_outcomes(what, accepted, refused);
 }
 
 #[test]
@@ -380,14 +423,11 @@ fn mutated_obj_and_mtl_files_never_panic() {
 /// The corpora of the harness targets, replayed.
 #[test]
 fn the_cargo_fuzz_corpora_of_the_newer_inputs_load_without_panics() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus");
     for (name, target) in harness::TARGETS {
         let mut replayed = 0;
-        for entry in std::fs::read_dir(root.join(name)).unwrap().flatten() {
-            let bytes = std::fs::read(entry.path()).unwrap();
-            if catch_unwind(AssertUnwindSafe(|| target(&bytes))).is_err() {
-                panic!("{name} panicked on {}", entry.path().display());
-            }
+        for file in corpus_files(name) {
+            let bytes = std::fs::read(&file).unwrap();
+            replay(name, &file, || target(&bytes));
             replayed += 1;
         }
         assert!(replayed > 0, "no corpus for {name}");
