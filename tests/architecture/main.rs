@@ -93,7 +93,7 @@ fn dependencies_run_one_way() {
         "scene" => 3,
         "photon" => 4,
         "render" => 5,
-        "stress" | "regress" => 6,
+        "bench" | "regress" => 6,
         "twins" => 7,
         other => panic!("a module ARCHITECTURE.md does not place: {other}"),
     };

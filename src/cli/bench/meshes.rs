@@ -11,12 +11,15 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 
+use photonmap::bench::ray_rates;
 use photonmap::gpu::Platform;
-use photonmap::render::{ray_rates, render, RenderOptions};
+use photonmap::image::write_atomically;
+use photonmap::render::{render, RenderOptions};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{bvh, embedded, generate, Geometry, Scene};
 
-use super::args::in_range;
+use super::output::{folder, write_json};
+use crate::cli::args::in_range;
 
 #[derive(Args)]
 pub struct MeshesArgs {
@@ -39,6 +42,7 @@ pub struct MeshesArgs {
     /// Folder for meshes.json, meshes.svg and the renders (default photonmap-out/meshes).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// The report on stdout as JSON, not a table.
     #[arg(long)]
     pub json: bool,
 }
@@ -97,9 +101,8 @@ pub fn stage(triangles: u32) -> Result<Scene> {
 }
 
 pub fn run(a: &MeshesArgs, platform: Platform) -> Result<()> {
-    let gpu = super::gpu(platform)?;
-    let out = a.out.clone().unwrap_or_else(|| super::out_dir("meshes"));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let gpu = crate::cli::gpu(platform)?;
+    let out = folder(a.out.as_deref(), "meshes", None)?;
     let mut provenance = photonmap::provenance::Provenance::program();
     provenance.scene = "variants/mesh_stage".into();
     (provenance.width, provenance.height) = (a.width, a.height);
@@ -144,17 +147,16 @@ pub fn run(a: &MeshesArgs, platform: Platform) -> Result<()> {
         rows.push(row);
     }
     let report = MeshReport {
-        provenance: super::with_driver(provenance, &gpu),
+        provenance: crate::cli::with_driver(provenance, &gpu),
         width: a.width,
         height: a.height,
         photons: a.photons,
         rows,
     };
-    let json = serde_json::to_string_pretty(&report)?;
-    photonmap::image::write_atomically(&out.join("meshes.json"), json.as_bytes())?;
-    photonmap::image::write_atomically(&out.join("meshes.svg"), svg_plot(&report).as_bytes())?;
+    write_json(&out.join("meshes.json"), &report)?;
+    write_atomically(&out.join("meshes.svg"), svg_plot(&report).as_bytes())?;
     if a.json {
-        println!("{json}");
+        crate::cli::print_json(&report)?;
     } else {
         eprintln!(
             "wrote {}/meshes.json, meshes.svg and the renders",
@@ -196,7 +198,7 @@ fn measure_row(
             format!("{n}")
         };
         let png = full.image.png_bytes()?;
-        photonmap::image::write_atomically(&out.join(format!("render_{name}.png")), &png)?;
+        write_atomically(&out.join(format!("render_{name}.png")), &png)?;
         let direct = options.direct_only();
         direct_only_seconds = Some(fastest_of_two(|| render(gpu, &scene, &direct, &mut ()))?.0);
     }

@@ -22,7 +22,9 @@ use photonmap::render::{
 };
 use photonmap::scene::{embedded, Light, Scene};
 
+use super::output::{folder, write_json, BenchOutput};
 use super::reference::{read_reference, reference_options, ReferenceInfo};
+use super::scene::{default_reference, reference_scale, stem};
 
 /// `bench accuracy`'s options.
 #[derive(Args)]
@@ -42,16 +44,14 @@ pub struct AccuracyArgs {
     #[arg(long)]
     pub quick: bool,
     /// Seeds per configuration (2..=64; default 4, or 2 with --quick).
-    #[arg(long, value_parser = super::args::in_range(2, 64))]
+    #[arg(long, value_parser = crate::cli::args::in_range(2, 64))]
     pub seeds: Option<u32>,
     /// Only the runs whose label contains this text (e.g. "scene defaults",
     /// "SPPM", "max radius"); repeat it for the runs matching any.
     #[arg(long, value_name = "TEXT")]
     pub only: Vec<String>,
-    #[arg(long)]
-    pub json: bool,
-    #[arg(long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub output: BenchOutput,
 }
 
 /// One configuration's renders against the reference.
@@ -368,7 +368,7 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
             a.scene.display()
         );
     }
-    let gpu = super::gpu(platform)?;
+    let gpu = crate::cli::gpu(platform)?;
     let seeds = a.seeds.unwrap_or(if a.quick { 2 } else { 4 });
     let report = bench_accuracy(
         &gpu,
@@ -377,66 +377,40 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
         a.quick,
         seeds,
         &a.only,
-        &super::progress_lines(a.quiet),
+        &a.output.progress(),
     )?;
-    let dir = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::out_dir("accuracy").join(stem(&a.scene)));
-    std::fs::create_dir_all(&dir)?;
+    let dir = folder(a.out.as_deref(), "accuracy", Some(&stem(&a.scene)))?;
     let write = |name: &str, bytes: &[u8]| write_atomically(&dir.join(name), bytes);
     write("accuracy.csv", csv(&report).as_bytes())?;
-    write(
-        "accuracy.json",
-        serde_json::to_string_pretty(&report)?.as_bytes(),
-    )?;
+    write_json(&dir.join("accuracy.json"), &report)?;
     write("accuracy.svg", svg_plot(&report).as_bytes())?;
     write("accuracy.png", &png_plot(&report))?;
     if let Some(map) = &report.bias_map {
         write("bias.png", &map.png_bytes()?)?;
     }
-    if a.json {
-        super::print_json(&report)?;
-    } else {
-        println!(
-            "{:<26} {:>8} {:>9} {:>9} {:>9} {:>7} {:>5}",
-            "run", "seconds", "RMSE", "bias", "noise", "SSIM", "front"
-        );
-        for r in &report.runs {
-            println!(
-                "{:<26} {:>8.3} {:>9.5} {:>9.5} {:>9.5} {:>7.4} {:>5}",
-                r.label,
-                r.seconds,
-                r.rmse,
-                r.bias_rmse,
-                r.noise_rmse,
-                r.ssim,
-                if r.on_pareto_front { "*" } else { "" }
-            );
-        }
-        println!("recommended: {}", report.recommended);
-    }
+    a.output.print(&report, print_table)?;
     eprintln!("wrote {}", dir.display());
     Ok(())
 }
 
-pub fn stem(scene: &Path) -> String {
-    scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
-}
-
-/// The reference `bench accuracy` looks for: photonmap-out/reference/ first,
-/// then the committed reference_images/.
-pub fn default_reference(scene: &Path) -> PathBuf {
-    let name = format!("{}.sppm.exr", stem(scene));
-    let made = super::out_dir("reference").join(&name);
-    if made.is_file() {
-        made
-    } else {
-        PathBuf::from("reference_images").join(name)
+fn print_table(report: &AccuracyReport) {
+    println!(
+        "{:<26} {:>8} {:>9} {:>9} {:>9} {:>7} {:>5}",
+        "run", "seconds", "RMSE", "bias", "noise", "SSIM", "front"
+    );
+    for r in &report.runs {
+        println!(
+            "{:<26} {:>8.3} {:>9.5} {:>9.5} {:>9.5} {:>7.4} {:>5}",
+            r.label,
+            r.seconds,
+            r.rmse,
+            r.bias_rmse,
+            r.noise_rmse,
+            r.ssim,
+            if r.on_pareto_front { "*" } else { "" }
+        );
     }
+    println!("recommended: {}", report.recommended);
 }
 
 /// One render of a configuration with `seed`: its image and wall seconds.
@@ -499,17 +473,7 @@ pub fn bench_accuracy(
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
     let (reference_img, info) = read_reference(reference)?;
-    if reference_img.width == 0 || !scene.camera.width.is_multiple_of(reference_img.width) {
-        bail!(
-            "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
-            reference.display(),
-            reference_img.width,
-            reference_img.height,
-            scene.camera.width,
-            scene.camera.height
-        );
-    }
-    let scale = scene.camera.width / reference_img.width;
+    let scale = reference_scale(reference, &reference_img, scene)?;
     let mut configs = sweep(scene, quick);
     if !only.is_empty() {
         let labels: Vec<String> = configs.iter().map(|c| c.run.label.clone()).collect();

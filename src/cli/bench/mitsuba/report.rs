@@ -1,0 +1,167 @@
+//! `bench mitsuba`'s table (stdout and table.md) and its convergence plot.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use photonmap::image::write_atomically;
+
+use super::score::Target;
+use super::{Curve, MitsubaBench, Row};
+use crate::cli::bench::output::write_json;
+use crate::cli::bench::plot::LogLog;
+
+pub(super) const PLOT_FILE: &str = "convergence.svg";
+const TABLE_FILE: &str = "table.md";
+
+/// The report's files beside the images: the convergence plot, mitsuba.json
+/// and the table.
+pub(super) fn write(dir: &Path, target: &Target, report: &MitsubaBench) -> Result<()> {
+    let svg = plot(&report.scene, target, &report.rows, &report.curves);
+    write_atomically(&dir.join(PLOT_FILE), svg.as_bytes())?;
+    write_json(&dir.join("mitsuba.json"), report)?;
+    let table = markdown_table(report, &command_line());
+    write_atomically(&dir.join(TABLE_FILE), table.as_bytes())?;
+    Ok(())
+}
+
+/// This run's command line, for the table's heading (arguments as given).
+fn command_line() -> String {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    format!("photonmap {}", args.join(" "))
+}
+
+/// The rows as a Markdown table, headed by the command that made them, for
+/// the documentation to link rather than retype.
+fn markdown_table(b: &MitsubaBench, command: &str) -> String {
+    let mut s = format!("`{command}`\n\n{}; {}.\n\n", heading(b), b.gl_renderer);
+    s += "| renderer | budget (s) | seconds | samples | camera paths/s | photons/s | relative RMSE | energy |\n";
+    s += "|---|---|---|---|---|---|---|---|\n";
+    for r in &b.rows {
+        s += &format!(
+            "| {} | {} | {:.1} | {} | {:.3e} | {} | {:.4} | {:.4} |\n",
+            r.renderer,
+            r.budget.map_or("-".into(), |x| format!("{x:.0}")),
+            r.seconds,
+            r.samples,
+            r.paths_per_second,
+            r.photons_per_second
+                .map_or("-".into(), |p| format!("{p:.3e}")),
+            r.rel_rmse,
+            r.energy
+        );
+    }
+    s
+}
+
+const COLOURS: [&str; 6] = [
+    "#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#8c564b", "#9467bd",
+];
+
+/// Relative RMSE against seconds: each method's longest run joined, its
+/// shorter budgets as dots, the one-map renders as labelled dots, and the
+/// truth's own noise as a level.
+fn plot(name: &str, target: &Target, rows: &[Row], curves: &[Curve]) -> String {
+    let mask = if target.mask.is_some() {
+        "interior mask"
+    } else {
+        "all pixels"
+    };
+    let mut p = LogLog::new(
+        &format!("{name}: error against wall time ({}, {mask})", target.kind),
+        "wall seconds",
+        "relative RMSE (RMSE / mean of the reference)",
+    );
+    for (c, colour) in curves.iter().zip(COLOURS.iter().cycle()) {
+        p.line(
+            &c.renderer,
+            colour,
+            c.points.iter().map(|q| (q.seconds, q.rel_rmse)).collect(),
+        );
+        let on_curve = |r: &Row| c.points.iter().any(|q| q.image == r.image);
+        let others: Vec<_> = rows
+            .iter()
+            .filter(|r| r.renderer == c.renderer && !on_curve(r))
+            .map(|r| (r.seconds, r.rel_rmse, String::new()))
+            .collect();
+        p.points(colour, others, false);
+    }
+    let one_map: Vec<_> = rows
+        .iter()
+        .filter(|r| r.budget.is_none())
+        .map(|r| {
+            (
+                r.seconds,
+                r.rel_rmse,
+                format!("photonmap {} spp", r.samples),
+            )
+        })
+        .collect();
+    if !one_map.is_empty() {
+        p.points("#9467bd", one_map, false);
+    }
+    if let Some(n) = target.noise {
+        p.level("the reference's own noise", "#7f7f7f", n);
+    }
+    p.svg()
+}
+
+/// What was compared with what: the tables' first line.
+fn heading(b: &MitsubaBench) -> String {
+    format!(
+        "{} ({} x {}), against {} ({}), {}, {} pixels{}",
+        b.scene,
+        b.width,
+        b.height,
+        b.reference,
+        b.reference_kind,
+        b.mask
+            .as_deref()
+            .map_or("no mask".into(), |m| format!("mask {m}")),
+        b.pixels_compared,
+        b.truth_noise.map_or(String::new(), |n| format!(
+            ", whose own noise is {:.2}%",
+            100.0 * n
+        ))
+    )
+}
+
+pub(super) fn print_table(b: &MitsubaBench) {
+    println!("{}", heading(b));
+    println!(
+        "{:<16} {:>7} {:>8} {:>8} {:>9} {:>9} {:>9} {:>7} {:>8}  image",
+        "renderer",
+        "budget",
+        "seconds",
+        "samples",
+        "paths/s",
+        "photons/s",
+        "rel.RMSE",
+        "energy",
+        "rel.MSE"
+    );
+    for r in &b.rows {
+        println!(
+            "{:<16} {:>7} {:>8.2} {:>8} {:>9.3e} {:>9} {:>9.4} {:>7.4} {:>8.4}  {}",
+            r.renderer,
+            r.budget.map_or("-".into(), |s| format!("{s:.1}")),
+            r.seconds,
+            r.samples,
+            r.paths_per_second,
+            r.photons_per_second
+                .map_or("-".into(), |p| format!("{p:.3e}")),
+            r.rel_rmse,
+            r.energy,
+            r.rel_mse,
+            r.image
+        );
+    }
+    for c in &b.curves {
+        let points: Vec<String> = c
+            .points
+            .iter()
+            .map(|q| format!("{:.1} s {:.4}", q.seconds, q.rel_rmse))
+            .collect();
+        println!("curve {:<16} {}", c.renderer, points.join(", "));
+    }
+}
