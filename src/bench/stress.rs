@@ -81,30 +81,27 @@ pub fn transformed(scene: &Scene, s: f32, t: Vec3) -> Scene {
         shape.geometry = shape.geometry.scaled(s, p);
     }
     for light in &mut out.lights {
-        *light = match *light {
+        match light {
             Light::Area {
                 corner,
                 edge1,
                 edge2,
-                normal,
-                radiance,
-            } => Light::Area {
-                corner: p(corner),
-                edge1: edge1 * s,
-                edge2: edge2 * s,
-                normal,
-                radiance,
-            },
+                ..
+            } => {
+                *corner = p(*corner);
+                *edge1 *= s;
+                *edge2 *= s;
+            }
             Light::Point {
                 position,
                 intensity,
-            } => Light::Point {
-                position: p(position),
-                intensity: intensity * s * s,
-            },
+            } => {
+                *position = p(*position);
+                *intensity = *intensity * s * s;
+            }
             // Its triangles are shapes, moved above.
-            Light::Triangles { .. } => *light,
-        };
+            Light::Triangles { .. } => {}
+        }
     }
     out.photon_map.max_radius *= s;
     out.photon_map.grid_bounds = scene.photon_map.grid_bounds.map(|(lo, hi)| (p(lo), p(hi)));

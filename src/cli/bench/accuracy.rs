@@ -24,7 +24,7 @@ use photonmap::scene::{embedded, Light, Scene};
 
 use super::output::{folder, write_json, BenchOutput};
 use super::reference::{read_reference, reference_options, ReferenceInfo};
-use super::scene::{default_reference, reference_scale, stem};
+use super::scene::{default_reference, reference_scale, stem, SEED};
 
 /// `bench accuracy`'s options.
 #[derive(Args)]
@@ -157,6 +157,15 @@ impl Config {
         f(&mut c.run);
         c
     }
+
+    /// This run by another method, at `spp` eye samples, with its options set by `f`.
+    fn by(&self, label: &str, method: &str, spp: u32, f: impl FnOnce(&mut AccuracyRun)) -> Self {
+        self.with(label.into(), |r| {
+            r.method = method.into();
+            r.spp = spp;
+            f(r);
+        })
+    }
 }
 
 /// The sweep: one parameter at a time around the scene's defaults, the leak
@@ -207,13 +216,11 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     if !scene.photon_map.caustics_only {
         // 16 rays already take 15 times the scene defaults in CORNELL BOX.
         for rays in if quick { vec![4] } else { vec![4, 16] } {
-            out.push(base.with(format!("final gather {rays} rays"), |r| {
-                r.method = "final-gather".into();
-                r.gather_rays = rays;
-            }));
+            let label = format!("final gather {rays} rays");
+            out.push(base.by(&label, "final-gather", 1, |r| r.gather_rays = rays));
         }
-        out.push(base.with("final gather 16 rays, adaptive".into(), |r| {
-            r.method = "final-gather".into();
+        let label = "final gather 16 rays, adaptive";
+        out.push(base.by(label, "final-gather", 1, |r| {
             r.gather_rays = 16;
             r.adaptive = true;
         }));
@@ -229,10 +236,8 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     } else {
         vec![4, 16, 64, 256]
     } {
-        out.push(base.with(format!("SPPM {it} iterations"), |r| {
-            r.method = "sppm".into();
-            r.sppm_iterations = it;
-        }));
+        let label = format!("SPPM {it} iterations");
+        out.push(base.by(&label, "sppm", 1, |r| r.sppm_iterations = it));
     }
     out.extend(igi_rows(&base, quick));
     out.extend(differentials_rows(&base, quick));
@@ -243,8 +248,8 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     // Adaptive SPPM (a pilot of an eighth of the iterations, then the
     // gather only where the plan computes), beside the full runs above.
     for it in if quick { vec![16] } else { vec![16, 64] } {
-        out.push(base.with(format!("SPPM {it} iterations, adaptive"), |r| {
-            r.method = "sppm".into();
+        let label = format!("SPPM {it} iterations, adaptive");
+        out.push(base.by(&label, "sppm", 1, |r| {
             r.sppm_iterations = it;
             r.adaptive = true;
         }));
@@ -260,8 +265,7 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
 fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     let mut out = Vec::new();
     let igi = |label: &str, f: &dyn Fn(&mut IgiOptions)| {
-        base.with(label.into(), |r| {
-            r.method = "igi".into();
+        base.by(label, "igi", 1, |r| {
             let mut o = IgiOptions::default();
             f(&mut o);
             r.igi = Some(o);
@@ -313,13 +317,11 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// times the photons, the Epanechnikov kernel, and 4 spp.
 fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     let pd = |label: &str, kernel: Kernel, spp: u32| {
-        base.with(label.into(), |r| {
-            r.method = "differentials".into();
-            r.spp = spp;
+        base.by(label, "differentials", spp, |r| {
             r.differentials = Some(DifferentialsOptions {
                 kernel,
                 ..DifferentialsOptions::default()
-            });
+            })
         })
     };
     let mut out = vec![pd("differentials", Kernel::Constant, 1)];
@@ -338,13 +340,11 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, resolution: u32, spp: u32| {
-        base.with(label.into(), |r| {
-            r.method = "radiosity".into();
-            r.spp = spp;
+        base.by(label, "radiosity", spp, |r| {
             r.radiosity = Some(RadiosityOptions {
                 resolution,
                 ..RadiosityOptions::default()
-            });
+            })
         })
     };
     let mut out = vec![rad("radiosity", 16, 1)];
@@ -492,7 +492,7 @@ pub fn bench_accuracy(
         let mut images = Vec::new();
         let mut seconds = 0.0;
         for seed in 0..seeds {
-            let (img, s) = render_config(gpu, scene, &c.run, scale, 7 + seed)?;
+            let (img, s) = render_config(gpu, scene, &c.run, scale, SEED + seed)?;
             images.push(img);
             seconds += s;
         }

@@ -30,7 +30,7 @@ use photonmap::scene::Scene;
 
 use super::output::{folder, slug, write_json, BenchOutput};
 use super::reference::reference_options;
-use super::scene::{BenchScene, Loaded};
+use super::scene::{BenchScene, Loaded, SEED};
 
 #[derive(Args)]
 pub struct DifferentialsBenchArgs {
@@ -110,7 +110,7 @@ struct Bench<'a> {
 
 impl Bench<'_> {
     fn options(&self) -> RenderOptions {
-        reference_options(self.scene, self.scale, 7)
+        reference_options(self.scene, self.scale, SEED)
     }
 
     /// The bench's options with photon differentials `d`.

@@ -19,7 +19,7 @@ use photonmap::render::{render, IgiOptions, Image, Method, RenderOptions, WithCa
 
 use super::output::{folder, slug, write_json, BenchOutput};
 use super::reference::reference_options;
-use super::scene::{BenchScene, Loaded};
+use super::scene::{BenchScene, Loaded, SEED};
 use crate::cli::args::in_range;
 
 #[derive(Args)]
@@ -141,7 +141,7 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
     let all = rows(a.vpl_paths);
     for (i, (label, igi)) in all.iter().enumerate() {
         progress(&format!("{label} ({}/{})", i + 1, all.len()));
-        let o: RenderOptions = reference_options(&scene, scale, 7);
+        let o: RenderOptions = reference_options(&scene, scale, SEED);
         let map = o.method.photon_map().cloned().unwrap_or_default();
         let o = o.with_method(Method::Igi(WithCausticMap::from_map(map, igi.clone())));
         let r = render(&gpu, &scene, &o, &mut ())?;

@@ -174,14 +174,7 @@ fn measure_row(
 ) -> Result<MeshRow> {
     let mut scene = stage(n)?;
     (scene.camera.width, scene.camera.height) = (a.width, a.height);
-    let mut build_seconds = f64::INFINITY;
-    let mut tree = None;
-    for _ in 0..3 {
-        let start = Instant::now();
-        tree = Some(bvh::build(&scene)?);
-        build_seconds = build_seconds.min(start.elapsed().as_secs_f64());
-    }
-    let tree = tree.expect("built three times");
+    let (build_seconds, tree) = fastest(3, || bvh::build(&scene))?;
     let start = Instant::now();
     let textures = SceneTextures::with_bvh(gpu, &scene, &tree)?;
     let upload_seconds = start.elapsed().as_secs_f64();
@@ -190,7 +183,7 @@ fn measure_row(
     let (mut render_seconds, mut direct_only_seconds) = (None, None);
     if !a.no_render {
         let options = RenderOptions::for_scene(&scene);
-        let (seconds, full) = fastest_of_two(|| render(gpu, &scene, &options, &mut ()))?;
+        let (seconds, full) = fastest(2, || render(gpu, &scene, &options, &mut ()))?;
         render_seconds = Some(seconds);
         let name = if n == 0 {
             "analytic".into()
@@ -200,7 +193,7 @@ fn measure_row(
         let png = full.image.png_bytes()?;
         write_atomically(&out.join(format!("render_{name}.png")), &png)?;
         let direct = options.direct_only();
-        direct_only_seconds = Some(fastest_of_two(|| render(gpu, &scene, &direct, &mut ()))?.0);
+        direct_only_seconds = Some(fastest(2, || render(gpu, &scene, &direct, &mut ()))?.0);
     }
     Ok(MeshRow {
         // What the generator made of the count asked for.
@@ -223,19 +216,19 @@ fn measure_row(
     })
 }
 
-/// The faster of two runs (the first pays the shader compiler), and its result.
-fn fastest_of_two<T>(mut f: impl FnMut() -> photonmap::error::Result<T>) -> Result<(f64, T)> {
-    let start = Instant::now();
-    let first = f()?;
-    let once = start.elapsed().as_secs_f64();
-    let start = Instant::now();
-    let second = f()?;
-    let twice = start.elapsed().as_secs_f64();
-    Ok(if twice <= once {
-        (twice, second)
-    } else {
-        (once, first)
-    })
+/// The fastest of `runs` runs of `f` (the first pays the shader compiler),
+/// and its result (the later run's on a tie).
+fn fastest<T>(runs: u32, mut f: impl FnMut() -> photonmap::error::Result<T>) -> Result<(f64, T)> {
+    let mut best: Option<(f64, T)> = None;
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let value = f()?;
+        let seconds = start.elapsed().as_secs_f64();
+        if best.as_ref().is_none_or(|(fastest, _)| seconds <= *fastest) {
+            best = Some((seconds, value));
+        }
+    }
+    Ok(best.expect("at least one run"))
 }
 
 /// Render seconds (full and direct only) against triangles, log-log; the

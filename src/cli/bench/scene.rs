@@ -13,6 +13,10 @@ use photonmap::scene::{embedded, Scene};
 use super::reference::read_reference;
 use crate::cli::args::in_range;
 
+/// The seed of every method benchmark's renders (`bench accuracy`'s first
+/// of its seeds), so that their images compare across benchmarks.
+pub const SEED: u32 = 7;
+
 /// The scene a method benchmark renders, and its reference.
 #[derive(Args)]
 pub struct BenchScene {

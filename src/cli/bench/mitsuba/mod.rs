@@ -33,7 +33,7 @@ use photonmap::scene::{embedded, Scene};
 
 use super::output::{folder, BenchOutput};
 use super::reference::reference_options;
-use super::scene::stem;
+use super::scene::{stem, SEED};
 use crate::cli::args::in_range;
 use runner::Taken;
 use score::{Bench, Target};
@@ -257,7 +257,7 @@ fn race(
         seconds: Some(budget),
         ..SppmOptions::default()
     };
-    let o = reference_options(scene, scale, 7);
+    let o = reference_options(scene, scale, SEED);
     let mut watch = Checkpoints::new(checkpoints.clone());
     let s = render_sppm(gpu, scene, &o, &sppm, &mut watch)?;
     let taken = (watch.seconds(), s.iterations, s.image);
@@ -340,7 +340,7 @@ pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
     spp.dedup();
     for &n in &spp {
         progress(&format!("photonmap, {n} spp"));
-        let mut o = reference_options(&scene, scale, 7);
+        let mut o = reference_options(&scene, scale, SEED);
         o.spp = n;
         let t = Instant::now();
         let out = render(&gpu, &scene, &o, &mut ())?;

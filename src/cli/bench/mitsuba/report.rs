@@ -41,17 +41,27 @@ fn markdown_table(b: &MitsubaBench, command: &str) -> String {
         s += &format!(
             "| {} | {} | {:.1} | {} | {:.3e} | {} | {:.4} | {:.4} |\n",
             r.renderer,
-            r.budget.map_or("-".into(), |x| format!("{x:.0}")),
+            budget(r, 0),
             r.seconds,
             r.samples,
             r.paths_per_second,
-            r.photons_per_second
-                .map_or("-".into(), |p| format!("{p:.3e}")),
+            photons_per_second(r),
             r.rel_rmse,
             r.energy
         );
     }
     s
+}
+
+/// A row's budget with `decimals` decimals, or "-" for the one-map render.
+fn budget(r: &Row, decimals: usize) -> String {
+    r.budget.map_or("-".into(), |x| format!("{x:.decimals$}"))
+}
+
+/// A row's photons a second, or "-" for renderers that emit none.
+fn photons_per_second(r: &Row) -> String {
+    r.photons_per_second
+        .map_or("-".into(), |p| format!("{p:.3e}"))
 }
 
 const COLOURS: [&str; 6] = [
@@ -144,12 +154,11 @@ pub(super) fn print_table(b: &MitsubaBench) {
         println!(
             "{:<16} {:>7} {:>8.2} {:>8} {:>9.3e} {:>9} {:>9.4} {:>7.4} {:>8.4}  {}",
             r.renderer,
-            r.budget.map_or("-".into(), |s| format!("{s:.1}")),
+            budget(r, 1),
             r.seconds,
             r.samples,
             r.paths_per_second,
-            r.photons_per_second
-                .map_or("-".into(), |p| format!("{p:.3e}")),
+            photons_per_second(r),
             r.rel_rmse,
             r.energy,
             r.rel_mse,
