@@ -22,9 +22,9 @@ use photonmap::render::{
 };
 use photonmap::scene::{embedded, Light, Scene};
 
-use super::output::{folder, write_json, BenchOutput};
+use super::output::{folder, stem, write_json, BenchOutput};
 use super::reference::{read_reference, reference_options, ReferenceInfo};
-use super::scene::{default_reference, reference_scale, stem, SEED};
+use super::scene::{default_reference, reference_scale, SEED};
 
 /// `bench accuracy`'s options.
 #[derive(Args)]

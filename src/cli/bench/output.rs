@@ -1,7 +1,7 @@
 //! What the benchmark commands share in their output: `--json` and
 //! `--quiet` (one option group, flattened into each), the folder a
 //! benchmark writes into, its JSON written all or nothing, and file names
-//! made from run labels.
+//! made from scene arguments and run labels.
 
 use std::path::{Path, PathBuf};
 
@@ -56,6 +56,14 @@ pub fn folder(out: Option<&Path>, kind: &str, name: Option<&str>) -> Result<Path
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     write_atomically(path, serde_json::to_string_pretty(value)?.as_bytes())?;
     Ok(())
+}
+
+/// A scene argument's file stem: its name in output folders and references.
+pub fn stem(scene: &Path) -> String {
+    scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 /// A run's label as a file name: lower-case letters and digits, each other

@@ -21,7 +21,7 @@ use photonmap::render::{Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::Scene;
 use photonmap::timing::Timings;
 
-use super::scene::stem;
+use super::output::stem;
 use crate::cli::args::{in_range, SceneArgs};
 
 /// Render a reference of a scene by SPPM (it converges to the exact image):

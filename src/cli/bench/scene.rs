@@ -10,6 +10,7 @@ use clap::Args;
 use photonmap::render::Image;
 use photonmap::scene::{embedded, Scene};
 
+use super::output::stem;
 use super::reference::read_reference;
 use crate::cli::args::in_range;
 
@@ -31,14 +32,6 @@ pub struct BenchScene {
     /// none for the mesh stage). Images render at its size.
     #[arg(long)]
     pub reference: Option<PathBuf>,
-}
-
-/// A scene argument's file stem: its name in output folders and references.
-pub fn stem(scene: &Path) -> String {
-    scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
 }
 
 /// The reference `bench accuracy` looks for: photonmap-out/reference/ first,

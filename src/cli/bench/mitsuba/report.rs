@@ -1,23 +1,92 @@
-//! `bench mitsuba`'s table (stdout and table.md) and its convergence plot.
+//! What `bench mitsuba` reports (mitsuba.json): a row per render and the
+//! convergence curves; and its table (stdout and table.md) and convergence
+//! plot.
 
 use std::path::Path;
 
 use anyhow::Result;
+use serde::Serialize;
 
 use photonmap::image::write_atomically;
 
-use super::score::Target;
-use super::{Curve, MitsubaBench, Row};
 use crate::cli::bench::output::write_json;
 use crate::cli::bench::plot::LogLog;
+
+#[derive(Serialize, Clone, Debug)]
+pub struct Row {
+    pub renderer: String,
+    /// The wall time it was given: a --seconds budget, or the one-map
+    /// render's time with --spp (None for that render itself).
+    pub budget: Option<f64>,
+    /// Wall seconds it took (Mitsuba: its first render call on, JIT
+    /// included; SPPM: setup included).
+    pub seconds: f64,
+    /// Samples per pixel (Mitsuba, the one-map render) or iterations (SPPM).
+    pub samples: u32,
+    /// Camera paths a second: samples x width x height / seconds.
+    pub paths_per_second: f64,
+    /// SPPM: photons emitted a second.
+    pub photons_per_second: Option<f64>,
+    /// RMSE over the reference's mean, on the mask's pixels: the headline.
+    pub rel_rmse: f64,
+    /// The image's mean over the reference's, same pixels.
+    pub energy: f64,
+    /// Mean of (a - b)^2 / (b^2 + 0.01).
+    pub rel_mse: f64,
+    pub rmse: f64,
+    /// PNG in the out folder (the EXR beside it has the same stem).
+    pub image: String,
+}
+
+/// One image along a method's longest run.
+#[derive(Serialize, Clone, Debug)]
+pub struct CurvePoint {
+    pub seconds: f64,
+    pub samples: u32,
+    pub rel_rmse: f64,
+    pub energy: f64,
+    pub rel_mse: f64,
+    pub image: String,
+}
+
+/// Error against wall time for one method, along its longest run.
+#[derive(Serialize, Clone, Debug)]
+pub struct Curve {
+    pub renderer: String,
+    pub points: Vec<CurvePoint>,
+}
+
+#[derive(Serialize)]
+pub struct MitsubaBench {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub reference: String,
+    /// "truth" (the committed ground truth), "given" (--reference) or "SPPM
+    /// reference".
+    pub reference_kind: String,
+    pub mask: Option<String>,
+    pub pixels_compared: usize,
+    /// The reference's own relative noise: the truth's noise.json figure
+    /// (full-size image), or a --mitsuba-reference's from its two runs.
+    /// Nothing is measured more finely.
+    pub truth_noise: Option<f64>,
+    pub gl_renderer: String,
+    pub variant: String,
+    pub max_depth: i32,
+    pub budgets: Vec<f64>,
+    pub rows: Vec<Row>,
+    pub curves: Vec<Curve>,
+    pub convergence_plot: String,
+}
 
 pub(super) const PLOT_FILE: &str = "convergence.svg";
 const TABLE_FILE: &str = "table.md";
 
 /// The report's files beside the images: the convergence plot, mitsuba.json
 /// and the table.
-pub(super) fn write(dir: &Path, target: &Target, report: &MitsubaBench) -> Result<()> {
-    let svg = plot(&report.scene, target, &report.rows, &report.curves);
+pub(super) fn write(dir: &Path, report: &MitsubaBench) -> Result<()> {
+    let svg = plot(report);
     write_atomically(&dir.join(PLOT_FILE), svg.as_bytes())?;
     write_json(&dir.join("mitsuba.json"), report)?;
     let table = markdown_table(report, &command_line());
@@ -71,14 +140,18 @@ const COLOURS: [&str; 6] = [
 /// Relative RMSE against seconds: each method's longest run joined, its
 /// shorter budgets as dots, the one-map renders as labelled dots, and the
 /// truth's own noise as a level.
-fn plot(name: &str, target: &Target, rows: &[Row], curves: &[Curve]) -> String {
-    let mask = if target.mask.is_some() {
+fn plot(b: &MitsubaBench) -> String {
+    let (name, rows, curves) = (&b.scene, &b.rows, &b.curves);
+    let mask = if b.mask.is_some() {
         "interior mask"
     } else {
         "all pixels"
     };
     let mut p = LogLog::new(
-        &format!("{name}: error against wall time ({}, {mask})", target.kind),
+        &format!(
+            "{name}: error against wall time ({}, {mask})",
+            b.reference_kind
+        ),
         "wall seconds",
         "relative RMSE (RMSE / mean of the reference)",
     );
@@ -110,7 +183,7 @@ fn plot(name: &str, target: &Target, rows: &[Row], curves: &[Curve]) -> String {
     if !one_map.is_empty() {
         p.points("#9467bd", one_map, false);
     }
-    if let Some(n) = target.noise {
+    if let Some(n) = b.truth_noise {
         p.level("the reference's own noise", "#7f7f7f", n);
     }
     p.svg()

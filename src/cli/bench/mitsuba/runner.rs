@@ -12,7 +12,7 @@ use photonmap::image::write_atomically;
 use photonmap::render::Image;
 use photonmap::scene::{Geometry, Light, Material, Scene};
 
-use super::MitsubaBenchArgs;
+use super::args::MitsubaBenchArgs;
 
 /// The script, embedded; written beside the export for each run.
 const SCRIPT: &str = include_str!("mitsuba_render.py");

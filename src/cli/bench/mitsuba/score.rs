@@ -12,8 +12,9 @@ use photonmap::metrics::{compare, Metrics};
 use photonmap::render::Image;
 use photonmap::scene::Scene;
 
+use super::args::MitsubaBenchArgs;
+use super::report::{Curve, CurvePoint, Row};
 use super::runner::{render_mitsuba, Taken};
-use super::{Curve, CurvePoint, MitsubaBenchArgs, Row};
 use crate::cli::bench::scene::default_reference;
 use crate::cli::compare::read_mask;
 

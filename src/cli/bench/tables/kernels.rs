@@ -2,7 +2,7 @@
 //! address arithmetic of each kernel the paper counts, from its optimised
 //! SPIR-V (glslangValidator, when installed).
 
-use super::KernelCount;
+use super::report::KernelCount;
 
 /// Counts the instructions of a kernel's optimised SPIR-V (glslangValidator -Os).
 fn spirv_counts(

@@ -1,7 +1,7 @@
 //! `tables`' report as Markdown (tables.md, and stdout without --json) and
 //! Table 1 as CSV.
 
-use super::{TablesReport, FIGURE8_BUDGET, STAGES};
+use super::report::{TablesReport, FIGURE8_BUDGET, STAGES};
 
 pub(super) fn table1_csv(r: &TablesReport) -> String {
     let mut s = String::from(

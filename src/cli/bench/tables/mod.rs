@@ -1,28 +1,31 @@
 //! `photonmap tables`: every table and figure of the paper this machine can
 //! regenerate, beside the paper's own numbers, into results/<renderer>/.
-//! The renders behind Table 1, section 3.3 and figure 8 are in `renders`,
-//! Table 2's instruction counts in `kernels`, the Markdown and CSV in
-//! `markdown`; here are the command, its report, and the run that stages
-//! every file and writes them all or nothing.
+//! What the report holds is in `report`, the renders behind Table 1,
+//! section 3.3 and figure 8 in `renders`, Table 2's instruction counts in
+//! `kernels`, the Markdown and CSV in `markdown`, and the files kept until
+//! they are all written at once in `staged`; here are the command and its
+//! run.
 
 mod kernels;
 mod markdown;
 mod renders;
+mod report;
+mod staged;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use serde::Serialize;
 
-use photonmap::bench::build::{bench_size, paper_grid, BuildBenchRow};
+use photonmap::bench::build::{bench_size, paper_grid};
 use photonmap::gpu::{Gpu, Platform};
-use photonmap::photon::{BuildMethod, PhotonConfig};
-use photonmap::render::{EstimateMode, Image, Method, PhotonMapOptions, RenderOptions};
-use photonmap::scene::Scene;
 
 use super::output::BenchOutput;
-use renders::montage;
+use renders::{montage, TablesRun};
+use report::TablesReport;
+use staged::Staged;
+
+pub(crate) use renders::table1_options;
 
 /// Reproduce the paper's tables and figures into results/<renderer>/ (or --out).
 #[derive(Args)]
@@ -62,109 +65,6 @@ pub fn run(a: &TablesArgs, platform: Platform) -> Result<()> {
     })
 }
 
-/// Table 1 of the paper (GeForce FX 5900 Ultra, seconds).
-const PAPER_TABLE1: [(&str, [f64; 4], [f64; 4]); 3] = [
-    ("glass_ball", [1.2, 0.8, 0.5, 14.9], [1.2, 1.8, 0.5, 7.8]),
-    ("ring", [1.3, 0.8, 0.4, 6.5], [1.3, 1.8, 0.4, 4.6]),
-    ("cornell_box", [2.1, 1.4, 8.4, 52.4], [2.1, 1.7, 8.4, 35.0]),
-];
-/// Steps per pixel per pass of figure 8's render.
-const FIGURE8_BUDGET: u32 = 16;
-
-const STAGES: [&str; 4] = [
-    "trace photons",
-    "build map",
-    "trace rays",
-    "radiance estimate",
-];
-
-#[derive(Serialize)]
-pub struct Table1Cell {
-    pub scene: String,
-    pub build: BuildMethod,
-    pub stage: String,
-    pub wall_seconds: Vec<f64>,
-    pub median_wall_seconds: f64,
-    pub min_wall_seconds: f64,
-    pub max_wall_seconds: f64,
-    pub median_gpu_seconds: f64,
-    pub paper_seconds: f64,
-    pub ratio_to_paper: f64,
-    pub at_or_below_paper: bool,
-}
-
-#[derive(Serialize)]
-pub struct Table1Total {
-    pub scene: String,
-    pub build: BuildMethod,
-    pub median_seconds: f64,
-    pub paper_seconds: f64,
-    pub ratio_to_paper: f64,
-    /// The target: at most a quarter of the paper's total.
-    pub at_most_a_quarter: bool,
-}
-
-#[derive(Serialize)]
-pub struct ConvergenceRow {
-    pub scene: String,
-    pub mode: String,
-    pub wall_seconds: f64,
-    pub passes: u32,
-    pub tile_draws: u64,
-}
-
-#[derive(Serialize)]
-pub struct Figure8 {
-    pub file: String,
-    pub snapshots: Vec<(String, f64, f64)>,
-    pub full_convergence_seconds: f64,
-    pub visual_convergence_seconds: f64,
-    pub criterion: String,
-}
-
-#[derive(Serialize)]
-pub struct KernelCount {
-    pub kernel: String,
-    pub instructions: usize,
-    pub texture_fetches: usize,
-    pub address_arithmetic: usize,
-    pub packing: usize,
-    pub paper: [usize; 4],
-}
-
-#[derive(Serialize)]
-pub struct TablesReport {
-    pub renderer: String,
-    pub gl_version: String,
-    pub cores: usize,
-    pub quick: bool,
-    pub faithful: bool,
-    pub stencil_m: u32,
-    pub table1_only: bool,
-    pub image_scale: String,
-    pub runs: u32,
-    pub command: String,
-    pub table1: Vec<Table1Cell>,
-    pub totals: Vec<Table1Total>,
-    pub convergence: Vec<ConvergenceRow>,
-    pub passes: Vec<BuildBenchRow>,
-    pub figure7: String,
-    pub figure8: Option<Figure8>,
-    pub table2: Result<Vec<KernelCount>, String>,
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    if s.is_empty() {
-        0.0
-    } else if s.len() % 2 == 1 {
-        s[s.len() / 2]
-    } else {
-        0.5 * (s[s.len() / 2 - 1] + s[s.len() / 2])
-    }
-}
-
 /// photonmap-out/tables/<first word of the renderer, lower case>/: the
 /// committed results/ change only when named with --out.
 pub fn default_out(renderer: &str) -> PathBuf {
@@ -181,70 +81,6 @@ pub fn default_out(renderer: &str) -> PathBuf {
     } else {
         word
     })
-}
-
-pub(crate) fn table1_options(
-    scene: &Scene,
-    scale: u32,
-    build: BuildMethod,
-    (faithful, stencil_m): (bool, u32),
-    mode: EstimateMode,
-) -> RenderOptions {
-    let mut o = RenderOptions::for_scene(scene);
-    o.width = (scene.camera.width / scale).max(1);
-    o.height = (scene.camera.height / scale).max(1);
-    let mut gi = PhotonMapOptions {
-        photons: PhotonConfig {
-            build,
-            faithful,
-            stencil_block: stencil_m,
-            // The paper aims no photons: it emits them all from the light.
-            projection_maps: !faithful,
-            ..PhotonConfig::default()
-        },
-        ..PhotonMapOptions::default()
-    };
-    gi.estimate.mode = mode;
-    // The paper's estimate, every photon in the sphere, so the times compare
-    // with the paper's (the default leak test costs RING about half again).
-    gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
-    o.with_method(Method::PhotonMap(gi))
-}
-
-/// Every file of a `tables` run, kept until the run has finished and then
-/// written all or nothing, so an interrupted or failed run leaves the
-/// previous results as they were.
-#[derive(Default)]
-struct Staged(std::cell::RefCell<Vec<(PathBuf, Vec<u8>)>>);
-
-impl Staged {
-    fn add(&self, path: PathBuf, bytes: Vec<u8>) {
-        self.0.borrow_mut().push((path, bytes));
-    }
-
-    fn png(&self, path: PathBuf, img: &Image) -> Result<()> {
-        self.add(path, img.png_bytes()?);
-        Ok(())
-    }
-
-    /// Writes every file; then removes older snapshots in `figure8/` that this run did not make.
-    fn publish(self, out: &Path) -> Result<()> {
-        let files = self.0.into_inner();
-        let refs: Vec<(&Path, &[u8])> = files
-            .iter()
-            .map(|(p, b)| (p.as_path(), b.as_slice()))
-            .collect();
-        photonmap::image::write_all_atomically(&refs)?;
-        let made: std::collections::HashSet<&Path> = refs.iter().map(|(p, _)| *p).collect();
-        if let Ok(entries) = std::fs::read_dir(out.join("figure8")) {
-            for e in entries.flatten() {
-                if !made.contains(e.path().as_path()) {
-                    let _ = std::fs::remove_file(e.path());
-                }
-            }
-        }
-        Ok(())
-    }
 }
 
 pub fn run_tables(
@@ -347,18 +183,3 @@ pub fn run_tables(
     staged.publish(&out)?;
     Ok((report, out))
 }
-
-/// One `tables` run: its scale, runs per cell and output folder.
-struct TablesRun<'a> {
-    gpu: &'a Gpu,
-    scale: u32,
-    runs: u32,
-    quick: bool,
-    faithful: bool,
-    stencil_m: u32,
-    out: &'a Path,
-    progress: &'a dyn Fn(&str),
-    staged: Staged,
-}
-
-type Table1 = (Vec<Table1Cell>, Vec<Table1Total>, Vec<Vec<Image>>);

@@ -8,16 +8,82 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use photonmap::photon::BuildMethod;
+use photonmap::gpu::Gpu;
+use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::render::software::software_image;
-use photonmap::render::{render, EstimateMode, Image, RenderOptions, StageTiming, Timings};
+use photonmap::render::{
+    render, EstimateMode, Image, Method, PhotonMapOptions, RenderOptions, StageTiming, Timings,
+};
 use photonmap::scene::{embedded, Scene};
 
-use super::{
-    median, table1_options, ConvergenceRow, Figure8, Table1, Table1Cell, Table1Total, TablesRun,
-    FIGURE8_BUDGET, PAPER_TABLE1, STAGES,
-};
+use super::report::{ConvergenceRow, Figure8, Table1Cell, Table1Total, FIGURE8_BUDGET, STAGES};
+use super::staged::Staged;
 use crate::cli::render::{SnapshotEvery, SnapshotWriter};
+
+/// Table 1 of the paper (GeForce FX 5900 Ultra, seconds).
+const PAPER_TABLE1: [(&str, [f64; 4], [f64; 4]); 3] = [
+    ("glass_ball", [1.2, 0.8, 0.5, 14.9], [1.2, 1.8, 0.5, 7.8]),
+    ("ring", [1.3, 0.8, 0.4, 6.5], [1.3, 1.8, 0.4, 4.6]),
+    ("cornell_box", [2.1, 1.4, 8.4, 52.4], [2.1, 1.7, 8.4, 35.0]),
+];
+
+/// One `tables` run: its scale, runs per cell and output folder.
+pub(super) struct TablesRun<'a> {
+    pub(super) gpu: &'a Gpu,
+    pub(super) scale: u32,
+    pub(super) runs: u32,
+    pub(super) quick: bool,
+    pub(super) faithful: bool,
+    pub(super) stencil_m: u32,
+    pub(super) out: &'a Path,
+    pub(super) progress: &'a dyn Fn(&str),
+    pub(super) staged: Staged,
+}
+
+pub(super) type Table1 = (Vec<Table1Cell>, Vec<Table1Total>, Vec<Vec<Image>>);
+
+/// A render at Table 1's settings: 1/`scale` of the paper's resolution,
+/// the paper's estimate (no leak test), `build` and `mode`.
+pub(crate) fn table1_options(
+    scene: &Scene,
+    scale: u32,
+    build: BuildMethod,
+    (faithful, stencil_m): (bool, u32),
+    mode: EstimateMode,
+) -> RenderOptions {
+    let mut o = RenderOptions::for_scene(scene);
+    o.width = (scene.camera.width / scale).max(1);
+    o.height = (scene.camera.height / scale).max(1);
+    let mut gi = PhotonMapOptions {
+        photons: PhotonConfig {
+            build,
+            faithful,
+            stencil_block: stencil_m,
+            // The paper aims no photons: it emits them all from the light.
+            projection_maps: !faithful,
+            ..PhotonConfig::default()
+        },
+        ..PhotonMapOptions::default()
+    };
+    gi.estimate.mode = mode;
+    // The paper's estimate, every photon in the sphere, so the times compare
+    // with the paper's (the default leak test costs RING about half again).
+    gi.estimate.leak = photonmap::render::radiance_estimate::LeakTest::None;
+    o.with_method(Method::PhotonMap(gi))
+}
+
+/// The median (the mean of the middle two of an even count; 0 of none).
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    if s.is_empty() {
+        0.0
+    } else if s.len() % 2 == 1 {
+        s[s.len() / 2]
+    } else {
+        0.5 * (s[s.len() / 2 - 1] + s[s.len() / 2])
+    }
+}
 
 impl TablesRun<'_> {
     fn table1_options(
