@@ -4,10 +4,12 @@
 //!
 //! Dependencies run one way: render -> photon -> scene -> gpu, and every one
 //! of them may use the leaf modules (error, layout, random, sampling, timing,
-//! image). `stress` sits above render. `twins` holds the plain-Rust twins of
-//! the kernels, built only for tests (the `twins` feature).
+//! image). `bench` (the benchmarks and the stress suite) sits above render.
+//! `twins` holds the plain-Rust twins of the kernels, built only for tests
+//! (the `twins` feature).
 #![deny(unsafe_code)]
 
+pub mod bench;
 pub mod error;
 pub mod gpu;
 pub mod image;
@@ -21,7 +23,6 @@ pub mod regress;
 pub mod render;
 pub mod sampling;
 pub mod scene;
-pub mod stress;
 pub mod timing;
 /// Plain-Rust twins of the GPU kernels, compiled only with the `twins`
 /// feature, which the package's own tests enable (a dev-dependency on itself),

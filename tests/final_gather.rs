@@ -137,7 +137,7 @@ fn final_gather_equals_its_cpu_twin() {
 fn final_gather_in_the_furnace_is_analytic() {
     let gpu = common::gpu();
     let scene = load_scene_str(
-        photonmap::stress::FURNACE,
+        include_str!("../scenes/tests/furnace.toml"),
         std::path::Path::new("furnace.toml"),
     )
     .unwrap();

@@ -294,7 +294,7 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
 fn igi_in_the_furnace_converges_to_the_analytic_answer() {
     let gpu = common::gpu();
     let scene = load_scene_str(
-        photonmap::stress::FURNACE,
+        include_str!("../scenes/tests/furnace.toml"),
         std::path::Path::new("furnace.toml"),
     )
     .unwrap();

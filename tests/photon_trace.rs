@@ -312,7 +312,8 @@ fn the_random_texture_traces_the_same_photons_as_the_hash() {
 fn bounces_stop_when_no_photon_is_left_and_the_image_does_not_change() {
     use photonmap::render::{render, RenderOptions};
     let gpu = common::gpu();
-    let text = photonmap::stress::FURNACE.replace("max_bounces = 24", "max_bounces = 64");
+    let text = include_str!("../scenes/tests/furnace.toml")
+        .replace("max_bounces = 24", "max_bounces = 64");
     let scene = load_scene_str(&text, std::path::Path::new("furnace64.toml")).unwrap();
     let options = |all: bool| {
         let mut o = RenderOptions::for_scene(&scene);

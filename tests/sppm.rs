@@ -154,7 +154,7 @@ fn mean_of(img: &Image) -> f64 {
 #[test]
 fn the_furnace_converges_to_its_analytic_value() {
     let scene = load_scene_str(
-        photonmap::stress::FURNACE,
+        include_str!("../scenes/tests/furnace.toml"),
         std::path::Path::new("furnace.toml"),
     )
     .unwrap();
@@ -305,13 +305,13 @@ fn sppm_agrees_with_an_independent_path_tracer() {
 /// pixel sees the area R^2 d(omega).
 #[test]
 fn the_radiance_of_a_closed_scene_integrates_to_the_lights_power() {
-    let base = photonmap::stress::FURNACE.replace(
+    let base = include_str!("../scenes/tests/furnace.toml").replace(
         "position = [0.0, 0.0, 0.0]\nintensity",
         "position = [0.35, 0.2, -0.15]\nintensity",
     );
     assert_ne!(
         base,
-        photonmap::stress::FURNACE,
+        include_str!("../scenes/tests/furnace.toml"),
         "the light moved off centre"
     );
     let faces = [
@@ -364,7 +364,7 @@ fn the_radiance_of_a_closed_scene_integrates_to_the_lights_power() {
 fn the_error_falls_with_the_slope_theory_predicts() {
     let gpu = common::gpu();
     let scene = load_scene_str(
-        photonmap::stress::FURNACE,
+        include_str!("../scenes/tests/furnace.toml"),
         std::path::Path::new("furnace.toml"),
     )
     .unwrap();

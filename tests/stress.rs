@@ -3,7 +3,7 @@
 
 mod common;
 
-use photonmap::stress::{run, Outcome};
+use photonmap::bench::stress::{run, Outcome};
 
 #[test]
 fn quick_stress_cases_pass_or_refuse_clearly() {
@@ -40,7 +40,7 @@ fn quick_stress_cases_pass_or_refuse_clearly() {
 #[test]
 fn the_furnace_holds_its_analytic_radiance() {
     let gpu = common::gpu();
-    let (mean, expected, tolerance, bad) = photonmap::stress::furnace(&gpu).unwrap();
+    let (mean, expected, tolerance, bad) = photonmap::bench::stress::furnace(&gpu).unwrap();
     assert!(bad.is_empty(), "non-finite values: {bad}");
     eprintln!("furnace: {mean:.5} against {expected:.5} +- {tolerance:.5}");
     assert!(

@@ -1,25 +1,20 @@
 //! The subcommands, one module each, and what they share: option groups
-//! (`args`), output checks, and the GPU.
+//! (`args`), output checks, and the GPU. The benchmarks (`bench ...`) and
+//! the two commands that measure against references (`reference`, `tables`)
+//! live together in `bench/`.
 
-pub mod accuracy;
 pub mod args;
 pub mod bench;
 pub mod compare;
 pub mod convert;
-pub mod differentials_bench;
-pub mod estimate_bench;
-pub mod igi_bench;
 pub mod info;
-pub mod meshes;
-pub mod mitsuba_bench;
 pub mod photons;
-pub mod plot;
 pub mod progress;
-pub mod reference;
 pub mod regress;
 pub mod render;
 pub mod scenes;
-pub mod tables;
+
+pub use bench::{reference, tables};
 
 use std::path::Path;
 

@@ -2,7 +2,6 @@
 //! tracing into frames of photon textures (section 2.1), and the two photon-map
 //! builds, bitonic merge sort + binary search (2.2.1) and stencil routing (2.2.2).
 
-pub mod bench;
 pub mod bitonic;
 pub mod build;
 pub mod differentials;

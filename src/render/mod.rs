@@ -20,7 +20,6 @@ pub mod photon_options;
 pub mod plan;
 pub mod radiance_estimate;
 pub mod radiosity;
-pub mod ray_rates;
 pub mod ray_trace;
 pub mod sample;
 pub mod search_work;

@@ -28,22 +28,22 @@ use photonmap::render::{
 };
 use photonmap::scene::Scene;
 
+use super::output::{folder, slug, write_json, BenchOutput};
 use super::reference::reference_options;
+use super::scene::{BenchScene, Loaded, SEED};
 
 #[derive(Args)]
 pub struct DifferentialsBenchArgs {
     #[command(flatten)]
-    pub scene: super::igi_bench::BenchScene,
+    pub scene: BenchScene,
     /// Fewer leaf sizes and footprint scales.
     #[arg(long)]
     pub quick: bool,
     /// Folder for each row's PNG (default photonmap-out/differentials/<scene>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    #[arg(long)]
-    pub json: bool,
-    #[arg(long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub output: BenchOutput,
 }
 
 /// One render.
@@ -110,7 +110,7 @@ struct Bench<'a> {
 
 impl Bench<'_> {
     fn options(&self) -> RenderOptions {
-        reference_options(self.scene, self.scale, 7)
+        reference_options(self.scene, self.scale, SEED)
     }
 
     /// The bench's options with photon differentials `d`.
@@ -161,7 +161,7 @@ impl Bench<'_> {
             }
             None => (None, None, None, None, None),
         };
-        let file = format!("{:02}_{}.png", self.rendered, super::igi_bench::slug(label));
+        let file = format!("{:02}_{}.png", self.rendered, slug(label));
         self.rendered += 1;
         write_atomically(&self.dir.join(file), &r.image.png_bytes()?)?;
         let pd = r.differentials();
@@ -196,13 +196,14 @@ impl Bench<'_> {
 }
 
 pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name, reference, scale) = super::igi_bench::scene_and_reference(&a.scene)?;
-    let gpu = super::gpu(platform)?;
-    let dir = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::out_dir("differentials").join(&name));
-    std::fs::create_dir_all(&dir)?;
+    let Loaded {
+        scene,
+        name,
+        reference,
+        scale,
+    } = a.scene.load()?;
+    let gpu = crate::cli::gpu(platform)?;
+    let dir = folder(a.out.as_deref(), "differentials", Some(&name))?;
     let mut bench = Bench {
         gpu: &gpu,
         scene: &scene,
@@ -210,7 +211,7 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
         reference: reference.as_ref().map(|(_, i)| i),
         indirect: None,
         dir: dir.clone(),
-        progress: Box::new(super::progress_lines(a.quiet)),
+        progress: Box::new(a.output.progress()),
         rendered: 0,
     };
     // The indirect pixels: the reference above the direct-only image.
@@ -260,16 +261,11 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
         leaf_sizes,
         k_pairs,
     };
-    write_atomically(
-        &dir.join("differentials.json"),
-        serde_json::to_string_pretty(&report)?.as_bytes(),
-    )?;
-    if a.json {
-        return super::print_json(&report);
-    }
-    print_table(&report);
-    eprintln!("wrote {}", dir.display());
-    Ok(())
+    write_json(&dir.join("differentials.json"), &report)?;
+    a.output.print(&report, |r| {
+        print_table(r);
+        eprintln!("wrote {}", dir.display());
+    })
 }
 
 /// Their Table 1: the map at s fixed to the automatic run's, with each leaf

@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 
@@ -16,27 +16,11 @@ use photonmap::gpu::Platform;
 use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
 use photonmap::render::{render, IgiOptions, Image, Method, RenderOptions, WithCausticMap};
-use photonmap::scene::{embedded, Scene};
 
-use super::accuracy::default_reference;
-use super::args::in_range;
-use super::reference::{read_reference, reference_options};
-
-/// The scene a method benchmark renders, and its reference.
-#[derive(Args)]
-pub struct BenchScene {
-    /// Scene file or embedded name.
-    #[arg(long, required_unless_present = "triangles")]
-    pub scene: Option<PathBuf>,
-    /// Render `bench meshes`'s stage instead, its ball a mesh of about this
-    /// many triangles (1024..=4194304).
-    #[arg(long, value_name = "N", value_parser = in_range(1024, 1 << 22), conflicts_with = "scene")]
-    pub triangles: Option<u32>,
-    /// SPPM reference EXR (default: the scene's, as `bench accuracy` finds it;
-    /// none for the mesh stage). Images render at its size.
-    #[arg(long)]
-    pub reference: Option<PathBuf>,
-}
+use super::output::{folder, slug, write_json, BenchOutput};
+use super::reference::reference_options;
+use super::scene::{BenchScene, Loaded, SEED};
+use crate::cli::args::in_range;
 
 #[derive(Args)]
 pub struct IgiBenchArgs {
@@ -48,10 +32,8 @@ pub struct IgiBenchArgs {
     /// Folder for each row's PNG (default photonmap-out/igi/<scene>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    #[arg(long)]
-    pub json: bool,
-    #[arg(long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub output: BenchOutput,
 }
 
 /// One configuration's render.
@@ -145,20 +127,21 @@ fn component(stage: &str) -> usize {
 }
 
 pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
-    let (scene, name, reference, scale) = scene_and_reference(&a.scene)?;
-    let gpu = super::gpu(platform)?;
-    let progress = super::progress_lines(a.quiet);
-    let dir = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::out_dir("igi").join(&name));
-    std::fs::create_dir_all(&dir)?;
+    let Loaded {
+        scene,
+        name,
+        reference,
+        scale,
+    } = a.scene.load()?;
+    let gpu = crate::cli::gpu(platform)?;
+    let progress = a.output.progress();
+    let dir = folder(a.out.as_deref(), "igi", Some(&name))?;
     let mut out = Vec::new();
     let mut canonical: Option<Image> = None;
     let all = rows(a.vpl_paths);
     for (i, (label, igi)) in all.iter().enumerate() {
         progress(&format!("{label} ({}/{})", i + 1, all.len()));
-        let o: RenderOptions = reference_options(&scene, scale, 7);
+        let o: RenderOptions = reference_options(&scene, scale, SEED);
         let map = o.method.photon_map().cloned().unwrap_or_default();
         let o = o.with_method(Method::Igi(WithCausticMap::from_map(map, igi.clone())));
         let r = render(&gpu, &scene, &o, &mut ())?;
@@ -206,59 +189,11 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
         renderer: gpu.capabilities().gl_renderer,
         rows: out,
     };
-    write_atomically(
-        &dir.join("igi.json"),
-        serde_json::to_string_pretty(&report)?.as_bytes(),
-    )?;
-    if a.json {
-        return super::print_json(&report);
-    }
-    print_table(&report);
-    eprintln!("wrote {}", dir.display());
-    Ok(())
-}
-
-/// The scene (a file or embedded name, or `bench meshes`' stage of about
-/// `triangles` triangles), its name, its SPPM reference when there is one
-/// (given, or the scene's as `bench accuracy` finds it; none for the stage),
-/// and the reference's scale below the scene's resolution.
-#[allow(clippy::type_complexity)]
-pub(super) fn scene_and_reference(
-    s: &BenchScene,
-) -> Result<(Scene, String, Option<(PathBuf, Image)>, u32)> {
-    let (a_scene, triangles, reference) = (&s.scene, s.triangles, &s.reference);
-    let (scene, name): (Scene, String) = match (triangles, a_scene) {
-        (Some(n), _) => (super::meshes::stage(n)?, format!("stage_{n}")),
-        (None, Some(s)) => (embedded::load_path_or_name(s)?, super::accuracy::stem(s)),
-        (None, None) => bail!("give --scene or --triangles"),
-    };
-    let reference = match (reference, a_scene) {
-        (Some(r), _) => Some(r.clone()),
-        (None, Some(s)) if triangles.is_none() => {
-            Some(default_reference(s)).filter(|r| r.is_file())
-        }
-        _ => None,
-    };
-    let reference = reference
-        .map(|r| -> Result<(PathBuf, Image)> { Ok((r.clone(), read_reference(&r)?.0)) })
-        .transpose()?;
-    let scale = match &reference {
-        Some((path, img)) => {
-            if img.width == 0 || !scene.camera.width.is_multiple_of(img.width) {
-                bail!(
-                    "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
-                    path.display(),
-                    img.width,
-                    img.height,
-                    scene.camera.width,
-                    scene.camera.height
-                );
-            }
-            scene.camera.width / img.width
-        }
-        None => 1,
-    };
-    Ok((scene, name, reference, scale))
+    write_json(&dir.join("igi.json"), &report)?;
+    a.output.print(&report, |r| {
+        print_table(r);
+        eprintln!("wrote {}", dir.display());
+    })
 }
 
 fn print_table(report: &IgiBench) {
@@ -294,21 +229,4 @@ fn print_table(report: &IgiBench) {
             r.rmse_to_canonical
         );
     }
-}
-
-pub(super) fn slug(label: &str) -> String {
-    label
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '_'
-            }
-        })
-        .collect::<String>()
-        .split('_')
-        .filter(|s| !s.is_empty())
-        .collect::<Vec<_>>()
-        .join("_")
 }

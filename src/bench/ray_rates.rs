@@ -7,12 +7,9 @@ use serde::Serialize;
 
 use crate::gpu::{Gpu, Result};
 use crate::photon::PhotonTracer;
+use crate::render::{DirectLight, PassPlan, RayTracer, RenderOptions};
 use crate::scene::pack::SceneTextures;
 use crate::scene::{Material, Scene};
-
-use super::direct::DirectLight;
-use super::ray_trace::RayTracer;
-use super::{PassPlan, RenderOptions};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RayRates {

@@ -5,10 +5,9 @@
 use glam::Vec3;
 
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
-use crate::timing::Timings;
-
-use super::bitonic::{sort_texture_size, BitonicBuild};
-use super::{Grid, PhotonFrames, StencilRouting, VertexFeed};
+use crate::photon::bitonic::{sort_texture_size, BitonicBuild};
+use crate::photon::{Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
+use crate::timing::{StageTiming, Timings};
 
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct BuildBenchRow {
@@ -69,6 +68,15 @@ fn stage(t: &Timings, name: &str) -> f64 {
         .sum()
 }
 
+/// The sort's stage of a bitonic build.
+fn sort_stage(t: &Timings) -> StageTiming {
+    t.stages
+        .iter()
+        .find(|s| s.name == "bitonic sort")
+        .cloned()
+        .unwrap_or_default()
+}
+
 /// Benchmarks one size. `grid` is the paper's ~40^3 cells; `block` is m.
 pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBenchRow> {
     let frames = synthetic_frames(gpu, n, 0x5eed)?;
@@ -79,12 +87,7 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     bitonic.build(&frames, grid, &mut Timings::default())?;
     let mut t = Timings::default();
     bitonic.build(&frames, grid, &mut t)?;
-    let sort = t
-        .stages
-        .iter()
-        .find(|s| s.name == "bitonic sort")
-        .cloned()
-        .unwrap_or_default();
+    let sort = sort_stage(&t);
 
     // Copy passes over the same RGBA32I texture, ping-ponged like the sort (each
     // reads what the last wrote), as many as the sort has passes.
@@ -147,12 +150,7 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     fused.build(&frames, grid, &mut Timings::default())?;
     let mut tf = Timings::default();
     fused.build(&frames, grid, &mut tf)?;
-    let fused_sort = tf
-        .stages
-        .iter()
-        .find(|s| s.name == "bitonic sort")
-        .cloned()
-        .unwrap_or_default();
+    let fused_sort = sort_stage(&tf);
     Ok(BuildBenchRow {
         photons: n,
         bitonic_passes: sort.passes as u32,
@@ -187,71 +185,6 @@ pub fn paper_grid() -> Grid {
         min: Vec3::ZERO,
         max: Vec3::ONE,
         resolution: [40, 40, 40],
-        storage: super::GridStorage::Uniform,
+        storage: GridStorage::Uniform,
     }
-}
-
-/// One row of `bench mask`: an expensive full-screen pass with a share of its
-/// pixels masked by the stencil test.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct MaskBenchRow {
-    pub masked_fraction: f64,
-    /// Masked pixels in one block (the left of the image) or spread evenly.
-    pub contiguous: bool,
-    pub stencil_test: bool,
-    pub wall_seconds: f64,
-    /// wall_seconds / the unmasked pass's: 1 - masked_fraction if masked work is skipped.
-    pub relative: f64,
-}
-
-/// Does the stencil test skip fragment work on this driver? Times a heavy pass
-/// over `size` x `size` pixels with 0%, 50% and 90% of them masked.
-pub fn bench_mask(gpu: &Gpu, size: u32, iterations: i32) -> Result<Vec<MaskBenchRow>> {
-    let tex = Texture::new(gpu, size, size, TexFormat::Rgba32F)?;
-    let target = Target::with_stencil(gpu, &[&tex])?;
-    let heavy = Program::fullscreen(gpu, "bench/heavy.frag")?;
-    let pattern = Program::fullscreen(gpu, "bench/mask_pattern.frag")?;
-    let run = |tenths: i32, contiguous: bool, stencil: bool| -> Result<f64> {
-        target.clear_depth_stencil(1.0, 0);
-        let state = if stencil {
-            pattern
-                .bind()
-                .int("u_masked_tenths", tenths)
-                .int("u_contiguous", contiguous as i32)
-                .int("u_width", size as i32)
-                .draw_fullscreen(&target, &DrawState::stencil_replace(1))?;
-            DrawState::where_stencil_equals(0)
-        } else {
-            DrawState::PLAIN
-        };
-        gpu.finish();
-        let t0 = std::time::Instant::now();
-        heavy
-            .bind()
-            .int("u_iterations", iterations)
-            .draw_fullscreen(&target, &state)?;
-        gpu.finish();
-        Ok(t0.elapsed().as_secs_f64())
-    };
-    run(0, false, false)?; // warm-up: compile and first touch
-    let base = run(0, false, false)?;
-    let mut rows = vec![MaskBenchRow {
-        masked_fraction: 0.0,
-        contiguous: false,
-        stencil_test: false,
-        wall_seconds: base,
-        relative: 1.0,
-    }];
-    for (tenths, contiguous) in [(0, false), (5, false), (9, false), (5, true), (9, true)] {
-        let s = run(tenths, contiguous, true)?;
-        rows.push(MaskBenchRow {
-            masked_fraction: tenths as f64 / 10.0,
-            contiguous,
-            stencil_test: true,
-            wall_seconds: s,
-            relative: s / base,
-        });
-    }
-    gpu.check("mask benchmark")?;
-    Ok(rows)
 }

@@ -21,7 +21,8 @@ use photonmap::render::{Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::Scene;
 use photonmap::timing::Timings;
 
-use super::args::in_range;
+use super::output::stem;
+use crate::cli::args::{in_range, SceneArgs};
 
 /// Render a reference of a scene by SPPM (it converges to the exact image):
 /// two independent halves averaged, as EXR, with a JSON of its command, its
@@ -29,7 +30,7 @@ use super::args::in_range;
 #[derive(Args)]
 pub struct ReferenceArgs {
     #[command(flatten)]
-    pub scene: super::args::SceneArgs,
+    pub scene: SceneArgs,
     /// Output EXR (default: photonmap-out/reference/<scene>.sppm.exr under the
     /// current folder; a .json goes beside it).
     #[arg(long)]
@@ -76,7 +77,7 @@ pub struct ReferenceInfo {
 pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
     let scene = a.scene.load()?.scene;
     let out = a.out.clone().unwrap_or_else(|| {
-        super::out_dir("reference").join(format!("{}.sppm.exr", stem(&a.scene.scene)))
+        crate::cli::out_dir("reference").join(format!("{}.sppm.exr", stem(&a.scene.scene)))
     });
     if let Some(dir) = out
         .parent()
@@ -84,8 +85,8 @@ pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
     {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    super::check_output(&out, "exr", "--out")?;
-    let gpu = super::gpu(platform)?;
+    crate::cli::check_output(&out, "exr", "--out")?;
+    let gpu = crate::cli::gpu(platform)?;
     let mut command = format!(
         "photonmap reference {} --scale {} --iterations {} --photons-per-iteration {}",
         a.scene.scene.display(),
@@ -99,7 +100,7 @@ pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
     for (k, v) in &a.scene.set {
         command += &format!(" --set {k}={v}");
     }
-    let progress = super::progress_lines(a.quiet);
+    let progress = crate::cli::progress_lines(a.quiet);
     let (img, info) = make_reference(&gpu, &scene, a, command, &progress)?;
     write_reference(&img, &info, &out)?;
     let bias = info.bias.as_ref().expect("a new reference has its bias");
@@ -116,13 +117,6 @@ pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
         }
     );
     Ok(())
-}
-
-fn stem(scene: &Path) -> String {
-    scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
 }
 
 /// The size and seed every reference half runs with (and the visibility leak
@@ -475,9 +469,10 @@ mod tests {
 
     #[test]
     fn old_references_still_read_and_new_ones_round_trip() {
-        let old: ReferenceInfo =
-            serde_json::from_str(include_str!("../../reference_images/glass_ball.sppm.json"))
-                .unwrap();
+        let old: ReferenceInfo = serde_json::from_str(include_str!(
+            "../../../reference_images/glass_ball.sppm.json"
+        ))
+        .unwrap();
         assert!(old.bias.is_none());
         let (q, f, _) = synthetic(16, 16, |_, _, _| 0.01, 5);
         let info = ReferenceInfo {

@@ -20,21 +20,21 @@ use photonmap::render::search_work::SearchWork;
 use photonmap::render::{render, EstimateMode, Image};
 use photonmap::scene::{embedded, Scene};
 
+use super::output::BenchOutput;
+
 #[derive(Args)]
 pub struct EstimateBenchArgs {
     /// Scenes (files or embedded names; default the paper's three).
     #[arg(long, num_args = 1.., default_values_t = ["glass_ball".to_string(), "ring".into(), "cornell_box".into()])]
     pub scene: Vec<String>,
     /// Timed runs per variant, median quoted (1..=20).
-    #[arg(long, default_value_t = 3, value_parser = super::args::in_range(1, 20))]
+    #[arg(long, default_value_t = 3, value_parser = crate::cli::args::in_range(1, 20))]
     pub runs: u32,
     /// Skip the profiled run (lane use).
     #[arg(long)]
     pub no_lanes: bool,
-    #[arg(long)]
-    pub json: bool,
-    #[arg(long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub output: BenchOutput,
 }
 
 /// A way of running the same search.
@@ -113,8 +113,8 @@ pub struct EstimateBench {
 }
 
 pub fn run(a: &EstimateBenchArgs, platform: Platform) -> Result<()> {
-    let gpu = super::gpu(platform)?;
-    let say = super::progress_lines(a.quiet);
+    let gpu = crate::cli::gpu(platform)?;
+    let say = a.output.progress();
     let mut rows = Vec::new();
     for name in &a.scene {
         let scene = embedded::load_path_or_name(std::path::Path::new(name))?;
@@ -125,11 +125,7 @@ pub fn run(a: &EstimateBenchArgs, platform: Platform) -> Result<()> {
         command: std::env::args().collect::<Vec<_>>().join(" "),
         rows,
     };
-    if a.json {
-        super::print_json(&bench)?;
-    } else {
-        print_table(&bench);
-    }
+    a.output.print(&bench, print_table)?;
     if let Some(r) = bench.rows.iter().find(|r| !r.identical) {
         bail!(
             "{}: the {} search's image differs from the paper search's",

@@ -11,12 +11,15 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 
+use photonmap::bench::ray_rates;
 use photonmap::gpu::Platform;
-use photonmap::render::{ray_rates, render, RenderOptions};
+use photonmap::image::write_atomically;
+use photonmap::render::{render, RenderOptions};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{bvh, embedded, generate, Geometry, Scene};
 
-use super::args::in_range;
+use super::output::{folder, write_json};
+use crate::cli::args::in_range;
 
 #[derive(Args)]
 pub struct MeshesArgs {
@@ -39,6 +42,7 @@ pub struct MeshesArgs {
     /// Folder for meshes.json, meshes.svg and the renders (default photonmap-out/meshes).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// The report on stdout as JSON, not a table.
     #[arg(long)]
     pub json: bool,
 }
@@ -97,9 +101,8 @@ pub fn stage(triangles: u32) -> Result<Scene> {
 }
 
 pub fn run(a: &MeshesArgs, platform: Platform) -> Result<()> {
-    let gpu = super::gpu(platform)?;
-    let out = a.out.clone().unwrap_or_else(|| super::out_dir("meshes"));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let gpu = crate::cli::gpu(platform)?;
+    let out = folder(a.out.as_deref(), "meshes", None)?;
     let mut provenance = photonmap::provenance::Provenance::program();
     provenance.scene = "variants/mesh_stage".into();
     (provenance.width, provenance.height) = (a.width, a.height);
@@ -144,17 +147,16 @@ pub fn run(a: &MeshesArgs, platform: Platform) -> Result<()> {
         rows.push(row);
     }
     let report = MeshReport {
-        provenance: super::with_driver(provenance, &gpu),
+        provenance: crate::cli::with_driver(provenance, &gpu),
         width: a.width,
         height: a.height,
         photons: a.photons,
         rows,
     };
-    let json = serde_json::to_string_pretty(&report)?;
-    photonmap::image::write_atomically(&out.join("meshes.json"), json.as_bytes())?;
-    photonmap::image::write_atomically(&out.join("meshes.svg"), svg_plot(&report).as_bytes())?;
+    write_json(&out.join("meshes.json"), &report)?;
+    write_atomically(&out.join("meshes.svg"), svg_plot(&report).as_bytes())?;
     if a.json {
-        println!("{json}");
+        crate::cli::print_json(&report)?;
     } else {
         eprintln!(
             "wrote {}/meshes.json, meshes.svg and the renders",
@@ -172,14 +174,7 @@ fn measure_row(
 ) -> Result<MeshRow> {
     let mut scene = stage(n)?;
     (scene.camera.width, scene.camera.height) = (a.width, a.height);
-    let mut build_seconds = f64::INFINITY;
-    let mut tree = None;
-    for _ in 0..3 {
-        let start = Instant::now();
-        tree = Some(bvh::build(&scene)?);
-        build_seconds = build_seconds.min(start.elapsed().as_secs_f64());
-    }
-    let tree = tree.expect("built three times");
+    let (build_seconds, tree) = fastest(3, || bvh::build(&scene))?;
     let start = Instant::now();
     let textures = SceneTextures::with_bvh(gpu, &scene, &tree)?;
     let upload_seconds = start.elapsed().as_secs_f64();
@@ -188,7 +183,7 @@ fn measure_row(
     let (mut render_seconds, mut direct_only_seconds) = (None, None);
     if !a.no_render {
         let options = RenderOptions::for_scene(&scene);
-        let (seconds, full) = fastest_of_two(|| render(gpu, &scene, &options, &mut ()))?;
+        let (seconds, full) = fastest(2, || render(gpu, &scene, &options, &mut ()))?;
         render_seconds = Some(seconds);
         let name = if n == 0 {
             "analytic".into()
@@ -196,9 +191,9 @@ fn measure_row(
             format!("{n}")
         };
         let png = full.image.png_bytes()?;
-        photonmap::image::write_atomically(&out.join(format!("render_{name}.png")), &png)?;
+        write_atomically(&out.join(format!("render_{name}.png")), &png)?;
         let direct = options.direct_only();
-        direct_only_seconds = Some(fastest_of_two(|| render(gpu, &scene, &direct, &mut ()))?.0);
+        direct_only_seconds = Some(fastest(2, || render(gpu, &scene, &direct, &mut ()))?.0);
     }
     Ok(MeshRow {
         // What the generator made of the count asked for.
@@ -221,19 +216,19 @@ fn measure_row(
     })
 }
 
-/// The faster of two runs (the first pays the shader compiler), and its result.
-fn fastest_of_two<T>(mut f: impl FnMut() -> photonmap::error::Result<T>) -> Result<(f64, T)> {
-    let start = Instant::now();
-    let first = f()?;
-    let once = start.elapsed().as_secs_f64();
-    let start = Instant::now();
-    let second = f()?;
-    let twice = start.elapsed().as_secs_f64();
-    Ok(if twice <= once {
-        (twice, second)
-    } else {
-        (once, first)
-    })
+/// The fastest of `runs` runs of `f` (the first pays the shader compiler),
+/// and its result (the later run's on a tie).
+fn fastest<T>(runs: u32, mut f: impl FnMut() -> photonmap::error::Result<T>) -> Result<(f64, T)> {
+    let mut best: Option<(f64, T)> = None;
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let value = f()?;
+        let seconds = start.elapsed().as_secs_f64();
+        if best.as_ref().is_none_or(|(fastest, _)| seconds <= *fastest) {
+            best = Some((seconds, value));
+        }
+    }
+    Ok(best.expect("at least one run"))
 }
 
 /// Render seconds (full and direct only) against triangles, log-log; the

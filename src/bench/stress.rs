@@ -81,30 +81,27 @@ pub fn transformed(scene: &Scene, s: f32, t: Vec3) -> Scene {
         shape.geometry = shape.geometry.scaled(s, p);
     }
     for light in &mut out.lights {
-        *light = match *light {
+        match light {
             Light::Area {
                 corner,
                 edge1,
                 edge2,
-                normal,
-                radiance,
-            } => Light::Area {
-                corner: p(corner),
-                edge1: edge1 * s,
-                edge2: edge2 * s,
-                normal,
-                radiance,
-            },
+                ..
+            } => {
+                *corner = p(*corner);
+                *edge1 *= s;
+                *edge2 *= s;
+            }
             Light::Point {
                 position,
                 intensity,
-            } => Light::Point {
-                position: p(position),
-                intensity: intensity * s * s,
-            },
+            } => {
+                *position = p(*position);
+                *intensity = *intensity * s * s;
+            }
             // Its triangles are shapes, moved above.
-            Light::Triangles { .. } => *light,
-        };
+            Light::Triangles { .. } => {}
+        }
     }
     out.photon_map.max_radius *= s;
     out.photon_map.grid_bounds = scene.photon_map.grid_bounds.map(|(lo, hi)| (p(lo), p(hi)));
@@ -156,35 +153,24 @@ fn verdict(ok: bool, bad: &str, detail: String) -> (Outcome, String) {
 
 /// A closed diffuse sphere of albedo rho and radius R lit by a point light of
 /// intensity I at its centre: every wall point has L = rho I / (pi R^2 (1 - rho))
-/// (direct rho I / (pi R^2) by shadow rays, the rest by photons).
-pub const FURNACE: &str = r#"
-[camera]
-position = [0.0, 0.0, 0.5]
-look_at = [0.0, 0.0, -1.0]
-vfov = 60.0
-width = 48
-height = 48
-[photon_map]
-photons_stored = 60000
-grid_resolution = [24, 24, 24]
-k = 100
-max_radius = 0.3
-max_bounces = 24
-[materials]
-wall = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
-[[shape]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-material = "wall"
-[[light]]
-type = "point"
-position = [0.0, 0.0, 0.0]
-intensity = [1.0, 1.0, 1.0]
-"#;
+/// (direct rho I / (pi R^2) by shadow rays, the rest by photons). The embedded
+/// scene scenes/tests/furnace.toml, which tests read as well.
+const FURNACE: &str = "tests/furnace";
+
+/// The text of the embedded scene `name`, or an error naming its file.
+fn embedded_text(name: &str) -> Result<&'static str> {
+    embedded::source(name).ok_or_else(|| {
+        Error::from(crate::error::SceneError {
+            file: format!("scenes/{name}.toml").into(),
+            line: 0,
+            field: "(file)".into(),
+            message: "no embedded source".into(),
+        })
+    })
+}
 
 pub fn furnace(gpu: &Gpu) -> Result<(f64, f64, f64, String)> {
-    let scene = load_scene_str(FURNACE, std::path::Path::new("furnace.toml"))?;
+    let scene = embedded::load(FURNACE)?;
     let (out, bad) = finite_render(gpu, &scene, &small(&scene, 48, 48, 3))?;
     let mean = out.image.mean()[0];
     let (rho, k) = (0.5f64, scene.photon_map.k as f64);
@@ -301,14 +287,7 @@ fn placed(name: &str, scene: &Scene, placement: Placement) -> Result<Scene> {
     match placement {
         Placement::Scaled(s) => Ok(transformed(scene, s, Vec3::ZERO)),
         Placement::Moved(d, rebase) => {
-            let text = embedded::source(name).ok_or_else(|| {
-                Error::from(crate::error::SceneError {
-                    file: format!("scenes/{name}.toml").into(),
-                    line: 0,
-                    field: "(file)".into(),
-                    message: "no embedded source".into(),
-                })
-            })?;
+            let text = embedded_text(name)?;
             let file = format!("scenes/{name}.toml");
             let t = DVec3::new(d, -d, d);
             Ok(load_scene_str_translated(
@@ -549,7 +528,7 @@ fn bad_input(gpu: &Gpu, cases: &mut Vec<StressCase>) {
         "an empty photon map (no diffuse surface)",
         "-",
         || {
-            let text = FURNACE.replace(
+            let text = embedded_text(FURNACE)?.replace(
                 "type = \"diffuse\", albedo = [0.5, 0.5, 0.5]",
                 "type = \"mirror\", reflectance = [0.5, 0.5, 0.5]",
             );
@@ -568,13 +547,13 @@ fn bad_input(gpu: &Gpu, cases: &mut Vec<StressCase>) {
 
 /// Paths: photons trapped in glass, coincident surfaces, grazing views.
 fn difficult_paths(gpu: &Gpu, cases: &mut Vec<StressCase>) {
-    let trapped = FURNACE.replace("type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }", "type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\nglass = { type = \"glass\", ior = 9.0 }")
-        + "[[shape]]\ntype = \"sphere\"\ncenter = [0.3, 0.0, -0.4]\nradius = 0.25\nmaterial = \"glass\"\n[[shape]]\ntype = \"parallelogram\"\ncorner = [-0.5, -0.5, -0.6]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [0.0, 1.0, 0.0]\nmaterial = \"wall\"\n[[shape]]\ntype = \"parallelogram\"\ncorner = [-0.5, -0.5, -0.6]\nedge1 = [0.0, 1.0, 0.0]\nedge2 = [1.0, 0.0, 0.0]\nmaterial = \"wall\"\n";
     let figure = "mean image radiance";
     cases.push(case(
         "glass of ior 9 (total internal reflection, trapped photons), coincident surfaces",
         figure,
         || {
+            let trapped = embedded_text(FURNACE)?.replace("type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }", "type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\nglass = { type = \"glass\", ior = 9.0 }")
+        + "[[shape]]\ntype = \"sphere\"\ncenter = [0.3, 0.0, -0.4]\nradius = 0.25\nmaterial = \"glass\"\n[[shape]]\ntype = \"parallelogram\"\ncorner = [-0.5, -0.5, -0.6]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [0.0, 1.0, 0.0]\nmaterial = \"wall\"\n[[shape]]\ntype = \"parallelogram\"\ncorner = [-0.5, -0.5, -0.6]\nedge1 = [0.0, 1.0, 0.0]\nedge2 = [1.0, 0.0, 0.0]\nmaterial = \"wall\"\n";
             let scene = load_scene_str(&trapped, std::path::Path::new("trapped.toml"))?;
             let (out, bad) = finite_render(gpu, &scene, &small(&scene, 48, 48, 1))?;
             let (o, m) = verdict(true, &bad, String::new());

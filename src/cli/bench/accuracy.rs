@@ -22,7 +22,9 @@ use photonmap::render::{
 };
 use photonmap::scene::{embedded, Light, Scene};
 
+use super::output::{folder, stem, write_json, BenchOutput};
 use super::reference::{read_reference, reference_options, ReferenceInfo};
+use super::scene::{default_reference, reference_scale, SEED};
 
 /// `bench accuracy`'s options.
 #[derive(Args)]
@@ -42,16 +44,14 @@ pub struct AccuracyArgs {
     #[arg(long)]
     pub quick: bool,
     /// Seeds per configuration (2..=64; default 4, or 2 with --quick).
-    #[arg(long, value_parser = super::args::in_range(2, 64))]
+    #[arg(long, value_parser = crate::cli::args::in_range(2, 64))]
     pub seeds: Option<u32>,
     /// Only the runs whose label contains this text (e.g. "scene defaults",
     /// "SPPM", "max radius"); repeat it for the runs matching any.
     #[arg(long, value_name = "TEXT")]
     pub only: Vec<String>,
-    #[arg(long)]
-    pub json: bool,
-    #[arg(long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub output: BenchOutput,
 }
 
 /// One configuration's renders against the reference.
@@ -157,6 +157,15 @@ impl Config {
         f(&mut c.run);
         c
     }
+
+    /// This run by another method, at `spp` eye samples, with its options set by `f`.
+    fn by(&self, label: &str, method: &str, spp: u32, f: impl FnOnce(&mut AccuracyRun)) -> Self {
+        self.with(label.into(), |r| {
+            r.method = method.into();
+            r.spp = spp;
+            f(r);
+        })
+    }
 }
 
 /// The sweep: one parameter at a time around the scene's defaults, the leak
@@ -207,13 +216,11 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     if !scene.photon_map.caustics_only {
         // 16 rays already take 15 times the scene defaults in CORNELL BOX.
         for rays in if quick { vec![4] } else { vec![4, 16] } {
-            out.push(base.with(format!("final gather {rays} rays"), |r| {
-                r.method = "final-gather".into();
-                r.gather_rays = rays;
-            }));
+            let label = format!("final gather {rays} rays");
+            out.push(base.by(&label, "final-gather", 1, |r| r.gather_rays = rays));
         }
-        out.push(base.with("final gather 16 rays, adaptive".into(), |r| {
-            r.method = "final-gather".into();
+        let label = "final gather 16 rays, adaptive";
+        out.push(base.by(label, "final-gather", 1, |r| {
             r.gather_rays = 16;
             r.adaptive = true;
         }));
@@ -229,10 +236,8 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     } else {
         vec![4, 16, 64, 256]
     } {
-        out.push(base.with(format!("SPPM {it} iterations"), |r| {
-            r.method = "sppm".into();
-            r.sppm_iterations = it;
-        }));
+        let label = format!("SPPM {it} iterations");
+        out.push(base.by(&label, "sppm", 1, |r| r.sppm_iterations = it));
     }
     out.extend(igi_rows(&base, quick));
     out.extend(differentials_rows(&base, quick));
@@ -243,8 +248,8 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     // Adaptive SPPM (a pilot of an eighth of the iterations, then the
     // gather only where the plan computes), beside the full runs above.
     for it in if quick { vec![16] } else { vec![16, 64] } {
-        out.push(base.with(format!("SPPM {it} iterations, adaptive"), |r| {
-            r.method = "sppm".into();
+        let label = format!("SPPM {it} iterations, adaptive");
+        out.push(base.by(&label, "sppm", 1, |r| {
             r.sppm_iterations = it;
             r.adaptive = true;
         }));
@@ -260,8 +265,7 @@ fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
 fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     let mut out = Vec::new();
     let igi = |label: &str, f: &dyn Fn(&mut IgiOptions)| {
-        base.with(label.into(), |r| {
-            r.method = "igi".into();
+        base.by(label, "igi", 1, |r| {
             let mut o = IgiOptions::default();
             f(&mut o);
             r.igi = Some(o);
@@ -313,13 +317,11 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// times the photons, the Epanechnikov kernel, and 4 spp.
 fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     let pd = |label: &str, kernel: Kernel, spp: u32| {
-        base.with(label.into(), |r| {
-            r.method = "differentials".into();
-            r.spp = spp;
+        base.by(label, "differentials", spp, |r| {
             r.differentials = Some(DifferentialsOptions {
                 kernel,
                 ..DifferentialsOptions::default()
-            });
+            })
         })
     };
     let mut out = vec![pd("differentials", Kernel::Constant, 1)];
@@ -338,13 +340,11 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, resolution: u32, spp: u32| {
-        base.with(label.into(), |r| {
-            r.method = "radiosity".into();
-            r.spp = spp;
+        base.by(label, "radiosity", spp, |r| {
             r.radiosity = Some(RadiosityOptions {
                 resolution,
                 ..RadiosityOptions::default()
-            });
+            })
         })
     };
     let mut out = vec![rad("radiosity", 16, 1)];
@@ -368,7 +368,7 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
             a.scene.display()
         );
     }
-    let gpu = super::gpu(platform)?;
+    let gpu = crate::cli::gpu(platform)?;
     let seeds = a.seeds.unwrap_or(if a.quick { 2 } else { 4 });
     let report = bench_accuracy(
         &gpu,
@@ -377,66 +377,40 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
         a.quick,
         seeds,
         &a.only,
-        &super::progress_lines(a.quiet),
+        &a.output.progress(),
     )?;
-    let dir = a
-        .out
-        .clone()
-        .unwrap_or_else(|| super::out_dir("accuracy").join(stem(&a.scene)));
-    std::fs::create_dir_all(&dir)?;
+    let dir = folder(a.out.as_deref(), "accuracy", Some(&stem(&a.scene)))?;
     let write = |name: &str, bytes: &[u8]| write_atomically(&dir.join(name), bytes);
     write("accuracy.csv", csv(&report).as_bytes())?;
-    write(
-        "accuracy.json",
-        serde_json::to_string_pretty(&report)?.as_bytes(),
-    )?;
+    write_json(&dir.join("accuracy.json"), &report)?;
     write("accuracy.svg", svg_plot(&report).as_bytes())?;
     write("accuracy.png", &png_plot(&report))?;
     if let Some(map) = &report.bias_map {
         write("bias.png", &map.png_bytes()?)?;
     }
-    if a.json {
-        super::print_json(&report)?;
-    } else {
-        println!(
-            "{:<26} {:>8} {:>9} {:>9} {:>9} {:>7} {:>5}",
-            "run", "seconds", "RMSE", "bias", "noise", "SSIM", "front"
-        );
-        for r in &report.runs {
-            println!(
-                "{:<26} {:>8.3} {:>9.5} {:>9.5} {:>9.5} {:>7.4} {:>5}",
-                r.label,
-                r.seconds,
-                r.rmse,
-                r.bias_rmse,
-                r.noise_rmse,
-                r.ssim,
-                if r.on_pareto_front { "*" } else { "" }
-            );
-        }
-        println!("recommended: {}", report.recommended);
-    }
+    a.output.print(&report, print_table)?;
     eprintln!("wrote {}", dir.display());
     Ok(())
 }
 
-pub fn stem(scene: &Path) -> String {
-    scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
-}
-
-/// The reference `bench accuracy` looks for: photonmap-out/reference/ first,
-/// then the committed reference_images/.
-pub fn default_reference(scene: &Path) -> PathBuf {
-    let name = format!("{}.sppm.exr", stem(scene));
-    let made = super::out_dir("reference").join(&name);
-    if made.is_file() {
-        made
-    } else {
-        PathBuf::from("reference_images").join(name)
+fn print_table(report: &AccuracyReport) {
+    println!(
+        "{:<26} {:>8} {:>9} {:>9} {:>9} {:>7} {:>5}",
+        "run", "seconds", "RMSE", "bias", "noise", "SSIM", "front"
+    );
+    for r in &report.runs {
+        println!(
+            "{:<26} {:>8.3} {:>9.5} {:>9.5} {:>9.5} {:>7.4} {:>5}",
+            r.label,
+            r.seconds,
+            r.rmse,
+            r.bias_rmse,
+            r.noise_rmse,
+            r.ssim,
+            if r.on_pareto_front { "*" } else { "" }
+        );
     }
+    println!("recommended: {}", report.recommended);
 }
 
 /// One render of a configuration with `seed`: its image and wall seconds.
@@ -499,17 +473,7 @@ pub fn bench_accuracy(
     progress: &dyn Fn(&str),
 ) -> Result<AccuracyReport> {
     let (reference_img, info) = read_reference(reference)?;
-    if reference_img.width == 0 || !scene.camera.width.is_multiple_of(reference_img.width) {
-        bail!(
-            "{}: {} x {} pixels is not the scene's {} x {} divided by a whole number",
-            reference.display(),
-            reference_img.width,
-            reference_img.height,
-            scene.camera.width,
-            scene.camera.height
-        );
-    }
-    let scale = scene.camera.width / reference_img.width;
+    let scale = reference_scale(reference, &reference_img, scene)?;
     let mut configs = sweep(scene, quick);
     if !only.is_empty() {
         let labels: Vec<String> = configs.iter().map(|c| c.run.label.clone()).collect();
@@ -528,7 +492,7 @@ pub fn bench_accuracy(
         let mut images = Vec::new();
         let mut seconds = 0.0;
         for seed in 0..seeds {
-            let (img, s) = render_config(gpu, scene, &c.run, scale, 7 + seed)?;
+            let (img, s) = render_config(gpu, scene, &c.run, scale, SEED + seed)?;
             images.push(img);
             seconds += s;
         }
