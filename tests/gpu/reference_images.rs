@@ -10,7 +10,7 @@
 //! changes (a point light's shadow edge), far below any visible change.
 //! Regenerate only on purpose: PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test reference_images
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

@@ -1,7 +1,7 @@
 //! The quick stress cases on the real pipeline: none may fail, the impossible
 //! ones are refused with a clear message, and the furnace holds its analytic value.
 
-mod common;
+use crate::common;
 
 use photonmap::stress::{run, Outcome};
 

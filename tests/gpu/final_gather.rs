@@ -2,7 +2,7 @@
 //! global map's estimates at their hits equal the CPU twin on the same
 //! photons, and the method converges to an analytic answer.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::photon::PhotonConfig;

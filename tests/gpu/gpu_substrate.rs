@@ -1,7 +1,7 @@
 //! The substrate on the real pipeline: exact read-back, ping-pong, integer
 //! addressing, shader errors located in glsl/, and every GLSL file compiling.
 
-mod common;
+use crate::common;
 
 use photonmap::gpu::program::glsl_files;
 use photonmap::gpu::{DrawState, Error, PingPong, Program, Target, TexFormat, Texture};

@@ -1,7 +1,7 @@
 //! Breadth-first photon tracing on the GPU against the CPU twin fed the same
 //! random numbers, photon by photon, and stored flux against a closed form.
 
-mod common;
+use crate::common;
 
 use glam::{Vec3, Vec4};
 use photonmap::photon::{PhotonTracer, RandomSource, TraceConfig};

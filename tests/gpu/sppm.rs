@@ -2,7 +2,7 @@
 //! its CPU twin, and the method converges to the exact answer, shown against
 //! analytic scenes and against an independent CPU path tracer.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, PhotonConfig};

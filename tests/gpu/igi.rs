@@ -4,7 +4,7 @@
 //! the furnace, unbounded and with exact visibility, IGI converges to the
 //! analytic answer as the VPL paths grow.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::reference::igi::{incident, Vpl};

@@ -3,9 +3,9 @@
 //! and watertightness: no ray and no photon leaves a closed mesh through the
 //! edges its triangles share.
 
-mod common;
+use crate::common;
 
-use common::Rng;
+use crate::common::Rng;
 
 use glam::{DVec3, Vec3};
 use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};

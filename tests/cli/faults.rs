@@ -4,7 +4,7 @@
 //! src/image.rs.) Each must end with a clear error, the conventional exit
 //! code, and no partial or changed files.
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};

@@ -2,9 +2,9 @@
 //! sort vs a CPU sort, binary search vs a CPU lower bound, stencil routing vs a
 //! CPU simulation of the same draw order.
 
-mod common;
+use crate::common;
 
-use common::Rng;
+use crate::common::Rng;
 
 use photonmap::gpu::{Gpu, TexFormat, Texture};
 use photonmap::photon::bitonic::{

@@ -1,9 +1,9 @@
 //! Each GLSL intersection routine against its Rust twin on thousands of random
 //! rays (grazing ones included), and no self-intersection at any scene scale.
 
-mod common;
+use crate::common;
 
-use common::Rng;
+use crate::common::Rng;
 
 use glam::{DVec3, Vec3};
 use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};

@@ -5,7 +5,7 @@
 //! float rounding, in every paper scene and a mesh scene with vertex normals
 //! and an emissive OBJ group, jittered, with several shadow rays.
 
-mod common;
+use crate::common;
 
 use photonmap::render::{trace_eye_paths, At, DirectLight, EyeSample, PassPlan, RayTracer};
 use photonmap::render::{RenderOptions, Timings};

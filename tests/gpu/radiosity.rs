@@ -14,7 +14,7 @@
 //!   tile that could split is left uneven, and split tiles' children take the
 //!   shot as a uniform atlas at their resolution does.
 
-mod common;
+use crate::common;
 
 use glam::{Vec2, Vec3};
 use photonmap::layout::LUMINANCE;

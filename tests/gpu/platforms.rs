@@ -2,7 +2,7 @@
 //! the same seed renders the same image bit for bit through either. A missing
 //! OSMesa library is a clear error naming the package.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -13,7 +13,7 @@
 //! Regenerate only on purpose:
 //! PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test bit_identical
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

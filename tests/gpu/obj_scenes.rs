@@ -6,7 +6,7 @@
 //! seed-to-seed spread (`common::block_chi2`); each comparison also shows
 //! it tells a wrong scene apart.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

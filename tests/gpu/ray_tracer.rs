@@ -2,7 +2,7 @@
 //! the split tree, emitters show their radiance, and direct light matches a
 //! closed form.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::reference::ray_trace::{expected_moments, eye_ray_at};

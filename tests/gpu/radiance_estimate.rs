@@ -1,7 +1,7 @@
 //! The kNN-grid radiance estimate on the GPU against its CPU twin, against
 //! brute force, across drawing modes, and against an analytic irradiance.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, Grid, PhotonConfig, PhotonFrames, PhotonMap};

@@ -2,7 +2,7 @@
 //! cell, against their CPU twins; a hashed render against the uniform one;
 //! a 1024^3 grid that only the hash table can store.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::error::Error;

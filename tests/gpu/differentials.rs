@@ -6,7 +6,7 @@
 //! the walk finds exactly the footprints a brute-force check finds; and the
 //! estimate of a plane under a point light is its analytic irradiance.
 
-mod common;
+use crate::common;
 
 use glam::{Vec3, Vec4};
 use photonmap::photon::differentials::light_measures;

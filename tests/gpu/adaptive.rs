@@ -2,7 +2,7 @@
 //! with a full render's light, for the one-shot estimate and for final gather,
 //! and what it computes is exactly what a full render computes.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use photonmap::photon::{BuildMethod, PhotonConfig};

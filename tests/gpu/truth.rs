@@ -2,7 +2,7 @@
 //! reference_images/<scene>.sppm.exr (made by `photonmap reference`, an
 //! estimator that converges to the exact image), not the estimator's own.
 
-mod common;
+use crate::common;
 
 use photonmap::render::{render, Image, RenderOptions};
 
