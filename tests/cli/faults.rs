@@ -1,21 +1,14 @@
 //! Faults injected into real runs: a signal mid-render and mid-`tables`, a GL
 //! allocation the driver refuses partway through a render, and a scene file
-//! rewritten while it is loaded. (A full disk is tested in tests/cli.rs and
-//! src/image.rs.) Each must end with a clear error, the conventional exit
+//! rewritten while it is loaded. (A full disk is tested in the outputs module
+//! and src/image.rs.) Each must end with a clear error, the conventional exit
 //! code, and no partial or changed files.
-
-use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("photonmap-faults-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::common::{self, Printed, Run, TempDir};
 
 /// Every file under `dir`, relative, with its bytes.
 fn files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
@@ -41,12 +34,8 @@ fn files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 /// Runs photonmap with `args`, sends `signal` once stderr has shown `started`
 /// (and `delay` more), and returns the exit code and stderr.
 fn interrupted(args: &[&str], started: &str, delay_ms: u64, signal: &str) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_photonmap"))
-        .args(args)
-        .stderr(Stdio::piped())
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut running = Run::new(args).spawn();
+    let child = &mut running.child;
     let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
     let mut seen = String::new();
     for line in lines.by_ref() {
@@ -74,7 +63,7 @@ fn interrupted(args: &[&str], started: &str, delay_ms: u64, signal: &str) -> (Op
 #[test]
 fn sigint_and_sigterm_stop_a_render_with_130_and_143_and_no_output() {
     for (signal, code, name) in [("-INT", 130, "SIGINT"), ("-TERM", 143, "SIGTERM")] {
-        let d = tmp(&format!("render{code}"));
+        let d = TempDir::new(&format!("render{code}"));
         let png = d.join("out.png");
         let exr = d.join("out.exr");
         let args = [
@@ -109,7 +98,7 @@ fn sigint_and_sigterm_stop_a_render_with_130_and_143_and_no_output() {
 
 #[test]
 fn an_interrupted_tables_run_leaves_the_previous_results_as_they_were() {
-    let d = tmp("tables");
+    let d = TempDir::new("tables");
     // The previous results: the files a run writes, with known contents.
     std::fs::create_dir_all(d.join("figure7")).unwrap();
     std::fs::create_dir_all(d.join("figure8")).unwrap();
@@ -133,21 +122,13 @@ fn an_interrupted_tables_run_leaves_the_previous_results_as_they_were() {
 
 #[test]
 fn a_texture_the_driver_refuses_partway_through_a_render_is_a_clear_error_and_no_output() {
-    let d = tmp("oom");
-    let png = d.join("out.png");
+    let d = TempDir::new("oom");
     // 512^3 grid cells need a 2 GiB cell texture, made after the photons are traced.
-    let out = Command::new(env!("CARGO_BIN_EXE_photonmap"))
-        .args([
-            "render",
-            "glass_ball",
-            "--set",
-            "photon_map.grid_resolution=[512,512,512]",
-            "-o",
-        ])
-        .arg(&png)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let out = Run::new(["render", "glass_ball"])
+        .args(["--set", "photon_map.grid_resolution=[512,512,512]"])
+        .output_to(d.join("out.png"))
+        .run();
+    let stderr = out.stderr_text();
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     // Partway: the photon stage had begun.
@@ -169,9 +150,9 @@ fn a_texture_the_driver_refuses_partway_through_a_render_is_a_clear_error_and_no
 /// clear error, never a mixture.
 #[test]
 fn a_scene_file_rewritten_while_it_loads_loads_as_one_version() {
-    let d = tmp("changing");
+    let d = TempDir::new("changing");
     let file = d.join("scene.toml");
-    let original = std::fs::read_to_string(common::root().join("scenes/glass_ball.toml")).unwrap();
+    let original = std::fs::read_to_string(common::scene_file("glass_ball")).unwrap();
     // Two versions of the same length that differ at both ends of the file.
     let a = original.replace("name = \"GLASS BALL\"", "name = \"VERSION A\"");
     let b = original

@@ -12,10 +12,9 @@ use photonmap::render::{
     render, AdaptiveOptions, EstimateOptions, FinalGatherOptions, GlobalIllumination, Image,
     RenderOptions, RenderOutput,
 };
-use photonmap::scene::load_scene_str;
 
 fn options(w: u32, h: u32, gather: bool, adaptive: bool, build: BuildMethod) -> RenderOptions {
-    let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
+    let scene = common::fixture("mirror_box");
     let mut o = RenderOptions::for_scene(&scene);
     (o.width, o.height, o.seed) = (w, h, 3);
     o.global = Some(GlobalIllumination {
@@ -72,7 +71,7 @@ fn first_hits(out: &RenderOutput) -> FirstHits {
 /// where a corner contrast sits on the threshold to rounding.
 fn check(gather: bool, build: BuildMethod) {
     let gpu = common::gpu();
-    let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
+    let scene = common::fixture("mirror_box");
     let (w, h) = (40, 36);
     let full = render(&gpu, &scene, &options(w, h, gather, false, build), &mut ()).unwrap();
     let ad = render(&gpu, &scene, &options(w, h, gather, true, build), &mut ()).unwrap();
@@ -132,7 +131,7 @@ fn adaptive_sppm_computes_what_full_sppm_does_and_fills_as_its_twin() {
     use photonmap::render::sppm::{Sppm, SppmOptions};
     use photonmap::timing::Timings;
     let gpu = common::gpu();
-    let scene = load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap();
+    let scene = common::fixture("mirror_box");
     let (w, h, pilot, iterations) = (48u32, 40u32, 2u32, 6u32);
     let o = options(w, h, false, false, BuildMethod::Bitonic);
     let sppm = |adaptive: bool| SppmOptions {

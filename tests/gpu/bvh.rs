@@ -8,7 +8,7 @@ use crate::common;
 use crate::common::Rng;
 
 use glam::{DVec3, Vec3};
-use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};
+use photonmap::gpu::Gpu;
 use photonmap::photon::trace::PhotonTracer;
 use photonmap::reference::bvh as twin;
 use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
@@ -27,33 +27,9 @@ fn gpu_rays(
     dirs: &[[f32; 4]],
     mode: i32,
 ) -> Vec<[f32; 4]> {
-    let n = origins.len();
-    let w = 256u32;
-    let h = n.div_ceil(w as usize) as u32;
-    let upload = |mut d: Vec<f32>| {
-        d.resize((w * h * 4) as usize, 0.0);
-        Texture::from_f32(gpu, w, h, TexFormat::Rgba32F, &d).unwrap()
-    };
-    let to = upload(origins.iter().flat_map(|p| [p.x, p.y, p.z, 0.0]).collect());
-    let td = upload(dirs.iter().flatten().copied().collect());
-    let out = Texture::new(gpu, w, h, TexFormat::Rgba32F).unwrap();
-    let target = Target::new(gpu, &[&out]).unwrap();
-    let program = Program::fullscreen(gpu, "test/intersect_twin.frag").unwrap();
     let textures = SceneTextures::with_bvh(gpu, scene, tree).unwrap();
-    let mut b = program.bind();
-    textures.bind(&mut b);
-    b.texture("u_ray_origin", &to)
-        .texture("u_ray_direction", &td)
-        .texture("u_ray_normal", &td)
-        .int("u_primitive", 0)
-        .int("u_mode", mode)
-        .draw_fullscreen(&target, &DrawState::PLAIN)
-        .unwrap();
-    out.read_f32()
-        .chunks(4)
-        .take(n)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect()
+    let origins: Vec<[f32; 4]> = origins.iter().map(|&o| common::texel(o)).collect();
+    common::intersect_twin(gpu, &textures, 256, [&origins, dirs, dirs], mode)
 }
 
 /// The closest hit by testing every primitive: (primitive, t); ties go to the first.

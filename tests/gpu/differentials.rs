@@ -16,11 +16,7 @@ use photonmap::render::{
     render, DifferentialsOptions, DifferentialsRun, GlobalIllumination, Kernel, RenderOptions,
     RenderOutput,
 };
-use photonmap::scene::{load_scene_str, Material, Scene};
-
-fn scene(text: &str) -> Scene {
-    load_scene_str(text, std::path::Path::new("d.toml")).unwrap()
-}
+use photonmap::scene::{Material, Scene};
 
 fn run(scene: &Scene, w: u32, h: u32, o: DifferentialsOptions) -> RenderOutput {
     let mut options = RenderOptions::for_scene(scene);
@@ -146,7 +142,7 @@ fn twin_agreement(scene: &Scene, w: u32) -> [(usize, usize); 6] {
 /// every interaction the differentials know, by enough records each.
 #[test]
 fn the_differentials_equal_their_cpu_twin_on_every_record() {
-    let counts = twin_agreement(&scene(common::MIRROR_BOX), 24);
+    let counts = twin_agreement(&common::fixture("mirror_box"), 24);
     for (kind, min) in [(1, 10_000), (2, 1_000), (3, 100), (4, 1_000)] {
         assert!(
             counts[kind].0 >= min,
@@ -168,8 +164,8 @@ fn the_differentials_equal_their_twin_on_ring_s_cylinder_and_projection_maps() {
 /// A point light on the axis of a ball lens (or above a mirror), a diffuse
 /// floor below: the footprint of the stored photon nearest the axis against
 /// the paraxial one, |dp| = `expected` a unit emission angle.
-fn axial_footprint(text: &str, bounces_before_floor: u32, expected: f32) {
-    let scene = scene(text);
+fn axial_footprint(fixture: &str, bounces_before_floor: u32, expected: f32) {
+    let scene = common::fixture(fixture);
     let out = run(&scene, 8, 8, DifferentialsOptions::default());
     let run = state(&out);
     let recs = records(run);
@@ -207,28 +203,6 @@ fn axial_footprint(text: &str, bounces_before_floor: u32, expected: f32) {
     );
 }
 
-const FLOOR: &str = r#"
-[camera]
-position = [0.0, 6.0, 0.01]
-look_at = [0.0, 0.0, 0.0]
-vfov = 30.0
-width = 8
-height = 8
-[photon_map]
-photons_stored = 20000
-max_radius = 0.1
-[materials]
-floor = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
-glass = { type = "glass", ior = 1.5 }
-mirror = { type = "mirror", reflectance = [1.0, 1.0, 1.0] }
-[[shape]]
-type = "parallelogram"
-corner = [-4.0, 0.0, -4.0]
-edge1 = [0.0, 0.0, 8.0]
-edge2 = [8.0, 0.0, 0.0]
-material = "floor"
-"#;
-
 #[test]
 fn through_a_ball_lens_the_footprint_is_the_paraxial_one() {
     // Light 1.5 above a ball of radius 0.5 (n = 1.5) whose bottom is 1 above
@@ -239,25 +213,19 @@ fn through_a_ball_lens_the_footprint_is_the_paraxial_one() {
     // ((n - 1) / (n + 1))^2 = 0.04 at normal incidence, which widens the
     // differentials by 1 / sqrt(1 - F) (section 4.2's rescaling): twice.
     let f = 0.04f32;
-    let text = format!(
-        "{FLOOR}[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 1.5, 0.0]\nradius = 0.5\nmaterial = \"glass\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 3.5, 0.0]\nintensity = [1.0, 1.0, 1.0]\n"
-    );
-    axial_footprint(&text, 2, 0.5 / (1.0 - f));
+    axial_footprint("ball_lens", 2, 0.5 / (1.0 - f));
 }
 
 #[test]
 fn off_a_plane_mirror_the_footprint_is_the_mirror_images() {
     // Light 2 above the floor, a mirror 1 above the light facing down: the
     // reflected photon comes from the light's image 4 above the floor.
-    let text = format!(
-        "{FLOOR}[[shape]]\ntype = \"parallelogram\"\ncorner = [-1.0, 3.0, -1.0]\nedge1 = [2.0, 0.0, 0.0]\nedge2 = [0.0, 0.0, 2.0]\nmaterial = \"mirror\"\n[[light]]\ntype = \"point\"\nposition = [0.0, 2.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n"
-    );
-    axial_footprint(&text, 1, 4.0);
+    axial_footprint("plane_mirror", 1, 4.0);
 }
 
 #[test]
 fn the_morton_order_and_the_bvh_equal_a_cpu_build_on_the_same_footprints() {
-    let scene = scene(common::MIRROR_BOX);
+    let scene = common::fixture("mirror_box");
     let o = DifferentialsOptions {
         smoothing: Some(2.0),
         ..DifferentialsOptions::default()
@@ -335,7 +303,7 @@ fn the_morton_order_and_the_bvh_equal_a_cpu_build_on_the_same_footprints() {
 
 #[test]
 fn the_walk_finds_exactly_the_footprints_brute_force_finds() {
-    let scene = scene(common::MIRROR_BOX);
+    let scene = common::fixture("mirror_box");
     // A small leaf size makes a deep tree; Epanechnikov weights each find.
     let o = DifferentialsOptions {
         smoothing: Some(3.0),
@@ -387,11 +355,7 @@ fn the_walk_finds_exactly_the_footprints_brute_force_finds() {
 fn a_plane_under_a_point_light_gets_its_analytic_irradiance() {
     // E(x) = I h / (h^2 + rho^2)^(3/2) on the floor, h = 1, I = 1; first hits
     // stored, each footprint 5 Delta dp (only-specular photons' factor).
-    let text = FLOOR
-        .replace("max_radius = 0.1", "max_radius = 0.5\nstore_direct = true")
-        .replace("position = [0.0, 6.0, 0.01]", "position = [0.0, 3.0, 0.01]")
-        + "[[light]]\ntype = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n";
-    let scene = scene(&text);
+    let scene = common::fixture("floor_under_point_light");
     let out = run(&scene, 48, 48, DifferentialsOptions::default());
     let run = state(&out);
     let sum = common::texels(&run.estimate.sum);

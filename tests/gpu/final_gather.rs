@@ -44,8 +44,7 @@ fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -
 #[test]
 fn final_gather_equals_its_cpu_twin() {
     let gpu = common::gpu();
-    let scene =
-        load_scene_str(common::MIRROR_BOX, std::path::Path::new("mirror_box.toml")).unwrap();
+    let scene = common::fixture("mirror_box");
     let (w, h, rays, k, seed) = (24u32, 24u32, 8u32, 40u32, 5u32);
     let out = render(
         &gpu,

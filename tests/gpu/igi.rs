@@ -24,7 +24,7 @@ fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderO
 }
 
 fn mirror_box() -> Scene {
-    load_scene_str(common::MIRROR_BOX, std::path::Path::new("m.toml")).unwrap()
+    common::fixture("mirror_box")
 }
 
 fn vpls(out: &RenderOutput) -> Vec<Vpl> {
@@ -335,11 +335,7 @@ fn igi_in_the_furnace_converges_to_the_analytic_answer() {
 #[test]
 fn igi_converges_to_the_path_tracer_as_vpls_grow() {
     let gpu = common::gpu();
-    let scene = load_scene_str(
-        common::TWO_LIGHT_BOX,
-        std::path::Path::new("two_light_box.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("two_light_box");
     let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
     let mut chi = Vec::new();
     for paths in [64u32, 4096] {

@@ -6,7 +6,7 @@ use crate::common;
 use crate::common::Rng;
 
 use glam::{DVec3, Vec3};
-use photonmap::gpu::{DrawState, Gpu, Program, Target, TexFormat, Texture};
+use photonmap::gpu::Gpu;
 use photonmap::reference::intersect::{boundary_margin, intersect_geometry};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
@@ -38,34 +38,14 @@ fn gpu_hits(
     dirs: &[Vec3],
     normals: Option<&[Vec3]>,
 ) -> Vec<[f32; 4]> {
-    let n = origins.len();
-    let w = 128u32;
-    let h = n.div_ceil(w as usize) as u32;
-    let pack = |v: &[Vec3]| {
-        let mut d: Vec<f32> = v.iter().flat_map(|p| [p.x, p.y, p.z, 0.0]).collect();
-        d.resize((w * h * 4) as usize, 0.0);
-        Texture::from_f32(gpu, w, h, TexFormat::Rgba32F, &d).unwrap()
-    };
-    let (to, td) = (pack(origins), pack(dirs));
-    let tn = pack(normals.unwrap_or(dirs));
-    let out = Texture::new(gpu, w, h, TexFormat::Rgba32F).unwrap();
-    let target = Target::new(gpu, &[&out]).unwrap();
-    let program = Program::fullscreen(gpu, "test/intersect_twin.frag").unwrap();
     let textures = SceneTextures::new(gpu, scene).unwrap();
-    let mut b = program.bind();
-    textures.bind(&mut b);
-    b.texture("u_ray_origin", &to)
-        .texture("u_ray_direction", &td)
-        .texture("u_ray_normal", &tn)
-        .int("u_primitive", 0)
-        .int("u_mode", normals.is_some() as i32)
-        .draw_fullscreen(&target, &DrawState::PLAIN)
-        .unwrap();
-    out.read_f32()
-        .chunks(4)
-        .take(n)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect()
+    let texels = |v: &[Vec3]| -> Vec<[f32; 4]> { v.iter().map(|&p| common::texel(p)).collect() };
+    let (o, d, n) = (
+        texels(origins),
+        texels(dirs),
+        texels(normals.unwrap_or(dirs)),
+    );
+    common::intersect_twin(gpu, &textures, 128, [&o, &d, &n], normals.is_some() as i32)
 }
 
 /// A point on the primitive's surface or its boundary, for aiming rays.

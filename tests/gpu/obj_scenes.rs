@@ -49,65 +49,32 @@ fn agree(what: &str, a: &[Image], b: &[Image], wrong: &[Image], block: u32) {
 
 // ---- an emissive OBJ quad against the equivalent area light ------------------------
 
-const STAGE: &str = r#"
-[camera]
-position = [0.0, 1.0, 4.0]
-look_at = [0.0, 0.6, 0.0]
-vfov = 40.0
-width = 48
-height = 36
-[render]
-shadow_rays = 4
-max_specular_depth = 2
-[photon_map]
-photons_stored = 20000
-grid_resolution = [24, 12, 24]
-k = 50
-max_radius = 0.25
-max_bounces = 6
-[materials]
-floor = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
-wall = { type = "diffuse", albedo = [0.6, 0.3, 0.2] }
-ball = { type = "diffuse", albedo = [0.3, 0.5, 0.7] }
-[[shape]]
-type = "parallelogram"
-corner = [-2.0, 0.0, -1.5]
-edge1 = [0.0, 0.0, 3.5]
-edge2 = [4.0, 0.0, 0.0]
-material = "floor"
-[[shape]]
-type = "parallelogram"
-corner = [-2.0, 0.0, -1.5]
-edge1 = [4.0, 0.0, 0.0]
-edge2 = [0.0, 3.0, 0.0]
-material = "wall"
-[[shape]]
-type = "sphere"
-center = [0.3, 0.5, 0.0]
-radius = 0.5
-material = "ball"
-"#;
+/// The area light of scenes/tests/stage.toml, 0.8 x 0.6 at y = 2.2 (out of
+/// the camera's view), facing down.
+const STAGE_LIGHT: &str = "[[light]]\ntype = \"area\"\ncorner = [-0.6, 2.2, -0.4]\nedge1 = [0.8, 0.0, 0.0]\nedge2 = [0.0, 0.0, 0.6]\nnormal = [0.0, -1.0, 0.0]\nradiance = [12.0, 12.0, 12.0]\n";
 
-/// The stage lit by a 0.8 x 0.6 light at y = 2.2 (out of the camera's
-/// view), facing down: an area light, or the same rectangle as an emissive
+/// The stage lit by its area light, or by the same rectangle as an emissive
 /// OBJ quad of radiance `ke`.
 fn lit_stage(obj_light: Option<f32>) -> Scene {
-    let dir = common::tempdir("lit_stage");
-    let light = match obj_light {
-        None => "[[light]]\ntype = \"area\"\ncorner = [-0.6, 2.2, -0.4]\nedge1 = [0.8, 0.0, 0.0]\nedge2 = [0.0, 0.0, 0.6]\nnormal = [0.0, -1.0, 0.0]\nradiance = [12.0, 12.0, 12.0]\n".to_string(),
-        Some(ke) => {
-            let name = format!("lamp_{ke}");
-            std::fs::write(dir.join(format!("{name}.mtl")), format!("newmtl lamp\nKe {ke} {ke} {ke}\n")).unwrap();
-            // Counter-clockwise seen from below: its front faces down.
-            std::fs::write(
-                dir.join(format!("{name}.obj")),
-                format!("mtllib {name}.mtl\no lamp\nusemtl lamp\nv -0.6 2.2 -0.4\nv 0.2 2.2 -0.4\nv 0.2 2.2 0.2\nv -0.6 2.2 0.2\nf 1 2 3 4\n"),
-            )
-            .unwrap();
-            format!("[[shape]]\ntype = \"mesh\"\nfile = \"{name}.obj\"\n")
-        }
+    let Some(ke) = obj_light else {
+        return common::fixture("stage");
     };
-    load_scene_str(&format!("{STAGE}{light}"), &dir.join("stage.toml")).unwrap()
+    let dir = common::TempDir::new("lit_stage");
+    let name = format!("lamp_{ke}");
+    std::fs::write(
+        dir.join(format!("{name}.mtl")),
+        format!("newmtl lamp\nKe {ke} {ke} {ke}\n"),
+    )
+    .unwrap();
+    // Counter-clockwise seen from below: its front faces down.
+    std::fs::write(
+        dir.join(format!("{name}.obj")),
+        format!("mtllib {name}.mtl\no lamp\nusemtl lamp\nv -0.6 2.2 -0.4\nv 0.2 2.2 -0.4\nv 0.2 2.2 0.2\nv -0.6 2.2 0.2\nf 1 2 3 4\n"),
+    )
+    .unwrap();
+    let quad = format!("[[shape]]\ntype = \"mesh\"\nfile = \"{name}.obj\"\n");
+    let text = common::replace_once(&common::fixture_text("stage"), STAGE_LIGHT, &quad);
+    load_scene_str(&text, &dir.join("stage.toml")).unwrap()
 }
 
 fn sppm_renders(scene: &Scene, first: u32) -> Vec<Image> {
@@ -175,17 +142,18 @@ fn an_emissive_obj_quad_lights_like_the_equivalent_area_light() {
 /// The stage under its area light with its ball as an OBJ sphere of 20,000
 /// triangles with vertex normals, of albedo `albedo` x the analytic ball's.
 fn stage_with_mesh_ball(albedo: f32) -> Scene {
-    let dir = common::tempdir("stage_mesh_ball");
+    let dir = common::TempDir::new("stage_mesh_ball");
     common::write_sphere_obj(&dir.join("ball.obj"), 20_000, true);
     let ball = "type = \"sphere\"\ncenter = [0.3, 0.5, 0.0]\nradius = 0.5\nmaterial = \"ball\"";
     let mesh = "type = \"mesh\"\nfile = \"ball.obj\"\nscale = 0.5\ntranslate = [0.3, 0.5, 0.0]\nmaterial = \"ball\"";
     let [r, g, b] = [0.3f32, 0.5, 0.7].map(|c| c * albedo);
-    let text = STAGE.replace(ball, mesh).replace(
+    let text = common::replace_once(&common::fixture_text("stage"), ball, mesh);
+    let text = common::replace_once(
+        &text,
         "ball = { type = \"diffuse\", albedo = [0.3, 0.5, 0.7] }",
         &format!("ball = {{ type = \"diffuse\", albedo = [{r:?}, {g:?}, {b:?}] }}"),
     );
-    let light = "[[light]]\ntype = \"area\"\ncorner = [-0.6, 2.2, -0.4]\nedge1 = [0.8, 0.0, 0.0]\nedge2 = [0.0, 0.0, 0.6]\nnormal = [0.0, -1.0, 0.0]\nradiance = [12.0, 12.0, 12.0]\n";
-    load_scene_str(&format!("{text}{light}"), &dir.join("stage.toml")).unwrap()
+    load_scene_str(&text, &dir.join("stage.toml")).unwrap()
 }
 
 /// Shading normals are consistent between the eye and the photons: a
@@ -211,9 +179,9 @@ fn a_diffuse_obj_sphere_with_vertex_normals_matches_the_analytic_ball() {
 /// GLASS BALL with its sphere as an OBJ UV sphere of about `triangles`
 /// triangles (vertex normals: the exact sphere's), glass of `ior`.
 fn glass_ball_mesh(triangles: usize, ior: f32) -> Scene {
-    let dir = common::tempdir("glass_ball_mesh");
+    let dir = common::TempDir::new("glass_ball_mesh");
     common::write_sphere_obj(&dir.join("sphere.obj"), triangles, true);
-    let text = std::fs::read_to_string(common::root().join("scenes/glass_ball.toml")).unwrap();
+    let text = std::fs::read_to_string(common::scene_file("glass_ball")).unwrap();
     let sphere = "type = \"sphere\"\ncenter = [0.0, 0.8, 0.0]\nradius = 0.8\nmaterial = \"glass\"";
     assert!(text.contains(sphere));
     let mesh = "type = \"mesh\"\nfile = \"sphere.obj\"\nscale = 0.8\ntranslate = [0.0, 0.8, 0.0]\nmaterial = \"glass\"";

@@ -113,7 +113,7 @@ fn gpu_photons_equal_the_cpu_tracer_photon_by_photon() {
 /// (two `Triangles` lights), and UV spheres with vertex normals of glass,
 /// mirror and diffuse material, on a diffuse floor.
 fn obj_scene() -> Scene {
-    let dir = common::tempdir("photon_twin_obj");
+    let dir = common::TempDir::new("photon_twin_obj");
     common::write_sphere_obj(&dir.join("sphere.obj"), 400, true);
     std::fs::write(
         dir.join("lamps.mtl"),
@@ -191,44 +191,12 @@ fn gpu_photons_from_emissive_triangles_and_off_shaded_meshes_equal_the_cpu_trace
     }
 }
 
-fn plane_under_point_light(half: f32, height: f32, intensity: f32) -> Scene {
-    let text = format!(
-        r#"
-[camera]
-position = [0.0, 5.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-vfov = 40.0
-width = 8
-height = 8
-[photon_map]
-photons_stored = 20000
-max_bounces = 1
-store_direct = true
-grid_resolution = [16, 1, 16]
-[materials]
-floor = {{ type = "diffuse", albedo = [0.5, 0.5, 0.5] }}
-[[shape]]
-type = "parallelogram"
-corner = [{m}, 0.0, {m}]
-edge1 = [0.0, 0.0, {s}]
-edge2 = [{s}, 0.0, 0.0]
-material = "floor"
-[[light]]
-type = "point"
-position = [0.0, {height}, 0.0]
-intensity = [{intensity}, {intensity}, {intensity}]
-"#,
-        m = -half,
-        s = 2.0 * half
-    );
-    load_scene_str(&text, std::path::Path::new("plane.toml")).unwrap()
-}
-
 #[test]
 fn stored_flux_on_a_plane_matches_the_solid_angle() {
     let gpu = common::gpu();
+    // The fixture's floor half side, light height and intensity.
     let (half, height, intensity) = (2.0f32, 1.0f32, 3.0f32);
-    let scene = plane_under_point_light(half, height, intensity);
+    let scene = common::fixture("plane_under_point_light");
     let textures = SceneTextures::new(&gpu, &scene).unwrap();
     let tracer = PhotonTracer::new(&gpu).unwrap();
     // Solid angle of a 2a x 2a square at distance h, seen from above its centre.
@@ -510,41 +478,7 @@ fn projection_maps_keep_the_stored_caustic_flux() {
 /// behind a one-sided area light) is refused with a reason, not traced forever.
 #[test]
 fn caustics_only_with_no_reachable_mirror_is_refused() {
-    let scene = load_scene_str(
-        r#"
-[camera]
-position = [0.0, 1.0, 5.0]
-look_at = [0.0, 1.0, 0.0]
-vfov = 40.0
-width = 8
-height = 8
-[photon_map]
-caustics_only = true
-[materials]
-floor = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
-mirror = { type = "mirror", reflectance = [0.9, 0.9, 0.9] }
-[[shape]]
-type = "parallelogram"
-corner = [-2.0, 0.0, -2.0]
-edge1 = [0.0, 0.0, 4.0]
-edge2 = [4.0, 0.0, 0.0]
-material = "floor"
-[[shape]]
-type = "sphere"
-center = [0.0, 3.0, 0.0]
-radius = 0.5
-material = "mirror"
-[[light]]
-type = "area"
-corner = [-0.5, 2.0, -0.5]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 1.0]
-normal = [0.0, -1.0, 0.0]
-radiance = [10.0, 10.0, 10.0]
-"#,
-        std::path::Path::new("behind.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("mirror_behind_light");
     let gpu = common::gpu();
     let textures = SceneTextures::new(&gpu, &scene).unwrap();
     let tracer = PhotonTracer::new(&gpu).unwrap();

@@ -70,6 +70,14 @@ fn gpu_results(out: &RenderOutput) -> Vec<(usize, Vec3, Vec3, f32, u32)> {
     v
 }
 
+/// A GPU query's (accepted, r^2, flux) is its CPU twin's: the same accepted
+/// count, radius and flux to float precision.
+fn agrees((accepted, r2, flux): (u32, f32, Vec3), cpu: (u32, f32, Vec3)) -> bool {
+    cpu.0 == accepted
+        && (cpu.1 - r2).abs() <= 1e-5 * r2.max(1e-12)
+        && (cpu.2 - flux).abs().max_element() <= 1e-4 * cpu.2.max_element().max(1e-20)
+}
+
 #[test]
 fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
     for (name, w, h) in [
@@ -91,11 +99,10 @@ fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
             let mut mismatched = 0;
             for (i, x, flux, r2, accepted) in &results {
                 let cpu = knn_grid(&cpu_map, *x, k, max_r);
-                let same = cpu.accepted == *accepted
-                    && (cpu.radius2 - r2).abs() <= 1e-5 * r2.max(1e-12)
-                    && (cpu.flux - *flux).abs().max_element()
-                        <= 1e-4 * cpu.flux.max_element().max(1e-20);
-                if !same {
+                if !agrees(
+                    (*accepted, *r2, *flux),
+                    (cpu.accepted, cpu.radius2, cpu.flux),
+                ) {
                     mismatched += 1;
                     if mismatched < 4 {
                         eprintln!(
@@ -223,34 +230,7 @@ fn tiled_full_screen_and_masked_runs_give_identical_images() {
 fn a_uniform_photon_plane_gives_the_analytic_irradiance() {
     // 40,000 photons of equal power spread uniformly over the 2 x 2 floor: the
     // irradiance is total power / 4 everywhere, and the radiance albedo/pi of it.
-    let text = r#"
-[camera]
-position = [0.0, 3.0, 0.0001]
-look_at = [0.0, 0.0, 0.0]
-vfov = 20.0
-width = 48
-height = 48
-[photon_map]
-photons_stored = 40000
-grid_resolution = [40, 1, 40]
-grid_min = [-1.0, -0.01, -1.0]
-grid_max = [1.0, 0.01, 1.0]
-k = 50
-max_radius = 0.2
-[materials]
-floor = { type = "diffuse", albedo = [0.6, 0.6, 0.6] }
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, 0.0, -1.0]
-edge1 = [0.0, 0.0, 2.0]
-edge2 = [2.0, 0.0, 0.0]
-material = "floor"
-[[light]]
-type = "point"
-position = [0.0, 5.0, 0.0]
-intensity = [0.0, 0.0, 0.0]
-"#;
-    let scene = photonmap::scene::load_scene_str(text, std::path::Path::new("plane.toml")).unwrap();
+    let scene = common::fixture("photon_plane");
     let gpu = common::gpu();
     let o = RenderOptions::for_scene(&scene).direct_only();
     let out = render(&gpu, &scene, &o, &mut ()).unwrap();
@@ -430,11 +410,10 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
                     disc && seen
                 };
                 let cpu = knn_grid_filtered(&cpu_map, *x, k, max_r, &accept);
-                let same = cpu.accepted == *accepted
-                    && (cpu.radius2 - r2).abs() <= 1e-5 * r2.max(1e-12)
-                    && (cpu.flux - *flux).abs().max_element()
-                        <= 1e-4 * cpu.flux.max_element().max(1e-20);
-                mismatched += !same as usize;
+                mismatched += !agrees(
+                    (*accepted, *r2, *flux),
+                    (cpu.accepted, cpu.radius2, cpu.flux),
+                ) as usize;
             }
             eprintln!(
                 "{name} {leak:?}: {} query pixels, {mismatched} differ from the CPU twin",
@@ -469,7 +448,6 @@ fn culled_searches_end_in_the_paper_search_s_state_bit_for_bit() {
                 let gi = o.global.as_mut().unwrap();
                 (gi.estimate.cull, gi.estimate.runs) = (cull, runs);
                 let out = render(&gpu, &scene, &o, &mut ()).unwrap();
-                // Read now: the next render makes its own context current.
                 let est = out.state.estimate.as_ref().unwrap();
                 let twin = (cull, runs) == (false, false);
                 let cpu_map = twin.then(|| CpuPhotonMap::from_gpu(out.state.map.as_ref().unwrap()));

@@ -60,33 +60,13 @@ fn solve(scene: &Scene, o: RadiosityOptions) -> RenderOutput {
     render(&common::gpu(), scene, &options, &mut ()).unwrap()
 }
 
-/// A square light of side 0.2 (radiance 1) facing down at height h over a
-/// diffuse floor.
+/// scenes/tests/light_over_floor.toml, a square light of side 0.2 (radiance
+/// 1) facing down over a diffuse floor, with the light at height h.
 fn light_over_floor(h: f32) -> String {
-    format!(
-        r#"
-[camera]
-position = [0.0, 3.0, 0.01]
-look_at = [0.0, 0.0, 0.0]
-vfov = 40.0
-width = 16
-height = 16
-[materials]
-floor = {{ type = "diffuse", albedo = [0.5, 0.5, 0.5] }}
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, 0.0, -1.0]
-edge1 = [0.0, 0.0, 2.0]
-edge2 = [2.0, 0.0, 0.0]
-material = "floor"
-[[light]]
-type = "area"
-corner = [-0.1, {h}, -0.1]
-edge1 = [0.2, 0.0, 0.0]
-edge2 = [0.0, 0.0, 0.2]
-normal = [0.0, -1.0, 0.0]
-radiance = [1.0, 1.0, 1.0]
-"#
+    common::replace_once(
+        &common::fixture_text("light_over_floor"),
+        "corner = [-0.1, 0.5, -0.1]",
+        &format!("corner = [-0.1, {h}, -0.1]"),
     )
 }
 
@@ -252,26 +232,7 @@ fn the_item_buffer_sees_what_shadow_rays_see() {
 /// falls short near every shooter (reported).
 #[test]
 fn a_diffuse_sphere_around_a_point_light_reaches_its_steady_state() {
-    let text = r#"
-[camera]
-position = [0.0, 0.0, 0.5]
-look_at = [0.0, 0.0, -1.0]
-vfov = 40.0
-width = 16
-height = 16
-[materials]
-wall = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
-[[shape]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-material = "wall"
-[[light]]
-type = "point"
-position = [0.0, 0.0, 0.0]
-intensity = [1.0, 1.0, 1.0]
-"#;
-    let s = scene(text);
+    let s = common::fixture("sphere_around_point_light");
     let exact = 0.5 / (1.0 - 0.5);
     for form_factor in [FormFactor::Polygon, FormFactor::Disc] {
         let o = RadiosityOptions {
@@ -468,47 +429,10 @@ fn the_polygon_form_factor_is_the_analytic_point_to_rectangle_one_everywhere() {
     assert!(worst < 1e-4, "f32 rounding only: {worst}");
 }
 
-/// Two coaxial discs (32-gon fans) of radius r, h apart, the upper one
+/// Two coaxial discs (32-gon fans) of radius 0.5, 0.5 apart, the upper one
 /// emitting, and the scene's zero point light (a scene needs a light).
-fn discs(res: u32, r: f32, h: f32) -> (Scene, RadiosityOptions) {
-    let ring = |y: f32| {
-        (0..32)
-            .map(|k| {
-                let a = 2.0 * std::f32::consts::PI * k as f32 / 32.0;
-                format!("[{}, {y}, {}]", r * a.cos(), r * a.sin())
-            })
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let text = format!(
-        r#"
-[camera]
-position = [0.0, {mid}, 3.0]
-look_at = [0.0, {mid}, 0.0]
-vfov = 40.0
-width = 16
-height = 16
-[materials]
-lamp = {{ type = "diffuse", albedo = [0.0, 0.0, 0.0] }}
-floor = {{ type = "diffuse", albedo = [0.5, 0.5, 0.5] }}
-[[shape]]
-type = "polygon"
-vertices = [{top}]
-material = "lamp"
-[[shape]]
-type = "polygon"
-vertices = [{bottom}]
-material = "floor"
-[[light]]
-type = "point"
-position = [5.0, 5.0, 5.0]
-intensity = [0.0, 0.0, 0.0]
-"#,
-        mid = h / 2.0,
-        top = ring(h),
-        bottom = ring(0.0)
-    );
-    let mut s = scene(&text);
+fn discs(res: u32) -> (Scene, RadiosityOptions) {
+    let mut s = common::fixture("coaxial_discs");
     let lamp = s.shapes[0].material;
     s.materials[lamp] = photonmap::scene::Material::Emitter {
         radiance: Vec3::ONE,
@@ -533,7 +457,7 @@ fn disc_to_disc(r1: f64, r2: f64, h: f64) -> f64 {
 
 /// What the lower disc receives over what the upper one shoots.
 fn measured_disc_form_factor(res: u32) -> f64 {
-    let (s, o) = discs(res, 0.5, 0.5);
+    let (s, o) = discs(res);
     let out = solve(&s, o);
     let r = out.state.radiosity.as_ref().unwrap();
     let e = &r.elements;
@@ -587,59 +511,13 @@ fn two_coaxial_discs_exchange_their_analytic_form_factor() {
     assert!((f16 - f_eq).abs() <= 2.0 * quadrature + shape);
 }
 
-/// A closed diffuse box, the cube [-1, 1]^3 (albedo 0.5), lit inside by
-/// `light`.
+/// A closed diffuse box, the cube [-1, 1]^3 (albedo 0.5) of
+/// scenes/tests/closed_box.toml, lit inside by `light` instead of its point
+/// light.
 fn closed_box(light: &str) -> Scene {
-    let text = format!(
-        r#"
-[camera]
-position = [0.0, 0.0, 0.9]
-look_at = [0.0, 0.0, 0.0]
-vfov = 60.0
-width = 16
-height = 16
-[materials]
-wall = {{ type = "diffuse", albedo = [0.5, 0.5, 0.5] }}
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, -1.0, -1.0]
-edge1 = [2.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 2.0]
-material = "wall"
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, 1.0, -1.0]
-edge1 = [2.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 2.0]
-material = "wall"
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, -1.0, -1.0]
-edge1 = [0.0, 2.0, 0.0]
-edge2 = [0.0, 0.0, 2.0]
-material = "wall"
-[[shape]]
-type = "parallelogram"
-corner = [1.0, -1.0, -1.0]
-edge1 = [0.0, 2.0, 0.0]
-edge2 = [0.0, 0.0, 2.0]
-material = "wall"
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, -1.0, -1.0]
-edge1 = [2.0, 0.0, 0.0]
-edge2 = [0.0, 2.0, 0.0]
-material = "wall"
-[[shape]]
-type = "parallelogram"
-corner = [-1.0, -1.0, 1.0]
-edge1 = [2.0, 0.0, 0.0]
-edge2 = [0.0, 2.0, 0.0]
-material = "wall"
-{light}
-"#
-    );
-    scene(&text)
+    let text = common::fixture_text("closed_box");
+    let (walls, _point_light) = text.split_once("[[light]]").unwrap();
+    scene(&format!("{walls}{light}"))
 }
 
 /// Over the elements of diffuse patches: the sums of direct x area,
@@ -716,13 +594,7 @@ fn a_closed_diffuse_box_reaches_the_furnace_total() {
     // add rho R / (1 - rho). Each shot loses or gains only the receivers'
     // midpoint-rule error (the polygon form factor is exact at each
     // receiver): its size at 16 elements is a third of the change from 8.
-    let light = r#"
-[[light]]
-type = "point"
-position = [0.1, 0.2, -0.15]
-intensity = [1.0, 1.0, 1.0]
-"#;
-    let s = closed_box(light);
+    let s = common::fixture("closed_box");
     let phi = 4.0 * std::f64::consts::PI;
     let exact = 0.5 * phi / (1.0 - 0.5);
     let total = |res: u32| {
@@ -829,8 +701,7 @@ fn split_tiles_take_the_shot_as_a_finer_uniform_atlas_does() {
     // (a low gradient threshold splits them all): each child takes the shot
     // again at its own elements, so its direct light equals the uniform
     // 16 x 16 atlas's at the same cells (the shooters are the same blocks
-    // of the light: 2 x 2 of 4 x 4 elements, and of 8 x 8). Each run's
-    // textures are read before the next: every render makes its own context.
+    // of the light: 2 x 2 of 4 x 4 elements, and of 8 x 8).
     let s = scene(&light_over_floor(0.5));
     let run = |o: RadiosityOptions| {
         let out = solve(&s, o);

@@ -12,39 +12,15 @@ use photonmap::scene::{load_scene_str, Scene};
 /// GLASS BALL's geometry under a point light, so direct light is deterministic
 /// and all the randomness left is the reflect-or-refract choice.
 fn glass_scene(ior: f32) -> Scene {
-    load_scene_str(&glass_text(ior), std::path::Path::new("glass_point.toml")).unwrap()
+    load_scene_str(&glass_text(ior), &common::fixture_file("glass_point")).unwrap()
 }
 
+/// scenes/tests/glass_point.toml with glass of `ior`.
 fn glass_text(ior: f32) -> String {
-    format!(
-        r#"
-[camera]
-position = [0.0, 2.0, 5.5]
-look_at = [0.0, 0.6, 0.0]
-vfov = 24.0
-width = 40
-height = 30
-[render]
-max_specular_depth = 8
-[materials]
-floor = {{ type = "diffuse", albedo = [0.75, 0.75, 0.75] }}
-glass = {{ type = "glass", ior = {ior} }}
-[[shape]]
-type = "parallelogram"
-corner = [-3.0, 0.0, -3.0]
-edge1 = [0.0, 0.0, 6.0]
-edge2 = [6.0, 0.0, 0.0]
-material = "floor"
-[[shape]]
-type = "sphere"
-center = [0.0, 0.8, 0.0]
-radius = 0.8
-material = "glass"
-[[light]]
-type = "point"
-position = [-1.0, 3.5, 2.5]
-intensity = [10.0, 10.0, 10.0]
-"#
+    common::replace_once(
+        &common::fixture_text("glass_point"),
+        "ior = 1.5 }",
+        &format!("ior = {ior} }}"),
     )
 }
 
@@ -98,38 +74,37 @@ fn failing(gpu_mean: &Image, n: usize, cpu: &(Image, Image, Vec<bool>)) -> f64 {
     bad as f64 / tested as f64
 }
 
+/// The mean of `images` (one a seed) against `scene`'s split tree and against
+/// `wrong`'s: (well-conditioned pixels, pixels, the fraction of channels
+/// failing against each).
+fn against_split_trees(images: &[Image], scene: &Scene, wrong: &Scene) -> (usize, usize, f64, f64) {
+    let mean = Image::average(images);
+    let cpu = cpu_expectation(scene);
+    let stable = cpu.2.iter().filter(|&&s| s).count();
+    let right = failing(&mean, images.len(), &cpu);
+    let wrong = failing(&mean, images.len(), &cpu_expectation(wrong));
+    (stable, cpu.2.len(), right, wrong)
+}
+
 #[test]
 fn stochastic_fresnel_choice_converges_to_the_split_tree() {
-    let gpu = common::gpu();
     let scene = glass_scene(1.5);
     let n = 256;
-    let images: Vec<Image> = (0..n)
-        .map(|seed| {
-            let mut o = RenderOptions::for_scene(&scene).direct_only();
-            o.seed = seed + 1;
-            render(&gpu, &scene, &o, &mut ()).unwrap().image
-        })
-        .collect();
-    let mean = Image::average(&images);
+    let images = direct_renders(&scene, 1..n + 1);
     // The choice is really random: some pixels vary between seeds.
     assert!(
         images.iter().any(|im| im.pixels != images[0].pixels),
         "no pixel varies: nothing stochastic was tested"
     );
-
-    let cpu = cpu_expectation(&scene);
-    let stable = cpu.2.iter().filter(|&&s| s).count();
-    let right = failing(&mean, n as usize, &cpu);
     // A different ior changes the expectation: the test must notice.
-    let wrong = failing(&mean, n as usize, &cpu_expectation(&glass_scene(1.6)));
+    let (stable, pixels, right, wrong) = against_split_trees(&images, &scene, &glass_scene(1.6));
     eprintln!(
-        "{stable} of {} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against the split tree, {:.3}% against ior 1.6",
-        cpu.2.len(),
+        "{stable} of {pixels} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against the split tree, {:.3}% against ior 1.6",
         100.0 * right,
         100.0 * wrong
     );
     assert!(
-        stable as f64 > 0.9 * cpu.2.len() as f64,
+        stable as f64 > 0.9 * pixels as f64,
         "too few pixels compared"
     );
     // At 4.5 sigma a correct estimator fails ~1e-5 of channels.
@@ -167,27 +142,7 @@ fn an_emitter_seen_directly_shows_its_radiance() {
 fn direct_light_from_a_point_light_matches_the_closed_form() {
     // A floor under a point light straight above the pixel seen at the image centre:
     // L = albedo / pi * I * cos / r^2 with cos = 1.
-    let text = r#"
-[camera]
-position = [0.0, 5.0, 0.001]
-look_at = [0.0, 0.0, 0.0]
-vfov = 10.0
-width = 9
-height = 9
-[materials]
-floor = { type = "diffuse", albedo = [0.5, 0.25, 1.0] }
-[[shape]]
-type = "parallelogram"
-corner = [-10.0, 0.0, -10.0]
-edge1 = [0.0, 0.0, 20.0]
-edge2 = [20.0, 0.0, 0.0]
-material = "floor"
-[[light]]
-type = "point"
-position = [0.0, 2.0, 0.0]
-intensity = [8.0, 8.0, 8.0]
-"#;
-    let scene = load_scene_str(text, std::path::Path::new("point.toml")).unwrap();
+    let scene = common::fixture("point_over_floor");
     let gpu = common::gpu();
     let img = render(
         &gpu,
@@ -241,7 +196,7 @@ fn samples_per_pixel_cut_noise_and_antialias_edges() {
 /// `glass_scene` with its sphere as an OBJ UV sphere of about `triangles`
 /// triangles with vertex normals (the sphere's own).
 fn shaded_glass_scene(triangles: usize, ior: f32) -> Scene {
-    let dir = common::tempdir("shaded_glass");
+    let dir = common::TempDir::new("shaded_glass");
     common::write_sphere_obj(&dir.join("sphere.obj"), triangles, true);
     let text = glass_text(ior).replace(
         "type = \"sphere\"\ncenter = [0.0, 0.8, 0.0]\nradius = 0.8\nmaterial = \"glass\"",
@@ -257,32 +212,19 @@ fn shaded_glass_scene(triangles: usize, ior: f32) -> Scene {
 /// differ much) under a point light.
 #[test]
 fn a_glass_mesh_with_vertex_normals_converges_to_its_split_tree() {
-    let gpu = common::gpu();
     let scene = shaded_glass_scene(224, 1.5);
-    let n = 256;
-    let images: Vec<Image> = (0..n)
-        .map(|seed| {
-            let mut o = RenderOptions::for_scene(&scene).direct_only();
-            o.seed = seed + 1;
-            render(&gpu, &scene, &o, &mut ()).unwrap().image
-        })
-        .collect();
-    let mean = Image::average(&images);
-    let cpu = cpu_expectation(&scene);
-    let stable = cpu.2.iter().filter(|&&s| s).count();
-    let right = failing(&mean, n as usize, &cpu);
+    let images = direct_renders(&scene, 1..257);
     // The same sphere without its normals (flat facets) is another image.
     let mut flat = scene.clone();
     flat.shapes.iter_mut().for_each(|s| s.normals = None);
-    let wrong = failing(&mean, n as usize, &cpu_expectation(&flat));
+    let (stable, pixels, right, wrong) = against_split_trees(&images, &scene, &flat);
     eprintln!(
-        "{stable} of {} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against the shaded split tree, {:.3}% against flat facets",
-        cpu.2.len(),
+        "{stable} of {pixels} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against the shaded split tree, {:.3}% against flat facets",
         100.0 * right,
         100.0 * wrong
     );
     assert!(
-        stable as f64 > 0.8 * cpu.2.len() as f64,
+        stable as f64 > 0.8 * pixels as f64,
         "too few pixels compared"
     );
     assert!(
@@ -301,7 +243,7 @@ fn a_glass_mesh_with_vertex_normals_converges_to_its_split_tree() {
 /// emissive OBJ triangles in two groups: a quad and a small triangle of one
 /// material (Ke 8 6 4 times `scale`), a tilted triangle of another.
 fn triangle_lights_scene(scale: f32) -> Scene {
-    let dir = common::tempdir(&format!("triangle_lights_{scale}"));
+    let dir = common::TempDir::new(&format!("triangle_lights_{scale}"));
     common::write_sphere_obj(&dir.join("sphere.obj"), 224, true);
     let (w, c) = (
         Vec3::new(8.0, 6.0, 4.0) * scale,

@@ -8,9 +8,9 @@
 //! the other seeds' mean and variance (leave-one-out), mean + 4 sigma.
 //! floor = 1e-3 x the mean + 1e-6: a rounding allowance for pixels that no seed
 //! changes (a point light's shadow edge), far below any visible change.
-//! Regenerate only on purpose: PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test reference_images
+//! Regenerate only on purpose: PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test gpu reference_images
 
-use crate::common;
+use crate::common::{self, Run};
 
 use std::path::PathBuf;
 
@@ -43,30 +43,17 @@ fn dir() -> PathBuf {
 
 /// The same render from the binary in a fresh process with another SIMD width.
 fn render_with_narrow_simd(name: &str, o: &RenderOptions, seed: u32) -> Image {
-    let out =
-        std::env::temp_dir().join(format!("photonmap-simd-{name}-{}.exr", std::process::id()));
-    let png = out.with_extension("png");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_photonmap"))
+    let d = common::TempDir::new("simd");
+    let (png, out) = (d.join(format!("{name}.png")), d.join(format!("{name}.exr")));
+    Run::new(["render", "--quiet", "--seed", &seed.to_string()])
+        .args(["--width", &o.width.to_string()])
+        .args(["--height", &o.height.to_string()])
+        .scene(name)
+        .output_to(&png)
+        .writing("--exr", &out)
         .env("LP_NATIVE_VECTOR_WIDTH", "128")
-        .args(["render", "--quiet", "--seed", &seed.to_string()])
-        .args([
-            "--width",
-            &o.width.to_string(),
-            "--height",
-            &o.height.to_string(),
-        ])
-        .arg(common::root().join("scenes").join(format!("{name}.toml")))
-        .arg("-o")
-        .arg(&png)
-        .arg("--exr")
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let img = Image::read_exr(&out).unwrap();
-    let _ = std::fs::remove_file(&out);
-    let _ = std::fs::remove_file(&png);
-    img
+        .succeeds();
+    Image::read_exr(&out).unwrap()
 }
 
 fn regenerate(gpu: &photonmap::gpu::Gpu, name: &str) {
@@ -84,8 +71,9 @@ fn regenerate(gpu: &photonmap::gpu::Gpu, name: &str) {
         loo_fail_std: 0.0,
         driver_rmse: 0.0,
         tolerance: 0.0,
-        command: "PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test reference_images"
-            .into(),
+        command:
+            "PHOTONMAP_REGENERATE_REFERENCES=1 cargo test --release --test gpu reference_images"
+                .into(),
     };
     let r = make_reference(&images, &narrow, tol).unwrap();
     r.write(&dir(), name).unwrap();
@@ -145,6 +133,27 @@ fn paper_scenes_match_their_references() {
     }
 }
 
+/// A render of `name` with a defect, `(label, as the report names it, as the
+/// failure names it)`, must fail the comparison.
+fn assert_caught(
+    name: &str,
+    (label, defect, what): (&str, &str, &str),
+    img: &Image,
+    r: &Reference,
+) {
+    let f = score(&format!("{name}.{label}"), img, r);
+    eprintln!(
+        "{name}: {defect} fails {:.3}% (tolerance {:.3}%)",
+        100.0 * f,
+        100.0 * r.tol.tolerance
+    );
+    assert!(
+        f > r.tol.tolerance,
+        "{name}: {what} passed ({f}, tolerance {})",
+        r.tol.tolerance
+    );
+}
+
 /// The comparison can fail: a 10% brighter light, a camera one pixel off, and
 /// (where there is one) a missing caustic.
 #[test]
@@ -166,21 +175,9 @@ fn the_comparison_catches_defects() {
                 *radiance *= 1.1;
             }
         }
-        let f = score(
-            &format!("{name}.brighter"),
-            &render_seed(&gpu, &bright, TEST_SEED),
-            &r,
-        );
-        eprintln!(
-            "{name}: brighter light fails {:.3}% (tolerance {:.3}%)",
-            100.0 * f,
-            100.0 * r.tol.tolerance
-        );
-        assert!(
-            f > r.tol.tolerance,
-            "{name}: a 10% brighter light passed ({f}, tolerance {})",
-            r.tol.tolerance
-        );
+        let img = render_seed(&gpu, &bright, TEST_SEED);
+        let defect = ("brighter", "brighter light", "a 10% brighter light");
+        assert_caught(name, defect, &img, &r);
 
         let mut shifted = common::paper_scene(name);
         let o = reduced(&shifted);
@@ -191,21 +188,9 @@ fn the_comparison_catches_defects() {
             2.0 * dist * (shifted.camera.vfov_degrees.to_radians() * 0.5).tan() / o.height as f32;
         shifted.camera.position += u * pixel;
         shifted.camera.look_at += u * pixel;
-        let f = score(
-            &format!("{name}.shifted"),
-            &render_seed(&gpu, &shifted, TEST_SEED),
-            &r,
-        );
-        eprintln!(
-            "{name}: shifted camera fails {:.3}% (tolerance {:.3}%)",
-            100.0 * f,
-            100.0 * r.tol.tolerance
-        );
-        assert!(
-            f > r.tol.tolerance,
-            "{name}: a camera one pixel off passed ({f}, tolerance {})",
-            r.tol.tolerance
-        );
+        let img = render_seed(&gpu, &shifted, TEST_SEED);
+        let defect = ("shifted", "shifted camera", "a camera one pixel off");
+        assert_caught(name, defect, &img, &r);
         if name != "cornell_box" {
             // In these two scenes the floor is the only diffuse surface and
             // nothing above it is diffuse, so every stored photon is a caustic
@@ -214,17 +199,12 @@ fn the_comparison_catches_defects() {
             let mut o = reduced(&scene).direct_only();
             o.seed = TEST_SEED;
             let img = render(&gpu, &scene, &o, &mut ()).unwrap().image;
-            let f = score(&format!("{name}.no_caustic"), &img, &r);
-            eprintln!(
-                "{name}: missing caustic fails {:.3}% (tolerance {:.3}%)",
-                100.0 * f,
-                100.0 * r.tol.tolerance
+            let defect = (
+                "no_caustic",
+                "missing caustic",
+                "a render without its caustic",
             );
-            assert!(
-                f > r.tol.tolerance,
-                "{name}: a render without its caustic passed ({f}, tolerance {})",
-                r.tol.tolerance
-            );
+            assert_caught(name, defect, &img, &r);
         }
     }
 }

@@ -206,32 +206,7 @@ fn plane_irradiance(x: f64, z: f64, s: f64, h: f64, le: f64) -> f64 {
 /// give the closed-form irradiance, pixel by pixel averaged over the view.
 #[test]
 fn a_uniformly_lit_plane_gives_its_analytic_irradiance() {
-    let text = r#"
-[camera]
-position = [0.0, 0.95, 0.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, 1.0]
-vfov = 120.0
-width = 32
-height = 32
-[photon_map]
-max_radius = 0.2
-[materials]
-floor = { type = "diffuse", albedo = [0.5, 0.5, 0.5] }
-[[shape]]
-type = "parallelogram"
-corner = [-10.0, 0.0, -10.0]
-edge1 = [20.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 20.0]
-material = "floor"
-[[light]]
-type = "area"
-corner = [-10.0, 1.0, -10.0]
-edge1 = [20.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 20.0]
-radiance = [1.0, 1.0, 1.0]
-"#;
-    let scene = load_scene_str(text, std::path::Path::new("lit_plane.toml")).unwrap();
+    let scene = common::fixture("lit_plane");
     let o = SppmOptions {
         iterations: 32,
         photons_per_iteration: 1 << 15,
@@ -276,11 +251,7 @@ radiance = [1.0, 1.0, 1.0]
 /// estimation) must agree block by block within their combined noise.
 #[test]
 fn sppm_agrees_with_an_independent_path_tracer() {
-    let scene = load_scene_str(
-        common::TWO_LIGHT_BOX,
-        std::path::Path::new("two_light_box.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("two_light_box");
     let t0 = std::time::Instant::now();
     let pt = photonmap::reference::path_trace::path_trace(&scene, 32, 32, 1024, 11);
     let pt_seconds = t0.elapsed().as_secs_f64();
