@@ -34,8 +34,7 @@ fn files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 /// Runs photonmap with `args`, sends `signal` once stderr has shown `started`
 /// (and `delay` more), and returns the exit code and stderr.
 fn interrupted(args: &[&str], started: &str, delay_ms: u64, signal: &str) -> (Option<i32>, String) {
-    let mut running = Run::new(args).spawn();
-    let child = &mut running.child;
+    let mut child = Run::new(args).spawn();
     let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
     let mut seen = String::new();
     for line in lines.by_ref() {

@@ -18,7 +18,7 @@ use photonmap::scene::{load_scene, Scene};
 #[allow(unused_imports)]
 pub use context::{gpu, OwnGpu};
 #[allow(unused_imports)]
-pub use run::{Printed, Run, Running};
+pub use run::{Printed, Run};
 #[allow(unused_imports)]
 pub use temp::TempDir;
 

@@ -6,17 +6,17 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 
-use super::TempDir;
-
-/// One run of `photonmap`, in a fresh temporary folder unless [`Run::in_dir`]
-/// names another.
+/// One run of `photonmap`. It runs in the package root, as a user runs it in
+/// a checkout: commands find `reference_images/` there (bench accuracy,
+/// differentials and mitsuba look for their references by that relative
+/// path), so a test gives every output a path in its own `TempDir`.
+/// [`Run::in_dir`] runs it elsewhere.
 pub struct Run {
     command: Command,
     shown: String,
     /// Files and folders the command is asked to write: a refused command
     /// must leave each one that did not exist before it ran as absent.
     outputs: Vec<PathBuf>,
-    folder: Option<TempDir>,
 }
 
 impl Run {
@@ -27,14 +27,12 @@ impl Run {
 
     /// The binary at `bin` (a copy of `photonmap`) with `args`.
     pub fn of<S: AsRef<OsStr>>(bin: impl AsRef<OsStr>, args: impl IntoIterator<Item = S>) -> Self {
-        let folder = TempDir::new("run");
         let mut command = Command::new(bin);
-        command.current_dir(&folder);
+        command.current_dir(super::root());
         Self {
             command,
             shown: "photonmap".into(),
             outputs: Vec::new(),
-            folder: Some(folder),
         }
         .args(args)
     }
@@ -67,10 +65,9 @@ impl Run {
         self.writing("-o", path)
     }
 
-    /// Runs in `dir` instead of a fresh folder.
+    /// Runs in `dir` instead of the package root.
     pub fn in_dir(mut self, dir: impl AsRef<Path>) -> Self {
         self.command.current_dir(dir);
-        self.folder = None;
         self
     }
 
@@ -129,24 +126,13 @@ impl Run {
     }
 
     /// Starts it with stderr piped to the test and stdout discarded.
-    pub fn spawn(mut self) -> Running {
-        let child = self
-            .command
+    pub fn spawn(mut self) -> Child {
+        self.command
             .stderr(Stdio::piped())
             .stdout(Stdio::null())
             .spawn()
-            .unwrap_or_else(|e| panic!("{}: {e}", self.shown));
-        Running {
-            child,
-            _folder: self.folder,
-        }
+            .unwrap_or_else(|e| panic!("{}: {e}", self.shown))
     }
-}
-
-/// A run under way (its folder lives as long as it does).
-pub struct Running {
-    pub child: Child,
-    _folder: Option<TempDir>,
 }
 
 /// A finished run's output as text.
