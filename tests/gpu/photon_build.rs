@@ -254,15 +254,20 @@ fn check_routing(gpu: &Gpu, points: &[[f32; 3]], grid: &Grid, block: u32, feed: 
     let _ = total_destined_power;
 }
 
+/// A uniform grid of `resolution` cells over the unit cube.
+fn unit_grid(resolution: [u32; 3]) -> Grid {
+    Grid {
+        min: glam::Vec3::ZERO,
+        max: glam::Vec3::ONE,
+        resolution,
+        storage: GridStorage::Uniform,
+    }
+}
+
 #[test]
 fn stencil_routing_equals_a_cpu_simulation_of_the_draw_order() {
     let gpu = common::gpu();
-    let grid = Grid {
-        min: glam::Vec3::ZERO,
-        max: glam::Vec3::ONE,
-        resolution: [5, 4, 3],
-        storage: GridStorage::Uniform,
-    };
+    let grid = unit_grid([5, 4, 3]);
     let mut rng = Rng(7);
     let mut points: Vec<[f32; 3]> = (0..3000)
         .map(|_| {
@@ -281,12 +286,7 @@ fn stencil_routing_equals_a_cpu_simulation_of_the_draw_order() {
 #[test]
 fn stencil_routing_counts_past_255_and_never_overwrites() {
     let gpu = common::gpu();
-    let grid = Grid {
-        min: glam::Vec3::ZERO,
-        max: glam::Vec3::ONE,
-        resolution: [2, 1, 1],
-        storage: GridStorage::Uniform,
-    };
+    let grid = unit_grid([2, 1, 1]);
     // 300 photons into cell 0 and 5 into cell 1, at distinct points.
     let mut points: Vec<[f32; 3]> = (0..300)
         .map(|i| [0.1 + 0.001 * i as f32, 0.5, 0.5])
@@ -302,10 +302,7 @@ fn stencil_routing_counts_past_255_and_never_overwrites() {
     check_routing(
         &gpu,
         &one,
-        &Grid {
-            resolution: [1, 1, 1],
-            ..grid
-        },
+        &unit_grid([1, 1, 1]),
         16,
         VertexFeed::VertexFetch,
     );
@@ -316,12 +313,7 @@ fn routed_power_equals_destined_power_when_photons_are_alike() {
     // Equal-power photons, cells far over capacity: redistribution must conserve
     // the total exactly (up to float rounding).
     let gpu = common::gpu();
-    let grid = Grid {
-        min: glam::Vec3::ZERO,
-        max: glam::Vec3::ONE,
-        resolution: [3, 1, 2],
-        storage: GridStorage::Uniform,
-    };
+    let grid = unit_grid([3, 1, 2]);
     let mut rng = Rng(99);
     let points: Vec<[f32; 3]> = (0..5000)
         .map(|_| {
@@ -363,12 +355,7 @@ fn the_stencil_pattern_and_saturation_are_as_the_paper_describes() {
     // Read the stencil after routing 300 photons into one 16 x 16 cell: every
     // slot has counted min(255, slot + 300) = 255; with 10 photons, slot + 10.
     let gpu = common::gpu();
-    let grid = Grid {
-        min: glam::Vec3::ZERO,
-        max: glam::Vec3::ONE,
-        resolution: [1, 1, 1],
-        storage: GridStorage::Uniform,
-    };
+    let grid = unit_grid([1, 1, 1]);
     for n in [10usize, 300] {
         let points: Vec<[f32; 3]> = (0..n).map(|i| [0.001 * i as f32, 0.5, 0.5]).collect();
         let frames = common::frames_from_points(&gpu, &points, |_| [1.0; 3]);

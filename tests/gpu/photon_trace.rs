@@ -372,6 +372,15 @@ fn projection_maps_keep_every_direction_that_reaches_a_specular_shape() {
     }
 }
 
+/// The default tracer, aiming photons by projection maps or not.
+fn aiming(gpu: &photonmap::gpu::Gpu, projection_maps: bool) -> PhotonTracer {
+    let config = TraceConfig {
+        projection_maps,
+        ..TraceConfig::default()
+    };
+    PhotonTracer::with_config(gpu, config).unwrap()
+}
+
 /// RING stores caustics only (scenes/ring.toml says so) because that loses
 /// nothing: its only diffuse surface is a plane, and a vertical mirror keeps a
 /// photon's vertical direction, so light that left the floor never returns to
@@ -386,14 +395,7 @@ fn ring_loses_no_stored_photon_by_storing_caustics_only() {
     let mut caustics = all_paths.clone();
     caustics.photon_map.caustics_only = true;
     let textures = SceneTextures::new(&gpu, &all_paths).unwrap();
-    let tracer = PhotonTracer::with_config(
-        &gpu,
-        TraceConfig {
-            projection_maps: false,
-            ..TraceConfig::default()
-        },
-    )
-    .unwrap();
+    let tracer = aiming(&gpu, false);
     let stored = |scene: &Scene| -> Vec<PhotonRecord> {
         let frames = tracer.trace(scene, &textures, 5, 200_000).unwrap();
         records(&frames)
@@ -430,14 +432,7 @@ fn projection_maps_keep_the_stored_caustic_flux() {
         scene.photon_map.caustics_only = true;
         let textures = SceneTextures::new(&gpu, &scene).unwrap();
         let flux = |aimed: bool, emitted: u32| -> (f64, f64) {
-            let tracer = PhotonTracer::with_config(
-                &gpu,
-                TraceConfig {
-                    projection_maps: aimed,
-                    ..TraceConfig::default()
-                },
-            )
-            .unwrap();
+            let tracer = aiming(&gpu, aimed);
             let frames = tracer.trace(&scene, &textures, 3, emitted).unwrap();
             assert_eq!(frames.projection.is_some(), aimed);
             let per_frame = (frames.width * frames.frame_height) as usize;

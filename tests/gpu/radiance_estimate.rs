@@ -70,12 +70,31 @@ fn gpu_results(out: &RenderOutput) -> Vec<(usize, Vec3, Vec3, f32, u32)> {
     v
 }
 
-/// A GPU query's (accepted, r^2, flux) is its CPU twin's: the same accepted
-/// count, radius and flux to float precision.
-fn agrees((accepted, r2, flux): (u32, f32, Vec3), cpu: (u32, f32, Vec3)) -> bool {
-    cpu.0 == accepted
-        && (cpu.1 - r2).abs() <= 1e-5 * r2.max(1e-12)
-        && (cpu.2 - flux).abs().max_element() <= 1e-4 * cpu.2.max_element().max(1e-20)
+/// How many of the GPU's queries `results` end otherwise than `twin(pixel,
+/// position)`'s (accepted, r^2, flux): another accepted count, or radius or
+/// flux beyond float precision. The first few are printed, named `what`.
+fn disagreeing(
+    what: &str,
+    results: &[(usize, Vec3, Vec3, f32, u32)],
+    twin: impl Fn(usize, Vec3) -> (u32, f32, Vec3),
+) -> usize {
+    let mut mismatched = 0;
+    for &(i, x, flux, r2, accepted) in results {
+        let cpu = twin(i, x);
+        let same = cpu.0 == accepted
+            && (cpu.1 - r2).abs() <= 1e-5 * r2.max(1e-12)
+            && (cpu.2 - flux).abs().max_element() <= 1e-4 * cpu.2.max_element().max(1e-20);
+        if !same {
+            mismatched += 1;
+            if mismatched < 4 {
+                eprintln!(
+                    "{what} pixel {i}: GPU {accepted} {r2} {flux}, CPU {} {} {}",
+                    cpu.0, cpu.1, cpu.2
+                );
+            }
+        }
+    }
+    mismatched
 }
 
 #[test]
@@ -96,22 +115,10 @@ fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
                 "{name}: only {} query pixels",
                 results.len()
             );
-            let mut mismatched = 0;
-            for (i, x, flux, r2, accepted) in &results {
-                let cpu = knn_grid(&cpu_map, *x, k, max_r);
-                if !agrees(
-                    (*accepted, *r2, *flux),
-                    (cpu.accepted, cpu.radius2, cpu.flux),
-                ) {
-                    mismatched += 1;
-                    if mismatched < 4 {
-                        eprintln!(
-                            "{name} {build:?} pixel {i}: GPU {accepted} {r2} {flux}, CPU {} {} {}",
-                            cpu.accepted, cpu.radius2, cpu.flux
-                        );
-                    }
-                }
-            }
+            let mismatched = disagreeing(&format!("{name} {build:?}"), &results, |_, x| {
+                let cpu = knn_grid(&cpu_map, x, k, max_r);
+                (cpu.accepted, cpu.radius2, cpu.flux)
+            });
             eprintln!(
                 "{name} {build:?}: {} query pixels, {mismatched} differ from the CPU kNN-grid",
                 results.len()
@@ -399,22 +406,18 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
             let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
             let thickness = photonmap::layout::DISC_THICKNESS * max_r;
             let results = gpu_results(&out);
-            let mut mismatched = 0;
-            for (i, x, flux, r2, accepted) in &results {
+            let mismatched = disagreeing(&format!("{name} {leak:?}"), &results, |i, x| {
                 let nf = Vec3::from_slice(&normal[4 * i..]);
                 let accept = |p: Vec3| {
                     let disc = !matches!(leak, LeakTest::Disc | LeakTest::DiscAndVisibility)
-                        || (p - *x).dot(nf).abs() <= thickness;
+                        || (p - x).dot(nf).abs() <= thickness;
                     let seen = !matches!(leak, LeakTest::Visibility | LeakTest::DiscAndVisibility)
-                        || photon_visible(&scene, *x, nf, p);
+                        || photon_visible(&scene, x, nf, p);
                     disc && seen
                 };
-                let cpu = knn_grid_filtered(&cpu_map, *x, k, max_r, &accept);
-                mismatched += !agrees(
-                    (*accepted, *r2, *flux),
-                    (cpu.accepted, cpu.radius2, cpu.flux),
-                ) as usize;
-            }
+                let cpu = knn_grid_filtered(&cpu_map, x, k, max_r, &accept);
+                (cpu.accepted, cpu.radius2, cpu.flux)
+            });
             eprintln!(
                 "{name} {leak:?}: {} query pixels, {mismatched} differ from the CPU twin",
                 results.len()
