@@ -18,7 +18,7 @@ use photonmap::scene::Scene;
 use super::args::{in_range, SceneArgs};
 
 /// Render a scene and test it against a regression reference (the z-test of
-/// tests/reference_images.rs); --update makes the reference instead.
+/// tests/gpu/reference_images.rs); --update makes the reference instead.
 #[derive(Args)]
 pub struct RegressArgs {
     #[command(flatten)]

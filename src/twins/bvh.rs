@@ -1,6 +1,6 @@
 //! The BVH traversal of glsl/common/scene.glsl in Rust, step for step: the
 //! same ordered stack, the same conservative box test and the same primitive
-//! tests, so its answers are the GPU's (tests/bvh.rs compares both with a loop
+//! tests, so its answers are the GPU's (tests/gpu/bvh.rs compares both with a loop
 //! over every primitive).
 
 use glam::Vec3;

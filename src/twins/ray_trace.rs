@@ -1,7 +1,7 @@
 //! A CPU ray tracer of the same light transport as the GPU passes, but
 //! deterministic: glass *splits* into both Fresnel-weighted branches where the
 //! GPU chooses one at random. Averaging GPU renders over seeds must converge to
-//! this (tests/ray_tracer.rs), which is what shows the stochastic choice is unbiased.
+//! this (tests/gpu/ray_tracer.rs), which is what shows the stochastic choice is unbiased.
 
 use glam::Vec3;
 

@@ -1,32 +1,66 @@
 #![allow(dead_code)]
-//! Helpers shared by the integration tests: a real GL context on whatever EGL
-//! offers (Mesa llvmpipe on CI), scenes, and image metrics.
+//! Helpers shared by the integration tests, in one place for every test
+//! binary: the GL context (`context`), scratch folders (`temp`), the built
+//! binary run as a user runs it (`run`), scenes (the paper's and the test
+//! fixtures in scenes/tests/), image metrics and the one random source.
+
+mod context;
+mod run;
+mod temp;
 
 use std::path::{Path, PathBuf};
 
-use photonmap::gpu::{Gpu, Platform};
+use photonmap::gpu::Gpu;
 use photonmap::render::Image;
 use photonmap::scene::{load_scene, Scene};
 
 mod moved_text;
 mod rng;
 
-// Not every test uses every helper (as with `dead_code` above).
+// Every test binary compiles this module; none uses all of it.
+#[allow(unused_imports)]
+pub use context::{gpu, OwnGpu};
 #[allow(unused_imports)]
 pub use moved_text::moved_scene_text;
 #[allow(unused_imports)]
 pub use rng::Rng;
-
-pub fn gpu() -> Gpu {
-    Gpu::new(Platform::Auto).expect("a GL 4 context (install libegl1 libegl-mesa0 libgl1-mesa-dri)")
-}
+#[allow(unused_imports)]
+pub use run::{Printed, Run};
+#[allow(unused_imports)]
+pub use temp::TempDir;
 
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// scenes/<name>.toml (`ring`, `variants/...`, `tests/...`).
+pub fn scene_file(name: &str) -> PathBuf {
+    root().join("scenes").join(format!("{name}.toml"))
+}
+
 pub fn paper_scene(name: &str) -> Scene {
-    load_scene(&root().join("scenes").join(format!("{name}.toml"))).expect("paper scene loads")
+    load_scene(&scene_file(name)).expect("paper scene loads")
+}
+
+/// A test scene of scenes/tests/ by name: `fixture_file("mirror_box")`.
+pub fn fixture_file(name: &str) -> PathBuf {
+    scene_file(&format!("tests/{name}"))
+}
+
+pub fn fixture_text(name: &str) -> String {
+    let file = fixture_file(name);
+    std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()))
+}
+
+pub fn fixture(name: &str) -> Scene {
+    load_scene(&fixture_file(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// `text` with `from`, which it must hold exactly once, replaced by `to`: a
+/// variant of a scene file, edited as a user would edit it.
+pub fn replace_once(text: &str, from: &str, to: &str) -> String {
+    assert_eq!(text.matches(from).count(), 1, "'{from}' once in: {text}");
+    text.replacen(from, to, 1)
 }
 
 /// Root-mean-square difference over all channels (sizes must match).
@@ -34,15 +68,18 @@ pub fn rmse(a: &Image, b: &Image) -> f64 {
     photonmap::metrics::rmse(a, b).unwrap()
 }
 
-pub fn write_exr(path: &Path, img: &Image) {
-    photonmap::image::write_atomically(path, &img.exr_bytes().unwrap()).unwrap();
+/// How many channels of two images differ in any bit (sizes must match).
+pub fn channels_differing(a: &Image, b: &Image) -> usize {
+    a.pixels
+        .iter()
+        .flatten()
+        .zip(b.pixels.iter().flatten())
+        .filter(|(x, y)| x.to_bits() != y.to_bits())
+        .count()
 }
 
-/// A fresh folder under the system's temporary directory for this test run.
-pub fn tempdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("photonmap-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+pub fn write_exr(path: &Path, img: &Image) {
+    photonmap::image::write_atomically(path, &img.exr_bytes().unwrap()).unwrap();
 }
 
 /// Writes a UV sphere of about `triangles` triangles (unit radius, outward
@@ -113,86 +150,6 @@ pub fn block_chi2(a: &[Image], b: &[Image], block: u32) -> (f64, usize, f64) {
     (chi2 / blocks as f64, blocks, bound)
 }
 
-/// A closed box with a mirror ball and a glass ball (gather rays follow both),
-/// a point light and an area light.
-pub const MIRROR_BOX: &str = r#"
-[camera]
-position = [0.5, 0.5, 1.4]
-look_at = [0.5, 0.45, 0.0]
-vfov = 55.0
-width = 24
-height = 24
-[render]
-shadow_rays = 4
-max_specular_depth = 6
-[photon_map]
-photons_stored = 20000
-grid_resolution = [16, 16, 24]
-k = 40
-max_radius = 0.15
-[materials]
-white = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
-red = { type = "diffuse", albedo = [0.7, 0.2, 0.2] }
-mirror = { type = "mirror", reflectance = [0.9, 0.9, 0.9] }
-glass = { type = "glass", ior = 1.5 }
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [0.0, 0.0, 1.5]
-edge2 = [1.0, 0.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 1.0, 0.0]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 1.5]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 1.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 1.5]
-edge1 = [0.0, 1.0, 0.0]
-edge2 = [1.0, 0.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [0.0, 1.0, 0.0]
-edge2 = [0.0, 0.0, 1.5]
-material = "red"
-[[shape]]
-type = "parallelogram"
-corner = [1.0, 0.0, 0.0]
-edge1 = [0.0, 0.0, 1.5]
-edge2 = [0.0, 1.0, 0.0]
-material = "white"
-[[shape]]
-type = "sphere"
-center = [0.3, 0.2, 0.5]
-radius = 0.18
-material = "mirror"
-[[shape]]
-type = "sphere"
-center = [0.72, 0.2, 0.6]
-radius = 0.16
-material = "glass"
-[[light]]
-type = "point"
-position = [0.5, 0.85, 0.7]
-intensity = [0.4, 0.4, 0.4]
-[[light]]
-type = "area"
-corner = [0.4, 0.999, 0.4]
-edge1 = [0.2, 0.0, 0.0]
-edge2 = [0.0, 0.0, 0.2]
-radiance = [5.0, 5.0, 5.0]
-"#;
-
 /// Photon frames with one frame of `records` photons at the given points.
 pub fn frames_from_points(
     gpu: &Gpu,
@@ -225,6 +182,45 @@ pub fn frames_from_points(
     .unwrap()
 }
 
+/// Runs glsl/test/intersect_twin.frag in `mode` on `textures`' scene over
+/// rays, one texel each in rows of `width`: `[origins, directions, normals]`
+/// (the normals only some modes read); returns each ray's output texel.
+pub fn intersect_twin(
+    gpu: &Gpu,
+    textures: &photonmap::scene::pack::SceneTextures,
+    width: u32,
+    [origins, directions, normals]: [&[[f32; 4]]; 3],
+    mode: i32,
+) -> Vec<[f32; 4]> {
+    use photonmap::gpu::{DrawState, Program, Target, TexFormat, Texture};
+    let n = origins.len();
+    let height = n.div_ceil(width as usize) as u32;
+    let upload = |texels: &[[f32; 4]]| {
+        let mut d: Vec<f32> = texels.iter().flatten().copied().collect();
+        d.resize((width * height * 4) as usize, 0.0);
+        Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, &d).unwrap()
+    };
+    let (to, td, tn) = (upload(origins), upload(directions), upload(normals));
+    let out = Texture::new(gpu, width, height, TexFormat::Rgba32F).unwrap();
+    let target = Target::new(gpu, &[&out]).unwrap();
+    let program = Program::fullscreen(gpu, "test/intersect_twin.frag").unwrap();
+    let mut b = program.bind();
+    textures.bind(&mut b);
+    b.texture("u_ray_origin", &to)
+        .texture("u_ray_direction", &td)
+        .texture("u_ray_normal", &tn)
+        .int("u_primitive", 0)
+        .int("u_mode", mode)
+        .draw_fullscreen(&target, &DrawState::PLAIN)
+        .unwrap();
+    texels(&out).into_iter().take(n).collect()
+}
+
+/// A point or vector as an RGBA texel (w = 0).
+pub fn texel(v: glam::Vec3) -> [f32; 4] {
+    [v.x, v.y, v.z, 0.0]
+}
+
 /// A texture read back as RGBA texels, in GL order.
 pub fn texels(t: &photonmap::gpu::Texture) -> Vec<[f32; 4]> {
     t.read_f32()
@@ -237,69 +233,6 @@ pub fn texels(t: &photonmap::gpu::Texture) -> Vec<[f32; 4]> {
 pub fn v3(t: [f32; 4]) -> glam::Vec3 {
     glam::Vec3::new(t[0], t[1], t[2])
 }
-
-/// A diffuse box with a point light and a small area light (the SPPM and IGI
-/// tests against the CPU path tracer).
-pub const TWO_LIGHT_BOX: &str = r#"
-[camera]
-position = [0.5, 0.5, 1.45]
-look_at = [0.5, 0.45, 0.0]
-vfov = 60.0
-width = 32
-height = 32
-[photon_map]
-max_radius = 0.08
-[materials]
-white = { type = "diffuse", albedo = [0.7, 0.7, 0.7] }
-red = { type = "diffuse", albedo = [0.7, 0.2, 0.2] }
-green = { type = "diffuse", albedo = [0.2, 0.6, 0.3] }
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 0.0, 1.5]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 1.0, 0.0]
-edge1 = [0.0, 0.0, 1.5]
-edge2 = [1.0, 0.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [0.0, 1.0, 0.0]
-edge2 = [1.0, 0.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 1.5]
-edge1 = [1.0, 0.0, 0.0]
-edge2 = [0.0, 1.0, 0.0]
-material = "white"
-[[shape]]
-type = "parallelogram"
-corner = [0.0, 0.0, 0.0]
-edge1 = [0.0, 0.0, 1.5]
-edge2 = [0.0, 1.0, 0.0]
-material = "red"
-[[shape]]
-type = "parallelogram"
-corner = [1.0, 0.0, 0.0]
-edge1 = [0.0, 1.0, 0.0]
-edge2 = [0.0, 0.0, 1.5]
-material = "green"
-[[light]]
-type = "point"
-position = [0.3, 0.7, 0.5]
-intensity = [0.3, 0.3, 0.3]
-[[light]]
-type = "area"
-corner = [0.6, 0.999, 0.4]
-edge1 = [0.2, 0.0, 0.0]
-edge2 = [0.0, 0.0, 0.2]
-radiance = [6.0, 6.0, 6.0]
-"#;
 
 /// Two independent 32 x 32 renders against the CPU path tracer, block by
 /// block over the interior 6 x 6 blocks of 4 x 4 pixels (the outer ring, the

@@ -1,0 +1,127 @@
+//! `photonmap compare`: metrics, a difference image and checked inputs, and
+//! compare as a CI gate (thresholds, exit code 1 on failure).
+
+use std::path::PathBuf;
+
+use crate::common::{Printed, Run, TempDir};
+
+#[test]
+fn compare_prints_metrics_writes_a_difference_image_and_checks_its_inputs() {
+    let d = TempDir::new("compare");
+    let render_exr = |seed: &str, name: &str| {
+        let exr = d.join(name);
+        Run::new(["render", "--quiet", "--direct-only", "--width", "40"])
+            .args(["--height", "30", "--seed", seed])
+            .scene("glass_ball")
+            .output_to(d.join("x.png"))
+            .writing("--exr", &exr)
+            .succeeds();
+        exr
+    };
+    let (a, b) = (render_exr("1", "a.exr"), render_exr("2", "b.exr"));
+    let metrics = |x: &PathBuf, y: &PathBuf, extra: &[&str]| {
+        Run::new(["compare"])
+            .arg(x)
+            .arg(y)
+            .arg("--json")
+            .args(extra)
+            .json()
+    };
+    let same = metrics(&a, &a, &[]);
+    assert_eq!(same["rmse"], 0.0);
+    assert_eq!(same["ssim"], 1.0);
+    let diff_png = d.join("diff.png");
+    let other = metrics(&a, &b, &["--diff", diff_png.to_str().unwrap()]);
+    assert!(
+        other["rmse"].as_f64().unwrap() > 0.0 && other["ssim"].as_f64().unwrap() < 1.0,
+        "{other}"
+    );
+    assert_eq!(
+        image::open(&diff_png).unwrap().to_rgb8().dimensions(),
+        (40, 30)
+    );
+    // A mask of the wrong size is refused, naming both sizes.
+    let small = d.join("mask.png");
+    image::RgbImage::new(10, 10).save(&small).unwrap();
+    Run::new(["compare"])
+        .arg(&a)
+        .arg(&b)
+        .arg("--mask")
+        .arg(&small)
+        .refused_with("10 x 10");
+    Run::new(["compare"])
+        .arg(d.join("nope.exr"))
+        .arg(&b)
+        .refused_with("nope.exr");
+}
+
+/// compare as a CI gate: an identical image passes, a perturbed one fails
+/// with exit code 1 and a difference image.
+#[test]
+fn compare_fails_a_perturbed_image_and_passes_an_identical_one() {
+    let d = TempDir::new("gate");
+    let (a, b) = (d.join("a.exr"), d.join("b.exr"));
+    let render = |path: &std::path::Path, extra: &[&str]| {
+        Run::new([
+            "render",
+            "glass_ball",
+            "--quiet",
+            "--width",
+            "48",
+            "--height",
+            "36",
+        ])
+        .args(extra)
+        .output_to(path)
+        .succeeds();
+    };
+    render(&a, &[]);
+    render(&b, &["--set", "light[0].radiance=[80.0, 80.0, 80.0]"]);
+    let gate = |image: &std::path::Path| {
+        Run::new([
+            "compare",
+            "--json",
+            "--fail-rmse",
+            "0.01",
+            "--fail-ssim",
+            "0.99",
+        ])
+        .args([
+            "--fail-flip",
+            "0.05",
+            "--fail",
+            "0.05",
+            "--fail-percent",
+            "1",
+        ])
+        .arg(image)
+        .arg(&a)
+        .writing("--diff", d.join("diff.png"))
+        .run()
+    };
+    let same = gate(&a);
+    assert_eq!(same.status.code(), Some(0), "{}", same.stderr_text());
+    let v = same.json();
+    assert_eq!(v["passed"], true);
+    assert_eq!(v["flip"], 0.0);
+    let _ = std::fs::remove_file(d.join("diff.png"));
+    let changed = gate(&b);
+    assert_eq!(changed.status.code(), Some(1));
+    let v = changed.json();
+    assert_eq!(v["passed"], false);
+    let failed: Vec<&str> = v["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["passed"] == false)
+        .map(|c| c["metric"].as_str().unwrap())
+        .collect();
+    assert!(
+        failed.contains(&"rmse") && failed.contains(&"percent_beyond"),
+        "{v}"
+    );
+    assert!(
+        d.join("diff.png").is_file(),
+        "the difference image is written on failure"
+    );
+}

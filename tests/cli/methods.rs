@@ -1,0 +1,320 @@
+//! `render --method ...` and its switches as a user runs them: final gather
+//! and adaptive sampling, IGI, photon differentials and radiosity each report
+//! what they did in the JSON, and a switch without its method, an
+//! acceleration its method cannot use, or an impossible value is refused
+//! with a reason, writing no image.
+
+use std::path::Path;
+
+use crate::common::{Run, TempDir};
+
+/// Final gather and adaptive sampling as a user runs them: the JSON reports
+/// the gather and the pyramid's levels (adaptive SPPM: its pilot and plan); a
+/// caustics-only scene, final gather with SPPM, a pilot that leaves no
+/// iterations, and --gather-k, a threshold or a pilot without their switch
+/// are refused with a reason, and write nothing.
+#[test]
+fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
+    let d = TempDir::new("final-gather");
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
+            "--final-gather",
+            "3",
+            "--adaptive",
+            "--set",
+            "photon_map.photons_stored=4000",
+        ],
+    );
+    assert_eq!(json["method"], "final-gather");
+    assert_eq!(json["final_gather"]["rays"], 3);
+    assert_eq!(json["gathers"][0]["rays_per_pixel"], 3);
+    let levels = json["adaptive_samples"][0]["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 4, "{levels:?}");
+    let computed = json["adaptive_samples"][0]["computed"].as_u64().unwrap();
+    let all = json["adaptive_samples"][0]["pixels_with_hits"]
+        .as_u64()
+        .unwrap();
+    assert!(0 < computed && computed < all, "{computed} of {all}");
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
+            "--method",
+            "sppm",
+            "--adaptive",
+            "--iterations",
+            "4",
+            "--photons-per-iteration",
+            "4096",
+        ],
+    );
+    assert_eq!(
+        json["adaptive_pilot"], 1,
+        "an eighth of 4 iterations, at least 1"
+    );
+    let interpolated = json["adaptive_samples"]["interpolated"].as_u64().unwrap();
+    assert!(0 < interpolated && interpolated < 40 * 36, "{interpolated}");
+    let refused: [(&[&str], &str); 13] = [
+        (
+            &["--adaptive", "--method", "sppm", "--sppm-direct", "photons"],
+            "shadow-rays",
+        ),
+        (
+            &["--final-gather", "2", "--scene-name-ring"],
+            "caustics_only",
+        ),
+        (&["--adaptive", "--snapshots", "."], "--snapshots"),
+        (
+            &["--final-gather", "2", "--reference-software", "r.png"],
+            "--reference-software",
+        ),
+        (
+            &[
+                "--adaptive",
+                "--method",
+                "sppm",
+                "--iterations",
+                "4",
+                "--adaptive-pilot",
+                "4",
+            ],
+            "pilot",
+        ),
+        (&["--adaptive", "--adaptive-pilot", "2"], "--adaptive-pilot"),
+        (&["--method", "sppm", "--adaptive-pilot", "2"], "--adaptive"),
+        (
+            &["--final-gather", "2", "--method", "sppm"],
+            "--final-gather",
+        ),
+        (&["--gather-k", "10"], "--final-gather"),
+        (&["--adaptive-threshold", "0.2"], "--adaptive"),
+        (
+            &["--method", "sppm", "--start-photons", "70000"],
+            "0..=65536",
+        ),
+        (
+            &["--method", "sppm", "--start-pixels=-1"],
+            "0..=1000000 (0: no bound)",
+        ),
+        (
+            &["--method", "sppm", "--start-pixels", "2", "--radius", "0.1"],
+            "--radius",
+        ),
+    ];
+    for (args, says) in refused {
+        let ring = args.contains(&"--scene-name-ring");
+        let args: Vec<&str> = args
+            .iter()
+            .copied()
+            .filter(|a| !a.starts_with("--scene-name"))
+            .collect();
+        assert_render_refused(&d, if ring { "ring" } else { "cornell_box" }, &args, says);
+    }
+}
+
+/// IGI as a user runs it: the JSON reports the VPLs and the gather; IGI's
+/// switches without `--method igi`, the one-shot estimate's accelerations
+/// with it, and impossible values are refused with a reason, writing nothing.
+#[test]
+fn igi_runs_and_refuses_what_it_cannot_do() {
+    let d = TempDir::new("igi");
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
+            "--method",
+            "igi",
+            "--vpl-paths",
+            "32",
+            "--interleave",
+            "2",
+            "--downsample",
+            "2",
+            "--imperfect-visibility",
+            "--set",
+            "photon_map.photons_stored=4000",
+        ],
+    );
+    assert_eq!(json["method"], "igi");
+    assert_eq!(json["vpls"]["paths"], 32);
+    let vpls = json["vpls"]["vpls"].as_u64().unwrap();
+    assert!(vpls >= 32, "{vpls}");
+    assert_eq!(json["igi"]["interleave"], 2);
+    let per_point = json["igi_samples"][0]["vpls_per_point"].as_f64().unwrap();
+    assert_eq!(per_point, vpls as f64 / 4.0);
+    let refused: [(&[&str], &str); 7] = [
+        (&["--interleave", "3"], "--method igi"),
+        (&["--method", "sppm", "--interleave", "3"], "IGI's switches"),
+        (&["--method", "igi", "--direct-only"], "--direct-only"),
+        (&["--method", "igi", "--adaptive"], "--adaptive"),
+        (
+            &["--method", "igi", "--final-gather", "2"],
+            "--final-gather",
+        ),
+        (&["--method", "igi", "--interleave", "0"], "1..=8"),
+        (&["--method", "igi", "--vpl-min-distance=-1"], "0 or more"),
+    ];
+    for (args, says) in refused {
+        assert_render_refused(&d, "cornell_box", args, says);
+    }
+}
+
+/// Photon differentials as a user runs them: the JSON reports the map (its
+/// footprints, s chosen by the pilot, the automatic leaf size) and the
+/// estimate; their switches without `--method differentials`, the kNN
+/// estimate's accelerations with it, and impossible values are refused with
+/// a reason, writing nothing.
+#[test]
+fn differentials_run_and_refuse_what_they_cannot_do() {
+    let d = TempDir::new("differentials");
+    let json = render_cornell_box_json(
+        &d,
+        ["40", "36"],
+        &[
+            "--method",
+            "differentials",
+            "--kernel",
+            "epanechnikov",
+            "--set",
+            "photon_map.photons_stored=4000",
+        ],
+    );
+    assert_eq!(json["method"], "differentials");
+    let map = &json["differentials"];
+    assert!(map["footprints"].as_u64().unwrap() >= 4000, "{map}");
+    assert_eq!(map["kernel"], "epanechnikov");
+    // Auto: s = sqrt((k - caustic) / diffuse), the pilot's means at s = 1,
+    // k = 500 in CORNELL BOX.
+    let diffuse = map["pilot_mean_diffuse_footprints"].as_f64().unwrap();
+    let caustic = map["pilot_mean_footprints"].as_f64().unwrap() - diffuse;
+    let s = map["smoothing"].as_f64().unwrap();
+    assert!(
+        (s - ((500.0 - caustic) / diffuse).sqrt()).abs() < 1e-3 * s,
+        "{map}"
+    );
+    assert_eq!(map["leaf_size"], map["auto_leaf_size"]);
+    let sample = &json["footprint_samples"][0];
+    assert!(
+        sample["mean_footprints"].as_f64().unwrap() > 1.0,
+        "{sample}"
+    );
+    assert!(sample["passes"].as_u64().unwrap() >= 1);
+    let refused: [(&[&str], &str); 10] = [
+        (&["--leaf-size", "8"], "--method differentials"),
+        (&["--method", "differentials", "--grid", "hash"], "--grid"),
+        (&["--method", "differentials", "--tile", "8"], "--tile"),
+        (
+            &["--method", "differentials", "--paper-search"],
+            "--paper-search",
+        ),
+        (
+            &["--method", "sppm", "--smoothing", "3"],
+            "photon differentials'",
+        ),
+        (&["--method", "differentials", "--adaptive"], "--adaptive"),
+        (
+            &["--method", "differentials", "--final-gather", "2"],
+            "--final-gather",
+        ),
+        (
+            &["--method", "differentials", "--leaf-size", "0"],
+            "1..=1024",
+        ),
+        (&["--method", "differentials", "--smoothing=0"], "positive"),
+        (
+            &["--method", "differentials", "--direct-only"],
+            "--direct-only",
+        ),
+    ];
+    for (args, says) in refused {
+        assert_render_refused(&d, "cornell_box", args, says);
+    }
+}
+
+/// Radiosity as a user runs it: the JSON reports the patches, the shots and
+/// the convergence after each; its switches without `--method radiosity`,
+/// the one-map estimate's accelerations with it, and impossible values are
+/// refused with a reason, writing nothing.
+#[test]
+fn radiosity_runs_and_refuses_what_it_cannot_do() {
+    let d = TempDir::new("radiosity");
+    let json = render_cornell_box_json(
+        &d,
+        ["32", "32"],
+        &[
+            "--method",
+            "radiosity",
+            "--elements",
+            "8",
+            "--substructure",
+            "2",
+            "--item-buffer",
+            "64",
+            "--set",
+            "photon_map.photons_stored=2000",
+        ],
+    );
+    assert_eq!(json["method"], "radiosity");
+    let r = &json["radiosity"];
+    assert_eq!(r["element_resolution"], 8);
+    assert_eq!(r["converged"], true);
+    let curve = r["convergence"].as_array().unwrap();
+    assert_eq!(curve.len() as u64, r["shots"].as_u64().unwrap() + 1);
+    let unshot: Vec<f64> = curve
+        .iter()
+        .map(|p| p["unshot_fraction"].as_f64().unwrap())
+        .collect();
+    assert!(
+        unshot[0] > 0.9 && *unshot.last().unwrap() < 1e-2,
+        "{unshot:?}"
+    );
+    assert!(r["tiles"].as_u64().unwrap() >= r["patches"].as_u64().unwrap());
+    let refused: [(&[&str], &str); 8] = [
+        (&["--elements", "8"], "--method radiosity"),
+        (&["--subdivide", "2"], "--method radiosity"),
+        (&["--method", "radiosity", "--subdivide", "7"], "0..=6"),
+        (&["--method", "radiosity", "--gradient", "0"], "positive"),
+        (&["--method", "radiosity", "--adaptive"], "--adaptive"),
+        (
+            &[
+                "--method",
+                "radiosity",
+                "--elements",
+                "8",
+                "--substructure",
+                "3",
+            ],
+            "divisor",
+        ),
+        (&["--method", "radiosity", "--convergence", "2"], "(0, 1)"),
+        (&["--method", "sppm", "--max-shots", "4"], "radiosity"),
+    ];
+    for (args, says) in refused {
+        assert_render_refused(&d, "cornell_box", args, says);
+    }
+}
+
+/// `render` of CORNELL BOX at the given size with `args` and `--json` into
+/// `dir/out.png`: it succeeds, writes the image, and prints this JSON.
+fn render_cornell_box_json(dir: &Path, [w, h]: [&str; 2], args: &[&str]) -> serde_json::Value {
+    let png = dir.join("out.png");
+    let json = Run::new(["render", "--quiet", "--json", "--width", w, "--height", h])
+        .args(args)
+        .scene("cornell_box")
+        .output_to(&png)
+        .json();
+    assert!(png.exists());
+    json
+}
+
+/// `render` of the named scene at 16 x 16 with `args` into `dir/bad.png`
+/// fails, says `says`, and writes no image.
+fn assert_render_refused(dir: &Path, name: &str, args: &[&str], says: &str) {
+    Run::new(["render", "--quiet", "--width", "16", "--height", "16"])
+        .args(args)
+        .scene(name)
+        .output_to(dir.join("bad.png"))
+        .refused_with(says);
+}

@@ -1,0 +1,361 @@
+//! Instant global illumination: the VPL gather equals its CPU twin on the same
+//! VPLs (exact and imperfect visibility), the discontinuity buffer and the
+//! joint bilateral upsampling equal theirs on the gather's own output, and in
+//! the furnace, unbounded and with exact visibility, IGI converges to the
+//! analytic answer as the VPL paths grow.
+
+use crate::common;
+
+use glam::Vec3;
+use photonmap::render::{render, IgiOptions, Method, RenderOptions, RenderOutput, WithCausticMap};
+use photonmap::scene::{load_scene_str, Material, Scene};
+use photonmap::twins::igi::{incident, Vpl};
+
+fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderOptions {
+    let mut o = RenderOptions::for_scene(scene);
+    (o.width, o.height, o.seed) = (w, h, seed);
+    o.method = Method::Igi(WithCausticMap {
+        method: igi,
+        ..WithCausticMap::default()
+    });
+    o
+}
+
+fn mirror_box() -> Scene {
+    common::fixture("mirror_box")
+}
+
+fn vpls(out: &RenderOutput) -> Vec<Vpl> {
+    out.igi_run()
+        .unwrap()
+        .vpls
+        .read()
+        .into_iter()
+        .map(|(p, n, i)| Vpl {
+            position: Vec3::from(p),
+            normal: Vec3::from(n),
+            intensity: Vec3::from(i),
+        })
+        .collect()
+}
+
+/// Pixels whose GPU and CPU values differ by more than float rounding allows.
+fn apart(gpu: &[Vec3], cpu: &[Vec3]) -> (usize, f32) {
+    let mut worst = 0f32;
+    let n = gpu
+        .iter()
+        .zip(cpu)
+        .filter(|(g, c)| {
+            let d = (**g - **c).abs().max_element() / (c.max_element() + 1e-6);
+            worst = worst.max(d);
+            d > 1e-4
+        })
+        .count();
+    (n, worst)
+}
+
+/// The gather at every pixel against the twin on the same VPLs and first hits.
+#[test]
+fn the_vpl_gather_equals_its_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = mirror_box();
+    for imperfect in [false, true] {
+        let igi = IgiOptions {
+            vpl_paths: 48,
+            imperfect_visibility: imperfect,
+            ..IgiOptions::default()
+        };
+        let m = igi.min_distance_for(&scene);
+        let out = render(&gpu, &scene, &options(&scene, 40, 36, 2, igi), &mut ()).unwrap();
+        let v = vpls(&out);
+        let pos = common::texels(&out.state.direct.diffuse_position);
+        let nor = common::texels(&out.state.direct.diffuse_normal);
+        let got: Vec<Vec3> = common::texels(&out.igi_run().unwrap().igi.incident)
+            .into_iter()
+            .map(common::v3)
+            .collect();
+        let twin: Vec<Vec3> = (0..pos.len())
+            .map(|i| {
+                if pos[i][3] > 0.0 {
+                    incident(
+                        &scene,
+                        &v,
+                        common::v3(pos[i]),
+                        common::v3(nor[i]),
+                        m,
+                        imperfect,
+                    )
+                } else {
+                    Vec3::ZERO
+                }
+            })
+            .collect();
+        let lit = twin.iter().filter(|c| c.max_element() > 0.0).count();
+        let (n, worst) = apart(&got, &twin);
+        eprintln!(
+            "IGI gather ({} visibility): {} VPLs; {lit} of {} pixels lit; {n} apart beyond 1e-4 (largest relative difference {worst:.2e})",
+            if imperfect { "imperfect" } else { "exact" },
+            v.len(),
+            got.len()
+        );
+        assert!(v.len() > 48, "every path leaves a VPL at its first hit");
+        assert!(lit * 2 > got.len());
+        // A shadow ray grazing an edge may decide differently in f32 on two
+        // sides of the same rounding: a handful of VPLs, never a systematic gap.
+        assert!(n * 100 <= got.len(), "{n} pixels apart");
+    }
+}
+
+/// Interleaving: each pixel's gather sums only its subset, scaled by the
+/// subsets (the twin on those VPLs), and the discontinuity buffer averages
+/// the window's continuous neighbours (the twin on the GPU's gather).
+/// Downsampling: the joint bilateral filter's twin on the GPU's low-resolution
+/// light gives the GPU's full-resolution indirect light.
+#[test]
+fn interleaving_and_upsampling_equal_their_cpu_twins() {
+    let gpu = common::gpu();
+    let scene = mirror_box();
+    let (w, h) = (40u32, 36u32);
+    let igi = IgiOptions {
+        vpl_paths: 48,
+        interleave: 3,
+        downsample: 2,
+        ..IgiOptions::default()
+    };
+    let (n, f) = (igi.interleave as i32, igi.downsample as i32);
+    let m = igi.min_distance_for(&scene);
+    let out = render(&gpu, &scene, &options(&scene, w, h, 4, igi), &mut ()).unwrap();
+    let v = vpls(&out);
+    let state = &out.igi_run().unwrap().igi;
+    let pos = common::texels(&out.state.direct.diffuse_position);
+    let nor = common::texels(&out.state.direct.diffuse_normal);
+    let thr = common::texels(&out.state.direct.diffuse_throughput);
+    let (lw, lh) = (w.div_ceil(f as u32) as i32, h.div_ceil(f as u32) as i32);
+    let shading = |qx: i32, qy: i32| -> usize {
+        let (x, y) = (
+            (qx * f + f / 2).min(w as i32 - 1),
+            (qy * f + f / 2).min(h as i32 - 1),
+        );
+        (y * w as i32 + x) as usize
+    };
+    // The gather, subset by subset.
+    let gathered: Vec<Vec3> = common::texels(&state.incident)
+        .into_iter()
+        .map(common::v3)
+        .collect();
+    let subsets = (n * n) as usize;
+    let twin: Vec<Vec3> = (0..lw * lh)
+        .map(|q| {
+            let (qx, qy) = (q % lw, q / lw);
+            let p = shading(qx, qy);
+            if pos[p][3] <= 0.0 {
+                return Vec3::ZERO;
+            }
+            let s = ((qx % n) + n * (qy % n)) as usize;
+            let mine: Vec<Vpl> = v.iter().copied().skip(s).step_by(subsets).collect();
+            incident(
+                &scene,
+                &mine,
+                common::v3(pos[p]),
+                common::v3(nor[p]),
+                m,
+                false,
+            ) * subsets as f32
+        })
+        .collect();
+    let (gather_apart, gather_worst) = apart(&gathered, &twin);
+    // The discontinuity buffer on the GPU's gather.
+    let eye = scene.camera.position;
+    let filtered: Vec<Vec3> = common::texels(state.filtered_incident())
+        .into_iter()
+        .map(common::v3)
+        .collect();
+    let ncos = photonmap::layout::VPL_NORMAL_COS;
+    let depth = photonmap::layout::VPL_DEPTH_TOLERANCE;
+    let filter_twin: Vec<Vec3> = (0..lw * lh)
+        .map(|q| {
+            let (qx, qy) = (q % lw, q / lw);
+            let p = shading(qx, qy);
+            if pos[p][3] <= 0.0 {
+                return gathered[q as usize];
+            }
+            let (x, nx) = (common::v3(pos[p]), common::v3(nor[p]));
+            let tol = depth * eye.distance(x);
+            let lo = -(n - 1) / 2;
+            let (mut sum, mut count) = (Vec3::ZERO, 0.0);
+            for j in lo..lo + n {
+                for i in lo..lo + n {
+                    let (ox, oy) = (qx + i, qy + j);
+                    if ox < 0 || oy < 0 || ox >= lw || oy >= lh {
+                        continue;
+                    }
+                    let op = shading(ox, oy);
+                    if pos[op][3] <= 0.0 {
+                        continue;
+                    }
+                    if (i, j) != (0, 0)
+                        && (common::v3(nor[op]).dot(nx) < ncos
+                            || (common::v3(pos[op]) - x).dot(nx).abs() > tol)
+                    {
+                        continue;
+                    }
+                    sum += gathered[(oy * lw + ox) as usize];
+                    count += 1.0;
+                }
+            }
+            sum / count
+        })
+        .collect();
+    let (filter_apart, filter_worst) = apart(&filtered, &filter_twin);
+    // The gather's occlusion query counts the shading points with a hit.
+    let points = (0..lw * lh)
+        .filter(|&q| pos[shading(q % lw, q / lw)][3] > 0.0)
+        .count() as u64;
+    assert_eq!(out.igi()[0].shading_points, points);
+    // The joint bilateral upsampling on the GPU's filtered light.
+    let albedo = |mat: f32| -> Vec3 {
+        match scene.materials[mat as usize - 1] {
+            Material::Diffuse { albedo } => albedo,
+            _ => Vec3::ZERO,
+        }
+    };
+    let indirect: Vec<Vec3> = common::texels(&state.indirect)
+        .into_iter()
+        .map(common::v3)
+        .collect();
+    let up_twin: Vec<Vec3> = (0..(w * h) as i32)
+        .map(|p| {
+            let (px, py) = (p % w as i32, p / w as i32);
+            let pi = p as usize;
+            if pos[pi][3] <= 0.0 || nor[pi][3] < 1.0 {
+                return Vec3::ZERO;
+            }
+            let np = common::v3(nor[pi]);
+            let (ux, uy) = (
+                (px as f32 - (f / 2) as f32) / f as f32,
+                (py as f32 - (f / 2) as f32) / f as f32,
+            );
+            let (bx, by) = (ux.floor() as i32 - 1, uy.floor() as i32 - 1);
+            let (mut sum, mut k) = (Vec3::ZERO, 0.0f32);
+            for j in 0..4 {
+                for i in 0..4 {
+                    let (qx, qy) = (bx + i, by + j);
+                    if qx < 0 || qy < 0 || qx >= lw || qy >= lh {
+                        continue;
+                    }
+                    let qp = shading(qx, qy);
+                    if pos[qp][3] <= 0.0 {
+                        continue;
+                    }
+                    let x = common::v3(pos[pi]);
+                    if (common::v3(pos[qp]) - x).dot(np).abs() > depth * eye.distance(x) {
+                        continue;
+                    }
+                    let range = np.dot(common::v3(nor[qp]));
+                    if range <= 0.0 {
+                        continue;
+                    }
+                    let (dx, dy) = (ux - qx as f32, uy - qy as f32);
+                    let wgt = (-0.5 * (dx * dx + dy * dy)).exp() * range;
+                    sum += wgt * filtered[(qy * lw + qx) as usize];
+                    k += wgt;
+                }
+            }
+            let e = if k > 0.0 {
+                sum / k
+            } else {
+                let qx = ((ux + 0.5).floor() as i32).clamp(0, lw - 1);
+                let qy = ((uy + 0.5).floor() as i32).clamp(0, lh - 1);
+                filtered[(qy * lw + qx) as usize]
+            };
+            common::v3(thr[pi]) * albedo(nor[pi][3]) / std::f32::consts::PI * e
+        })
+        .collect();
+    let (up_apart, up_worst) = apart(&indirect, &up_twin);
+    eprintln!(
+        "IGI interleave 3, downsample 2: gather apart at {gather_apart} of {} ({gather_worst:.1e}); discontinuity buffer apart at {filter_apart} ({filter_worst:.1e}); upsampling apart at {up_apart} of {} ({up_worst:.1e})",
+        gathered.len(),
+        indirect.len()
+    );
+    assert!(gather_apart * 100 <= gathered.len(), "{gather_apart}");
+    assert_eq!(filter_apart, 0);
+    assert_eq!(up_apart, 0);
+}
+
+/// The furnace (a closed diffuse sphere of albedo 1/2 and radius 1, a point
+/// light of intensity 1 at its centre) has L = 1 / pi everywhere. Inside a
+/// sphere cos(theta_x) cos(theta_y) / d^2 = 1 / (4 R^2) for any two points,
+/// so IGI unbounded with exact visibility is exact but for the VPLs' own
+/// sampling: each path leaves a geometric number of VPLs (Russian roulette
+/// at 1/2), so the total's relative error is at most 1 / sqrt(2 N) for N
+/// independent paths (Halton paths do better). It must shrink as N grows,
+/// and stay within 3 of those standard deviations.
+#[test]
+fn igi_in_the_furnace_converges_to_the_analytic_answer() {
+    let gpu = common::gpu();
+    let scene = load_scene_str(
+        include_str!("../../scenes/tests/furnace.toml"),
+        std::path::Path::new("furnace.toml"),
+    )
+    .unwrap();
+    let expected = 1.0 / std::f64::consts::PI;
+    let mut errors = Vec::new();
+    for paths in [16u32, 256, 4096] {
+        let igi = IgiOptions {
+            vpl_paths: paths,
+            min_distance: Some(0.0),
+            ..IgiOptions::default()
+        };
+        let out = render(&gpu, &scene, &options(&scene, 16, 16, 1, igi), &mut ()).unwrap();
+        let mean = out.image.mean()[0];
+        let err = (mean / expected - 1.0).abs();
+        let bound = 3.0 / (2.0 * paths as f64).sqrt();
+        eprintln!(
+            "furnace, IGI {paths} paths ({} VPLs): mean {mean:.5} against {expected:.5} ({:+.3}%, 3 sigma of independent paths {:.2}%)",
+            out.vpls().unwrap().vpls,
+            100.0 * (mean / expected - 1.0),
+            100.0 * bound
+        );
+        assert!(err < bound, "{paths} paths: {err}");
+        errors.push(err);
+    }
+    assert!(errors[2] < errors[0], "{errors:?}");
+}
+
+/// IGI unbounded with exact visibility against the independent CPU path
+/// tracer (next-event estimation) on a closed diffuse box lit by a point and
+/// an area light, the scene SPPM is checked on: block means over the
+/// interior 6 x 6 blocks of 4 x 4 pixels, with the variance of two IGI runs
+/// on independent VPL sets (their mean's, (a - b)^2 / 4) and the path
+/// tracer's own. chi^2/n must fall as the VPL paths grow and end within the
+/// bound the SPPM test uses (3).
+#[test]
+fn igi_converges_to_the_path_tracer_as_vpls_grow() {
+    let gpu = common::gpu();
+    let scene = common::fixture("two_light_box");
+    let pt = photonmap::twins::path_trace::path_trace(&scene, 32, 32, 1024, 11);
+    let mut chi = Vec::new();
+    for paths in [64u32, 4096] {
+        let runs: Vec<photonmap::render::Image> = [1u32, 2]
+            .iter()
+            .map(|&seed| {
+                let igi = IgiOptions {
+                    vpl_paths: paths,
+                    min_distance: Some(0.0),
+                    ..IgiOptions::default()
+                };
+                let mut o = options(&scene, 32, 32, seed, igi);
+                o.spp = 4;
+                render(&gpu, &scene, &o, &mut ()).unwrap().image
+            })
+            .collect();
+        let (_, chi2_n, worst) = common::blocks_against_path_tracer(&pt, [&runs[0], &runs[1]]);
+        eprintln!(
+            "two-light box, IGI {paths} paths x 2 seeds, 4 spp: chi^2/n = {chi2_n:.2}, largest relative difference {:.2}%",
+            100.0 * worst
+        );
+        chi.push((chi2_n, worst));
+    }
+    assert!(chi[1].1 < chi[0].1, "{chi:?}");
+    assert!(chi[1].0 < 3.0, "{chi:?}");
+}

@@ -1,0 +1,29 @@
+//! The GPU test suite, one binary: a module per kernel or stage, each on the
+//! real GL pipeline (llvmpipe in CI) and against its plain-Rust twin where it
+//! has one. `cargo test --release --test gpu` runs it all; a module alone is
+//! `cargo test --release --test gpu sppm::`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod adaptive;
+mod bit_identical;
+mod bvh;
+mod differentials;
+mod final_gather;
+mod fused_eye_path;
+mod gpu_substrate;
+mod hash_grid;
+mod igi;
+mod intersections;
+mod obj_scenes;
+mod photon_build;
+mod photon_trace;
+mod platforms;
+mod radiance_estimate;
+mod radiosity;
+mod ray_tracer;
+mod reference_images;
+mod sppm;
+mod stress;
+mod truth;
