@@ -56,7 +56,7 @@ note() {
     list="$dir/command.txt"
     mkdir -p "$dir"
     if [[ -f "$list" ]]; then
-        grep -v -F -- "$base: " "$list" >"$list.new" || true
+        awk -v line="$base: " 'index($0, line) != 1' "$list" >"$list.new"
         mv "$list.new" "$list"
     fi
     echo "$base: $command" >>"$list"
@@ -200,8 +200,11 @@ timings() {
     for k in 50 500; do
         render_to $res/igi/caustic_k/k$k cornell_box --method igi --width 256 --height 256 \
             --leak-test visibility --seed 7 --set photon_map.k=$k
-        cp "$scratch/render.exr" "$scratch/k$k.exr"
-        run_to $res/igi/caustic_k/compare_k$k.txt compare "$scratch/k$k.exr" reference_images/cornell_box.sppm.exr
+        echo "book-figures: photonmap compare (k = $k)" >&2
+        "$bin" compare "$scratch/render.exr" reference_images/cornell_box.sppm.exr \
+            >$res/igi/caustic_k/compare_k$k.txt
+        note $res/igi/caustic_k/compare_k$k.txt \
+            "photonmap compare IMAGE.exr reference_images/cornell_box.sppm.exr (IMAGE.exr: the render of k$k.json)"
     done
 
     # docs/src/evaluation/meshes.md: the BVH at scale, and small meshes at a
