@@ -4,7 +4,7 @@
 use glow::HasContext;
 
 use super::context;
-use super::{Gpu, TexFormat, Target, Texture};
+use super::{Gpu, Target, TexFormat, Texture};
 
 /// What the driver offers, as `photonmap info` prints it.
 #[derive(Debug, Clone, serde::Serialize)]

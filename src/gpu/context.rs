@@ -204,7 +204,11 @@ struct EglContext {
 impl Drop for EglContext {
     fn drop(&mut self) {
         let (egl, d) = (&self.display.egl, self.display.display);
-        let _ = egl.make_current(d, None, None, None);
+        // Release only our own context: another Gpu's current on this
+        // thread must stay current.
+        if egl.get_current_context() == Some(self.context) {
+            let _ = egl.make_current(d, None, None, None);
+        }
         let _ = egl.destroy_context(d, self.context);
     }
 }

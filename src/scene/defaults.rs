@@ -4,9 +4,9 @@
 //! scene-format section quotes these numbers (the loader's unit tests,
 //! src/scene/load/tests/defaults.rs, check that it still does).
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
-use super::{bounds_size, PhotonMapParams, RenderParams, Shape};
+use super::{bounds_size, Camera, Light, Material, PhotonMapParams, RenderParams, Scene, Shape};
 
 // ---- defaults of optional fields ---------------------------------------------
 
@@ -107,4 +107,29 @@ impl PhotonMapParams {
 /// The default `photon_map.max_radius` of a scene of these shapes.
 pub fn default_max_radius(shapes: &[Shape]) -> f32 {
     DEFAULT_MAX_RADIUS_OF_SIZE * bounds_size(shapes, &[])
+}
+
+impl Scene {
+    /// A scene of these shapes and lights with a neutral camera and the scene
+    /// file's default parameters (`defaults`), for measuring geometry, and
+    /// for tests.
+    pub fn with_shapes(shapes: Vec<Shape>, materials: Vec<Material>, lights: Vec<Light>) -> Self {
+        Scene {
+            name: String::new(),
+            camera: Camera {
+                position: Vec3::Z,
+                look_at: Vec3::ZERO,
+                up: DEFAULT_UP,
+                vfov_degrees: 40.0,
+                width: 1,
+                height: 1,
+            },
+            render: RenderParams::default(),
+            photon_map: PhotonMapParams::defaults_for(&shapes),
+            materials,
+            shapes,
+            lights,
+            origin: DVec3::ZERO,
+        }
+    }
 }

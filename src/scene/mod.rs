@@ -282,29 +282,6 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// A scene of these shapes and lights with a neutral camera and the scene
-    /// file's default parameters (`defaults`), for measuring geometry, and
-    /// for tests.
-    pub fn with_shapes(shapes: Vec<Shape>, materials: Vec<Material>, lights: Vec<Light>) -> Self {
-        Scene {
-            name: String::new(),
-            camera: Camera {
-                position: Vec3::Z,
-                look_at: Vec3::ZERO,
-                up: defaults::DEFAULT_UP,
-                vfov_degrees: 40.0,
-                width: 1,
-                height: 1,
-            },
-            render: RenderParams::default(),
-            photon_map: PhotonMapParams::defaults_for(&shapes),
-            materials,
-            shapes,
-            lights,
-            origin: DVec3::ZERO,
-        }
-    }
-
     /// Axis-aligned bounds of every shape (area lights included) and point light.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         bounds_of(&self.shapes, &self.lights)

@@ -383,3 +383,20 @@ fn layout_constants_reach_every_program_and_no_shader_redefines_them() {
         }
     }
 }
+
+/// Dropping a context that is not current leaves the current one current:
+/// the later context's textures still upload and read back.
+#[test]
+fn dropping_another_context_leaves_this_one_current() {
+    std::thread::spawn(|| {
+        let first = common::OwnGpu::new(photonmap::gpu::Platform::Auto).unwrap();
+        let second = common::OwnGpu::new(photonmap::gpu::Platform::Auto).unwrap();
+        drop(first);
+        let t = Texture::new(&second, 2, 1, TexFormat::Rgba32F).unwrap();
+        let texels = [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0];
+        t.upload_f32(&texels).unwrap();
+        assert_eq!(t.read_f32(), texels);
+    })
+    .join()
+    .unwrap();
+}
