@@ -53,10 +53,10 @@ impl LeakTest {
     }
 }
 
-/// Steps per pixel per pass by default. `bench estimate` measured 64, 128 and
-/// 256 (the same image each): 128 took CORNELL BOX's estimate from 4.18 s to
-/// 3.68 s (256: 3.53 s) and left GLASS BALL and RING within noise, at half the
-/// passes; 128 keeps the running image's steps finer than 256.
+/// Steps per pixel per pass by default. `bench estimate` measures 64, 128 and
+/// 256 (the same image each; `results/llvmpipe/estimate/estimate.json`): in
+/// each paper scene 128 took less time than 64 at half the passes and 256
+/// little less again; 128 keeps the running image's steps finer than 256.
 pub const DEFAULT_BUDGET: u32 = 128;
 
 #[derive(Clone, Debug, serde::Serialize)]
