@@ -120,18 +120,7 @@ impl Error {
             source,
         }
     }
-}
 
-/// A stopping signal's name, for messages.
-pub fn signal_name(signal: i32) -> &'static str {
-    match signal {
-        2 => "SIGINT",
-        15 => "SIGTERM",
-        _ => "a signal",
-    }
-}
-
-impl Error {
     /// `option` (a field path, `igi.vpl_paths`) is `value`, outside what is
     /// `allowed` (a range, or what to give instead).
     pub fn out_of_range(
@@ -144,5 +133,14 @@ impl Error {
             value: value.to_string(),
             allowed: allowed.into(),
         }
+    }
+}
+
+/// A stopping signal's name, for messages.
+pub fn signal_name(signal: i32) -> &'static str {
+    match signal {
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
     }
 }

@@ -244,13 +244,14 @@ impl RenderArgs {
         }
     }
 
-    pub(super) fn options(&self, scene: &Scene) -> Result<RenderOptions> {
-        let mut options = RenderOptions::for_scene(scene).with_method(self.method()?);
+    /// The render's options for `scene`, with the method `self.method()` chose.
+    pub(super) fn options(&self, scene: &Scene, method: render::Method) -> RenderOptions {
+        let mut options = RenderOptions::for_scene(scene).with_method(method);
         options.seed = self.seed;
         options.spp = self.spp;
         options.width = self.width.unwrap_or(options.width);
         options.height = self.height.unwrap_or(options.height);
-        Ok(options)
+        options
     }
 
     /// The method with its options: the one place where switches that do

@@ -16,12 +16,12 @@ use crate::cli::args::Method;
 use crate::cli::progress::Work;
 
 pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
-    args.method()?;
+    let method = args.method()?;
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
     let scene = &loaded.scene;
     warn_far_from_origin(scene, args.quiet);
-    let options = args.options(scene)?;
+    let options = args.options(scene, method);
     let cameras = match &args.camera_path {
         Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera, scene.origin)?,
         None => vec![scene.camera.clone()],

@@ -12,12 +12,12 @@ use crate::cli::progress::Work;
 
 /// `--method sppm`: one view, iterations until --iterations or --time.
 pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
-    args.method()?;
+    let method = args.method()?;
     let outputs = args.outputs()?;
     let loaded = args.scene.load()?;
     let scene = &loaded.scene;
     warn_far_from_origin(scene, args.quiet);
-    let options = args.options(scene)?;
+    let options = args.options(scene, method);
     let gpu = crate::cli::gpu(platform)?;
     let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
     if args.adaptive
