@@ -6,4 +6,5 @@
 pub mod build;
 pub mod mask;
 pub mod ray_rates;
+pub mod regions;
 pub mod stress;

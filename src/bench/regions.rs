@@ -1,0 +1,157 @@
+//! Regions of the image that an error can be split by: the diffuse surfaces
+//! the pixels see first, read back from the ray tracer's own first-hit
+//! record, and rectangles the user names. `bench accuracy --regions` reports
+//! each method's energy and error in each.
+
+use crate::gpu::{Gpu, Result};
+use crate::render::{render, RenderOptions};
+use crate::scene::{Geometry, Scene};
+
+/// A named set of pixels (top row first, as [`crate::render::Image`]).
+#[derive(Clone, Debug)]
+pub struct Region {
+    pub name: String,
+    pub pixels: Vec<bool>,
+}
+
+impl Region {
+    pub fn count(&self) -> usize {
+        self.pixels.iter().filter(|&&p| p).count()
+    }
+}
+
+/// A rectangle of pixels: columns `x0..x1`, rows `y0..y1` (row 0 at the top).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Rectangle {
+    pub name: String,
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
+}
+
+impl Rectangle {
+    /// The rectangle's pixels in a `width` x `height` image (clipped to it).
+    pub fn region(&self, width: u32, height: u32) -> Region {
+        let pixels = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y))
+            .collect();
+        Region {
+            name: self.name.clone(),
+            pixels,
+        }
+    }
+}
+
+/// One region per diffuse surface that some pixel centre sees first, in the
+/// order of the scene's shapes: coplanar primitives of one material (a wall
+/// of two triangles) are one surface. Pixels whose first hit is a light, a
+/// mirror, glass or nothing belong to none. Rendered at `width` x `height`
+/// with one eye ray a pixel and no specular bounce, so that the record is of
+/// the first hit itself.
+pub fn first_hit_regions(gpu: &Gpu, scene: &Scene, width: u32, height: u32) -> Result<Vec<Region>> {
+    let mut first = scene.clone();
+    first.render.max_specular_depth = 0;
+    first.render.shadow_rays = 1;
+    let mut options = RenderOptions::for_scene(&first).direct_only();
+    (options.width, options.height) = (width, height);
+    let out = render(gpu, &first, &options, &mut ())?;
+    let position = out.state.direct.diffuse_position.read_f32();
+    let throughput = out.state.direct.diffuse_throughput.read_f32();
+    let surfaces = surfaces_of(scene);
+    let mut regions: Vec<(usize, Region)> = Vec::new();
+    let mut index_of_surface = vec![None; surfaces.names.len()];
+    let pixels = (width * height) as usize;
+    // GL rows are bottom first; regions are top first.
+    for (i, (p, t)) in position.chunks(4).zip(throughput.chunks(4)).enumerate() {
+        let primitive = t[3].round();
+        if p[3] < 0.5 || primitive < 0.0 || primitive as usize >= scene.shapes.len() {
+            continue;
+        }
+        let surface = surfaces.of_shape[primitive as usize];
+        let r = *index_of_surface[surface].get_or_insert_with(|| {
+            let name = surfaces.names[surface].clone();
+            let pixels = vec![false; pixels];
+            regions.push((surface, Region { name, pixels }));
+            regions.len() - 1
+        });
+        let (x, row) = (i as u32 % width, i as u32 / width);
+        regions[r].1.pixels[((height - 1 - row) * width + x) as usize] = true;
+    }
+    regions.sort_by_key(|(surface, _)| *surface);
+    Ok(regions.into_iter().map(|(_, r)| r).collect())
+}
+
+/// The scene's surfaces: every shape's surface, and each surface's name.
+struct Surfaces {
+    of_shape: Vec<usize>,
+    names: Vec<String>,
+}
+
+/// Groups coplanar parallelograms and triangles of one material into one
+/// surface (planes compared to a thousandth of the scene's size); every other
+/// shape is its own.
+fn surfaces_of(scene: &Scene) -> Surfaces {
+    let size = scene.size().max(f32::MIN_POSITIVE);
+    let mut keys: Vec<Option<(usize, [i64; 4])>> = Vec::new();
+    let mut names = Vec::new();
+    let mut of_shape = Vec::with_capacity(scene.shapes.len());
+    for (i, s) in scene.shapes.iter().enumerate() {
+        let plane = match s.geometry {
+            Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            } => Some((corner, edge1.cross(edge2))),
+            Geometry::Triangle { v0, v1, v2 } => Some((v0, (v1 - v0).cross(v2 - v0))),
+            _ => None,
+        };
+        let key = plane.filter(|(_, n)| n.length() > 0.0).map(|(p, n)| {
+            let n = n.normalize();
+            let q = |v: f32| (v * 1000.0).round() as i64;
+            (s.material, [q(n.x), q(n.y), q(n.z), q(n.dot(p) / size)])
+        });
+        let existing = key.and_then(|k| keys.iter().position(|e| *e == Some(k)));
+        of_shape.push(existing.unwrap_or_else(|| {
+            keys.push(key);
+            names.push(surface_name(
+                scene,
+                i,
+                plane.map(|(p, n)| (p, n.normalize())),
+            ));
+            keys.len() - 1
+        }));
+    }
+    Surfaces { of_shape, names }
+}
+
+/// "plane y = 2.000 (facing -y), material 0", "sphere 5 at (-0.45, 0.35, -0.35)".
+fn surface_name(scene: &Scene, shape: usize, plane: Option<(glam::Vec3, glam::Vec3)>) -> String {
+    let s = &scene.shapes[shape];
+    let at = |p: glam::Vec3| format!("({:.2}, {:.2}, {:.2})", p.x, p.y, p.z);
+    match (plane, s.geometry) {
+        (Some((p, n)), _) => {
+            let axis = (0..3).find(|&a| n[a].abs() > 0.999);
+            match axis {
+                Some(a) => {
+                    let letter = ["x", "y", "z"][a];
+                    let sign = if n[a] > 0.0 { "+" } else { "-" };
+                    format!(
+                        "plane {letter} = {:.3} (facing {sign}{letter}), material {}",
+                        p[a], s.material
+                    )
+                }
+                None => format!(
+                    "plane through {} facing {}, material {}",
+                    at(p),
+                    at(n),
+                    s.material
+                ),
+            }
+        }
+        (None, Geometry::Sphere { center, .. }) => format!("sphere {shape} at {}", at(center)),
+        (None, Geometry::Cylinder { base, .. }) => format!("cylinder {shape} at {}", at(base)),
+        (None, _) => format!("shape {shape}"),
+    }
+}
