@@ -9,23 +9,21 @@
 
 mod plot;
 mod regions;
+mod report;
 mod sweep;
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use clap::Args;
-use serde::Serialize;
 
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
-use photonmap::photon::{BuildMethod, GridKind};
-use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::sppm::{render_sppm, SppmOptions};
 use photonmap::render::{
-    render, AdaptiveOptions, DifferentialsOptions, EstimateMode, FinalGatherOptions, IgiOptions,
-    Image, Method, RadiosityOptions, WithCausticMap, WithPhotons,
+    render, AdaptiveOptions, EstimateMode, FinalGatherOptions, Image, Method, WithCausticMap,
+    WithPhotons,
 };
 use photonmap::scene::{embedded, Scene};
 
@@ -33,7 +31,8 @@ use super::output::{folder, stem, write_json, BenchOutput};
 use super::reference::{read_reference, reference_options, ReferenceInfo};
 use super::scene::{default_reference, reference_scale, SEED};
 use plot::{bias_map, csv, png_plot, svg_plot};
-use regions::{RegionArgs, RegionScore, Regions};
+use regions::{RegionArgs, Regions};
+use report::{AccuracyReport, AccuracyRun, RunMethod};
 
 /// `bench accuracy`'s options.
 #[derive(Args)]
@@ -63,123 +62,14 @@ pub struct AccuracyArgs {
     #[arg(long, value_parser = crate::cli::args::in_range(2, 64))]
     pub seeds: Option<u32>,
     /// Only the runs whose label contains this text (e.g. "scene defaults",
-    /// "SPPM", "max radius"); repeat it for the runs matching any.
+    /// "SPPM", "max radius"), or, after a leading "=", is exactly it ("=IGI":
+    /// IGI at its defaults alone); repeat it for the runs matching any.
     #[arg(long, value_name = "TEXT")]
     pub only: Vec<String>,
     #[command(flatten)]
     pub regions: RegionArgs,
     #[command(flatten)]
     pub output: BenchOutput,
-}
-
-/// A run's method, with that method's own options.
-#[derive(Serialize, Clone, Debug)]
-#[serde(tag = "method", rename_all = "kebab-case")]
-pub enum RunMethod {
-    /// The paper's one-shot kNN estimate of the global map.
-    Paper,
-    /// Final gather from the global map, `gather_rays` rays a pixel.
-    FinalGather {
-        gather_rays: u32,
-    },
-    Sppm {
-        sppm_iterations: u32,
-    },
-    Igi(IgiOptions),
-    Differentials(DifferentialsOptions),
-    Radiosity(RadiosityOptions),
-}
-
-impl RunMethod {
-    /// Its name in the JSON and the CSV.
-    pub fn name(&self) -> &'static str {
-        match self {
-            RunMethod::Paper => "paper",
-            RunMethod::FinalGather { .. } => "final-gather",
-            RunMethod::Sppm { .. } => "sppm",
-            RunMethod::Igi(_) => "igi",
-            RunMethod::Differentials(_) => "differentials",
-            RunMethod::Radiosity(_) => "radiosity",
-        }
-    }
-}
-
-/// One configuration's renders against the reference.
-#[derive(Serialize, Clone, Debug)]
-pub struct AccuracyRun {
-    pub label: String,
-    #[serde(flatten)]
-    pub method: RunMethod,
-    pub photons_stored: u32,
-    pub k: u32,
-    pub max_radius: f32,
-    pub leak: LeakTest,
-    pub shadow_rays: u32,
-    pub build: BuildMethod,
-    pub tile: u32,
-    pub spp: u32,
-    /// Adaptive sampling of the global light (its default threshold).
-    pub adaptive: bool,
-    /// The photon map's grid storage: uniform, or hashed (section 4.4).
-    pub grid: GridKind,
-    /// Wall seconds of one render (mean over the seeds).
-    pub seconds: f64,
-    /// RMSE of one render against the reference (mean over the seeds).
-    pub rmse: f64,
-    /// The part of it more seeds would not remove: the RMSE of the seeds'
-    /// mean, less its noise and the reference's.
-    pub bias_rmse: f64,
-    /// The part they would: the RMS over pixels of one render's standard deviation.
-    pub noise_rmse: f64,
-    pub rel_mse: f64,
-    pub ssim: f64,
-    /// RMSE over the reference's mean (mean over the seeds): the relative
-    /// error ground truth is quoted in.
-    pub rel_rmse: f64,
-    /// The seeds' mean image's mean over the reference's: 1 conserves energy.
-    pub energy: f64,
-    /// Energy and error by region (with `--regions` or `--region`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub regions: Vec<RegionScore>,
-    pub on_pareto_front: bool,
-}
-
-#[derive(Serialize)]
-pub struct AccuracyReport {
-    pub scene: String,
-    /// The reference's file.
-    pub reference_file: String,
-    /// Its JSON, when it is an SPPM reference.
-    pub reference: Option<ReferenceInfo>,
-    /// The mask's file, when only its pixels were compared.
-    pub mask: Option<String>,
-    /// Pixels compared.
-    pub pixels_compared: usize,
-    /// The regions' names and sizes, in the order of each run's `regions`.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub regions: Vec<RegionSize>,
-    pub renderer: String,
-    pub seeds: u32,
-    pub runs: Vec<AccuracyRun>,
-    /// The front's fastest run within 10% of the least RMSE.
-    pub recommended: String,
-    /// `bias.png`'s full scale: a pixel is fully red (blue) where the scene
-    /// defaults' mean over the seeds is this much brighter (darker) than the
-    /// reference, in luminance. Half the reference's mean luminance.
-    pub bias_map_scale: Option<f64>,
-    /// `bias.png`, where the scene defaults' run is biased (when it ran).
-    #[serde(skip)]
-    pub bias_map: Option<Image>,
-    /// With regions: every run's bias map, by label.
-    #[serde(skip)]
-    pub bias_maps: Vec<(String, Image)>,
-}
-
-#[derive(Serialize, Clone, Debug)]
-pub struct RegionSize {
-    pub name: String,
-    /// Its pixels that are compared (inside the mask).
-    pub pixels: usize,
 }
 
 /// What `bench_accuracy` runs and against what.
@@ -341,7 +231,11 @@ pub fn bench_accuracy(
     if !sweep.only.is_empty() {
         let only = sweep.only;
         let labels: Vec<String> = configs.iter().map(|c| c.run.label.clone()).collect();
-        configs.retain(|c| only.iter().any(|text| c.run.label.contains(text.as_str())));
+        let matches = |label: &str, text: &str| match text.strip_prefix('=') {
+            Some(exact) => label == exact,
+            None => label.contains(text),
+        };
+        configs.retain(|c| only.iter().any(|text| matches(&c.run.label, text)));
         if configs.is_empty() {
             bail!(
                 "--only {only:?} matches no run; the runs are: {}",

@@ -3,7 +3,7 @@
 
 use photonmap::render::{IgiOptions, Image};
 
-use super::{AccuracyReport, AccuracyRun, RunMethod};
+use super::report::{AccuracyReport, AccuracyRun, RunMethod};
 
 /// Where `mean` is biased against `reference`: the reference in dim grey,
 /// turning red where the mean is brighter and blue where it is darker, fully

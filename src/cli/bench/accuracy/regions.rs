@@ -5,7 +5,6 @@
 
 use anyhow::{bail, Result};
 use clap::Args;
-use serde::Serialize;
 
 use photonmap::bench::regions::{first_hit_regions, Rectangle, Region};
 use photonmap::gpu::Gpu;
@@ -13,7 +12,7 @@ use photonmap::metrics::compare;
 use photonmap::render::Image;
 use photonmap::scene::Scene;
 
-use super::{AccuracyReport, RegionSize};
+use super::report::{AccuracyReport, RegionScore, RegionSize};
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct RegionArgs {
@@ -149,19 +148,6 @@ impl Regions {
             })
             .collect()
     }
-}
-
-/// One run on one region.
-#[derive(Serialize, Clone, Debug)]
-pub struct RegionScore {
-    pub name: String,
-    /// The seeds' mean image's mean over the reference's, on the region.
-    pub energy: f64,
-    /// The standard error of that ratio from the seeds' spread (the
-    /// reference's own noise not included).
-    pub energy_noise: f64,
-    /// One render's RMSE over the reference's mean, on the region.
-    pub rel_rmse: f64,
 }
 
 /// A file name for a run's label: lower case, runs of other characters as "-".

@@ -6,7 +6,7 @@ use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::{DifferentialsOptions, IgiOptions, Kernel, RadiosityOptions};
 use photonmap::scene::{Light, Scene};
 
-use super::{AccuracyRun, RunMethod};
+use super::report::{AccuracyRun, RunMethod};
 
 /// SPPM at `iterations`.
 fn sppm(iterations: u32) -> RunMethod {
