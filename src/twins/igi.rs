@@ -78,8 +78,10 @@ pub fn incident(
         }
         let s = offset_scale(x, floor);
         let origin = x + if w.dot(nx) >= 0.0 { s } else { -s } * nx;
-        let t_max = d - 2.0 * offset_scale(v.position, floor);
-        if occluded(scene, origin, w, t_max, imperfect) {
+        let to_y = v.position - origin;
+        let reach = to_y.length();
+        let t_max = reach - 2.0 * offset_scale(v.position, floor);
+        if occluded(scene, origin, to_y / reach, t_max, imperfect) {
             continue;
         }
         sum += v.intensity * g;
