@@ -3,9 +3,10 @@
 // fused path, photon/trace_fused.frag, both call it, so both trace the same
 // photons with the same random numbers).
 // Diffuse hits store the photon, except its first hit (direct light is the
-// shadow rays' job), and continue by Russian roulette (or end, when the scene
-// stores caustics only: every photon alive at a diffuse hit then came by
-// specular bounces alone); mirrors reflect; glass
+// shadow rays' job) and, when only specular-last photons are stored, a hit
+// reached straight from another diffuse one; they continue by Russian
+// roulette (or end, when the scene stores caustics only: every photon alive
+// at a diffuse hit then came by specular bounces alone); mirrors reflect; glass
 // reflects or refracts by exact Fresnel. On triangles with vertex normals,
 // mirror and glass directions are taken about the shading normal, and the
 // power takes the adjoint's shading-normal correction (below).
@@ -17,6 +18,7 @@
 uniform uint u_seed;
 uniform int u_store_direct;  // 1: store first hits too (tests of the flux)
 uniform int u_caustics_only; // 1: a diffuse hit ends the photon (stored if not its first)
+uniform int u_specular_last_only; // 1: store only photons whose last bounce was specular
 
 // A photon's record in one frame (photon/trace.frag names the channels).
 struct PhotonRecord {
@@ -73,6 +75,9 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
     if (shaded) ms = shading_normal(prim, p, n) * (dot(n, d) < 0.0 ? 1.0 : -1.0);
     if (kind == MAT_DIFFUSE) {
         stored = bounce >= 2 || u_store_direct != 0;
+        int last_mat = int(last.position.w);
+        bool after_specular = last_mat >= 0 && material_kind(last_mat) != MAT_DIFFUSE;
+        if (u_specular_last_only != 0) stored = stored && after_specular;
         vec3 albedo = material_texel(mat, 1).rgb;
         alive = u_caustics_only == 0 && u0 < max(albedo.r, max(albedo.g, albedo.b));
         next = sample_cosine(nf, u1, u2);

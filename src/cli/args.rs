@@ -336,6 +336,7 @@ impl From<&IgiArgs> for IgiOptions {
             imperfect_visibility: a.imperfect_visibility,
             interleave: a.interleave,
             downsample: a.downsample,
+            ..IgiOptions::default()
         }
     }
 }
@@ -433,6 +434,7 @@ impl From<&RadiosityArgs> for RadiosityOptions {
             subdivide: a.subdivide,
             gradient: a.gradient,
             form_factor: a.form_factor,
+            ..RadiosityOptions::default()
         }
     }
 }

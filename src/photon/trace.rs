@@ -130,7 +130,11 @@ fn bind_bounce_inputs(
         .uint("u_seed", seed)
         .int("u_frame_height", f.frame_height as i32)
         .int("u_store_direct", scene.photon_map.store_direct as i32)
-        .int("u_caustics_only", scene.photon_map.caustics_only as i32);
+        .int("u_caustics_only", scene.photon_map.caustics_only as i32)
+        .int(
+            "u_specular_last_only",
+            scene.photon_map.specular_last_only as i32,
+        );
 }
 
 /// Frame width and height for `emitted` photons and `frames` frames: square-ish

@@ -6,6 +6,7 @@ use crate::scene::Scene;
 use super::adaptive;
 use super::options::{Method, RenderOptions};
 use super::output::RenderOutput;
+use super::photon_options::CausticPaths;
 use super::radiance_estimate::EstimateMode;
 
 /// One line of `--explain`: a stage's passes, run or skipped, and why.
@@ -143,8 +144,8 @@ impl RenderOutput {
                 0,
                 true,
                 format!(
-                    "{} VPLs at the diffuse hits of {} Halton light paths (traced by the photon passes, compacted by the HistoPyramid); the photon map above, if any, is a caustic map: VPLs reach the first hit only straight from a diffuse surface, so IGI alone has no caustics",
-                    v.vpls, v.paths
+                    "{} VPLs at the diffuse hits of {} Halton light paths (traced by the photon passes, compacted by the HistoPyramid); VPLs reach the first hit only straight from a diffuse surface, so {}",
+                    v.vpls, v.paths, caustic_map(o.caustic_paths)
                 ),
             ));
             lines.push(line(
@@ -196,7 +197,7 @@ impl RenderOutput {
                 0,
                 true,
                 format!(
-                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; the photon map above, if any, is a caustic map. Light that leaves a mirror or glass onto a diffuse surface is in that map but never bounces on, and light from a diffuse surface through a mirror or glass onto another is in neither",
+                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; light that leaves a mirror or glass onto a diffuse surface never bounces on from there (L S+ D D+ is missing)",
                     r.patches,
                     r.elements,
                     r.element_resolution,
@@ -206,7 +207,8 @@ impl RenderOutput {
                     o.substructure,
                     o.item_buffer,
                     if r.converged { "converged" } else { "stopped at --max-shots" },
-                    100.0 * r.unshot_fraction
+                    100.0 * r.unshot_fraction,
+                    caustic_map(o.caustic_paths)
                 ),
             ));
         }
@@ -384,5 +386,13 @@ impl RenderOutput {
             ));
         }
         lines
+    }
+}
+
+/// What IGI's or radiosity's caustic map carries, and what it leaves out.
+fn caustic_map(paths: CausticPaths) -> &'static str {
+    match paths {
+        CausticPaths::All => "the photon map above, if any, is a caustic map of every path onto a diffuse surface from a mirror or glass (L (S|D)* S D), including light a diffuse surface sends through them (L D+ S+ D)",
+        CausticPaths::FromLights => "the photon map above, if any, is Jensen's caustic map, light straight from an emitter through mirrors and glass (L S+ D); light from a diffuse surface through a mirror or glass onto another (L D+ S+ D) is missing (--caustic-paths all carries it)",
     }
 }

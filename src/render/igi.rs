@@ -17,12 +17,14 @@
 //!    with the discontinuity buffer (`igi_interleave`); downsampling by a
 //!    factor with joint bilateral upsampling (`igi_upsample`).
 //! 4. **The image**: direct light and specular paths from the ray tracer,
-//!    caustics (light from an emitter through mirrors or glass onto x) from a
-//!    caustic photon map, and throughput x albedo / pi x the incident light.
-//!    Light from a diffuse surface through a mirror or glass onto x (L D S+ D
-//!    paths) is in none of them: VPL shadow rays stop at mirrors and glass as
-//!    every shadow ray does, and the caustic map holds only paths straight
-//!    from an emitter. IGI as Marques and Santos build it has the same gap.
+//!    throughput x albedo / pi x the incident light, and from a caustic photon
+//!    map the light that reaches x from a mirror or glass, which VPL shadow
+//!    rays cannot carry (they stop at mirrors and glass as every shadow ray
+//!    does). By default that map holds every such path, L (S|D)* S D, traced
+//!    on through diffuse hits and stored after specular bounces only, so light
+//!    a diffuse surface sends through mirrors and glass (L D+ S+ D) is in it;
+//!    `CausticPaths::FromLights` keeps Jensen's map of paths straight from an
+//!    emitter (L S+ D), as Marques and Santos's IGI does, with that gap.
 
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
@@ -34,7 +36,7 @@ use crate::scene::Scene;
 use super::direct::DirectLight;
 use super::observer::{Progress, RenderObserver};
 use super::photon_map::MapEstimate;
-use super::photon_options::WithCausticMap;
+use super::photon_options::{CausticPaths, WithCausticMap};
 use super::sample::{FrameMethod, Prepare, SampleFrame};
 use super::{Image, Timings};
 
@@ -56,6 +58,9 @@ pub struct IgiOptions {
     pub interleave: u32,
     /// The gather at one pixel per f x f block, upsampled (1: full resolution).
     pub downsample: u32,
+    /// The caustic map's paths: all light onto x from a mirror or glass, or
+    /// only light straight from an emitter (the paper's).
+    pub caustic_paths: CausticPaths,
 }
 
 impl Default for IgiOptions {
@@ -69,6 +74,7 @@ impl Default for IgiOptions {
             imperfect_visibility: false,
             interleave: 1,
             downsample: 1,
+            caustic_paths: CausticPaths::All,
         }
     }
 }
@@ -472,7 +478,7 @@ impl IgiRun {
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
         let (o, scene) = (&with.method, p.scene);
-        let caustics = MapEstimate::caustics(p, with, timings, observer)?;
+        let caustics = MapEstimate::caustics(p, with, o.caustic_paths, timings, observer)?;
         let igi = Igi::new(p.gpu, scene, p.width, p.height, o)?;
         observer.progress(&Progress::stage("VPLs", 0, 1));
         let vpl_seed = crate::random::pcg_hash(p.seed ^ crate::layout::VPL_STREAM);

@@ -45,7 +45,7 @@ pub use observer::{At, EstimatePass, Progress, RenderObserver, StopReason};
 pub use options::{Method, RenderOptions};
 pub use output::{FrameState, RenderOutput};
 pub use photon_map::{MapEstimate, PhotonMapRun, PhotonReport};
-pub use photon_options::{PhotonMapOptions, WithCausticMap, WithPhotons};
+pub use photon_options::{CausticPaths, PhotonMapOptions, WithCausticMap, WithPhotons};
 pub use plan::PassPlan;
 pub use radiance_estimate::{
     EstimateMode, EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate,

@@ -16,7 +16,7 @@ use super::adaptive::{self, Adaptive, AdaptiveOptions, AdaptiveStats};
 use super::direct::DirectLight;
 use super::final_gather::{self, FinalGather, FinalGatherOptions, GatherStats};
 use super::observer::{At, EstimatePass, Progress, RenderObserver};
-use super::photon_options::{PhotonMapOptions, WithCausticMap};
+use super::photon_options::{CausticPaths, PhotonMapOptions, WithCausticMap};
 use super::radiance_estimate::{EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate};
 use super::sample::{FrameMethod, Prepare, SampleFrame};
 
@@ -71,12 +71,14 @@ impl MapEstimate {
         })
     }
 
-    /// A caustic map (IGI's and radiosity's): the paths from an emitter
-    /// through mirrors or glass onto a diffuse surface, which their own
-    /// diffuse light cannot carry; none in a scene with nothing specular.
+    /// A caustic map (IGI's and radiosity's): the paths through mirrors or
+    /// glass onto a diffuse surface, which their own diffuse light cannot
+    /// carry, from an emitter only or from anywhere (`paths`); none in a
+    /// scene with nothing specular.
     pub fn caustics<T>(
         p: &Prepare<'_>,
         o: &WithCausticMap<T>,
+        paths: CausticPaths,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Option<Self>> {
@@ -85,7 +87,8 @@ impl MapEstimate {
             return Ok(None);
         }
         let mut caustic = p.scene.clone();
-        caustic.photon_map.caustics_only = true;
+        caustic.photon_map.caustics_only = paths == CausticPaths::FromLights;
+        caustic.photon_map.specular_last_only = paths == CausticPaths::All;
         caustic.photon_map.store_direct = false;
         let built = photon::build_map(p.gpu, &caustic, p.textures, &o.photons, p.seed, timings)?;
         let size = (p.width, p.height);

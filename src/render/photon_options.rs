@@ -28,6 +28,22 @@ impl PhotonMapOptions {
     }
 }
 
+/// Which light a method's caustic map carries: the light that reaches a
+/// diffuse surface from a mirror or glass, which a method of point
+/// connections or form factors (IGI, radiosity) cannot carry itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum CausticPaths {
+    /// All of it, L (S|D)* S D: also the light a diffuse surface sends
+    /// through mirrors and glass (L D+ S+ D), the paths traced on through
+    /// diffuse hits and stored after specular bounces only.
+    #[default]
+    All,
+    /// Jensen's caustic map, L S+ D: only light straight from an emitter
+    /// through mirrors and glass, aimed by projection maps; L D+ S+ D is lost.
+    FromLights,
+}
+
 /// A method's own options beside those of the caustic photon map it
 /// visualises at the first hits.
 #[derive(Clone, Debug, Default)]

@@ -99,6 +99,7 @@ impl PhotonMapParams {
             max_bounces: DEFAULT_MAX_BOUNCES,
             store_direct: DEFAULT_STORE_DIRECT,
             caustics_only: DEFAULT_CAUSTICS_ONLY,
+            specular_last_only: false,
             projection_resolution: DEFAULT_PROJECTION_RESOLUTION,
         }
     }

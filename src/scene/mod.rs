@@ -260,6 +260,13 @@ pub struct PhotonMapParams {
     /// light only through the cells of its projection map that can reach a
     /// specular object (Jensen's projection maps).
     pub caustics_only: bool,
+    /// Store only photons whose last bounce was specular (a mirror or glass),
+    /// tracing every path on through diffuse hits: all light that reaches a
+    /// diffuse surface from a specular one, L (S|D)* S D, including the light
+    /// a diffuse surface sends through mirrors and glass (L D S+ D), which
+    /// point connections cannot carry. Set by IGI and radiosity for their
+    /// caustic map; not a scene-file field.
+    pub specular_last_only: bool,
     /// Cells per side of each light's projection map (caustics only).
     pub projection_resolution: u32,
 }

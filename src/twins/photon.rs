@@ -181,6 +181,12 @@ pub fn bounce(
     let next = match material {
         Material::Diffuse { albedo } => {
             stored = bounce >= 2 || scene.photon_map.store_direct;
+            let last_mat = last.position.w as i32;
+            let after_specular = last_mat >= 0
+                && !matches!(scene.materials[last_mat as usize], Material::Diffuse { .. });
+            if scene.photon_map.specular_last_only {
+                stored = stored && after_specular;
+            }
             alive = !scene.photon_map.caustics_only && u0 < albedo.max_element();
             if shaded {
                 power *= diffuse_adjoint(d, nf, ms);

@@ -142,6 +142,10 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
     let vpls = json["vpls"]["vpls"].as_u64().unwrap();
     assert!(vpls >= 32, "{vpls}");
     assert_eq!(json["igi"]["interleave"], 2);
+    assert_eq!(
+        json["igi"]["caustic_paths"], "all",
+        "the default caustic map"
+    );
     let per_point = json["igi_samples"][0]["vpls_per_point"].as_f64().unwrap();
     assert_eq!(per_point, vpls as f64 / 4.0);
     let refused: [(&[&str], &str); 7] = [
@@ -271,7 +275,7 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
         "{unshot:?}"
     );
     assert!(r["tiles"].as_u64().unwrap() >= r["patches"].as_u64().unwrap());
-    let refused: [(&[&str], &str); 8] = [
+    let refused: [(&[&str], &str); 12] = [
         (&["--elements", "8"], "--method radiosity"),
         (&["--subdivide", "2"], "--method radiosity"),
         (&["--method", "radiosity", "--subdivide", "7"], "0..=6"),
@@ -290,6 +294,27 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
         ),
         (&["--method", "radiosity", "--convergence", "2"], "(0, 1)"),
         (&["--method", "sppm", "--max-shots", "4"], "radiosity"),
+        (
+            &["--caustic-paths", "all"],
+            "add --method igi or --method radiosity",
+        ),
+        (
+            &[
+                "--method",
+                "differentials",
+                "--caustic-paths",
+                "from-lights",
+            ],
+            "--method igi",
+        ),
+        (
+            &["--method", "sppm", "--caustic-paths", "all"],
+            "--caustic-paths",
+        ),
+        (
+            &["--method", "igi", "--caustic-paths", "some"],
+            "from-lights",
+        ),
     ];
     for (args, says) in refused {
         assert_render_refused(&d, "cornell_box", args, says);

@@ -84,18 +84,22 @@ fn compare(scene: &Scene, seed: u32, emitted: u32) -> (usize, usize, usize) {
 
 #[test]
 fn gpu_photons_equal_the_cpu_tracer_photon_by_photon() {
-    // Caustics only: emission through projection maps, photons ending at diffuse hits.
-    for (name, emitted, caustics_only) in [
-        ("cornell_box", 20_000, false),
-        ("glass_ball", 20_000, false),
-        ("ring", 20_000, false),
-        ("cornell_box", 10_000, true),
-        ("ring", 10_000, true),
+    // Caustics only: emission through projection maps, photons ending at
+    // diffuse hits. Specular-last only: every path, stored after mirrors and
+    // glass alone.
+    for (name, emitted, caustics_only, specular_last_only) in [
+        ("cornell_box", 20_000, false, false),
+        ("glass_ball", 20_000, false, false),
+        ("ring", 20_000, false, false),
+        ("cornell_box", 10_000, true, false),
+        ("ring", 10_000, true, false),
+        ("cornell_box", 10_000, false, true),
     ] {
         let mut scene = common::paper_scene(name);
         scene.photon_map.caustics_only = caustics_only;
+        scene.photon_map.specular_last_only = specular_last_only;
         let (photons, diverged, matched) = compare(&scene, 11, emitted);
-        eprintln!("{name} (caustics only: {caustics_only}): {photons} photons, {matched} records equal within 1e-4, {diverged} photons diverged");
+        eprintln!("{name} (caustics only: {caustics_only}, specular-last only: {specular_last_only}): {photons} photons, {matched} records equal within 1e-4, {diverged} photons diverged");
         // Rounding flips a decision for a handful of photons in tens of thousands:
         // more than 0.5% would mean a real difference between the twins.
         assert!(
@@ -107,6 +111,52 @@ fn gpu_photons_equal_the_cpu_tracer_photon_by_photon() {
             "{name}: too few records ({matched}) to have tested bounces"
         );
     }
+}
+
+/// The specular-last map traces the same paths as the all-paths one (same
+/// seed, same numbers) and stores exactly those of its records whose photon
+/// arrived from a mirror or glass: in CORNELL BOX, light through the balls
+/// after the walls (L D+ S+ D) as well as the caustics straight from the light.
+#[test]
+fn specular_last_photons_are_the_records_that_arrived_from_a_mirror_or_glass() {
+    let gpu = common::gpu();
+    let mut scene = common::paper_scene("cornell_box");
+    let textures = SceneTextures::new(&gpu, &scene).unwrap();
+    let tracer = PhotonTracer::new(&gpu).unwrap();
+    let all = records(&tracer.trace(&scene, &textures, 5, 8192).unwrap());
+    scene.photon_map.specular_last_only = true;
+    let frames = tracer.trace(&scene, &textures, 5, 8192).unwrap();
+    let last = records(&frames);
+    assert_eq!(all.len(), last.len());
+    let per_frame = (frames.width * frames.frame_height) as usize;
+    let specular = |mat: f32| mat >= 0.0 && scene.materials[mat as usize].is_specular();
+    let (mut stored, mut after_diffuse) = (0, 0);
+    for (i, (a, b)) in all.iter().zip(&last).enumerate() {
+        assert_eq!(
+            (a.position, a.outgoing),
+            (b.position, b.outgoing),
+            "record {i}"
+        );
+        let arrived_from_specular = i >= per_frame && specular(all[i - per_frame].position.w);
+        let expected = a.power.w == 1.0 && arrived_from_specular;
+        assert_eq!(b.power.w == 1.0, expected, "record {i}");
+        if expected {
+            stored += 1;
+            // The photon met a diffuse surface before the mirror or glass.
+            let earlier = (1..i / per_frame).any(|f| {
+                let m = all[i - f * per_frame].position.w;
+                m >= 0.0 && !specular(m)
+            });
+            after_diffuse += earlier as usize;
+        }
+    }
+    eprintln!(
+        "specular-last photons: {stored} stored, {after_diffuse} of them after a diffuse hit"
+    );
+    assert!(
+        stored > 100 && after_diffuse * 4 > stored,
+        "{stored}, {after_diffuse}"
+    );
 }
 
 /// A scene of OBJ meshes: emissive triangles of unequal areas in two groups

@@ -11,8 +11,8 @@ use photonmap::image::check_writable;
 use photonmap::provenance::Provenance;
 use photonmap::render::sppm::SppmOptions;
 use photonmap::render::{
-    self, AdaptiveOptions, FinalGatherOptions, Image, PhotonMapOptions, RenderOptions,
-    WithCausticMap, WithPhotons,
+    self, AdaptiveOptions, CausticPaths, FinalGatherOptions, IgiOptions, Image, PhotonMapOptions,
+    RadiosityOptions, RenderOptions, WithCausticMap, WithPhotons,
 };
 use photonmap::scene::Scene;
 
@@ -91,6 +91,13 @@ pub struct RenderArgs {
     pub sppm: SppmArgs,
     #[command(flatten)]
     pub igi: IgiArgs,
+    /// IGI and radiosity: the light their caustic map carries. all: every
+    /// path onto a diffuse surface from a mirror or glass, including light a
+    /// diffuse surface sends through them (L D+ S+ D), which VPLs and form
+    /// factors cannot carry; from-lights: Jensen's caustic map, light
+    /// straight from an emitter only (L S+ D).
+    #[arg(long, value_enum, value_name = "PATHS")]
+    pub caustic_paths: Option<CausticPaths>,
     #[command(flatten)]
     pub differentials: DifferentialsArgs,
     #[command(flatten)]
@@ -282,7 +289,10 @@ impl RenderArgs {
             Method::Igi => render::Method::Igi(WithCausticMap {
                 photons,
                 estimate,
-                method: (&self.igi).into(),
+                method: IgiOptions {
+                    caustic_paths: self.caustic_paths.unwrap_or_default(),
+                    ..(&self.igi).into()
+                },
             }),
             Method::Differentials => render::Method::Differentials(WithPhotons {
                 photons,
@@ -291,7 +301,10 @@ impl RenderArgs {
             Method::Radiosity => render::Method::Radiosity(WithCausticMap {
                 photons,
                 estimate,
-                method: (&self.radiosity).into(),
+                method: RadiosityOptions {
+                    caustic_paths: self.caustic_paths.unwrap_or_default(),
+                    ..(&self.radiosity).into()
+                },
             }),
             Method::Sppm => render::Method::Sppm(WithPhotons {
                 photons,
@@ -315,8 +328,9 @@ impl RenderArgs {
             || self.igi.any_given()
             || self.differentials.any_given()
             || self.radiosity.any_given()
+            || self.caustic_paths.is_some()
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor)");
         }
         Ok(())
     }
@@ -350,6 +364,9 @@ impl RenderArgs {
                 "--method radiosity computes the diffuse interreflection itself",
             ),
         ];
+        if self.caustic_paths.is_some() && !matches!(self.method, Method::Igi | Method::Radiosity) {
+            bail!("--caustic-paths chooses the caustic map of IGI and radiosity: add --method igi or --method radiosity");
+        }
         for (method, given, theirs, cannot) in methods {
             if self.method != method && given {
                 bail!("{theirs}");

@@ -33,9 +33,11 @@
 //!    (`accumulate`).
 //! 5. **The image**: direct light and specular paths from the ray tracer, the
 //!    radiosity less its direct part at each first diffuse hit (`lookup`,
-//!    down the quadtree to the leaf), and caustics from a caustic photon
-//!    map: radiosity has none, and light from a diffuse surface through
-//!    glass or a mirror is in neither.
+//!    down the quadtree to the leaf), and from a caustic photon map the light
+//!    that reaches x from a mirror or glass, which shots (stopped by both)
+//!    cannot carry: by default every such path (`CausticPaths::All`), light
+//!    a diffuse surface sends through them included. Light that leaves a
+//!    mirror or glass onto a diffuse surface does not bounce on from there.
 
 mod elements;
 mod options;

@@ -2,6 +2,7 @@
 
 use crate::error::Error;
 use crate::gpu::Result;
+use crate::render::photon_options::CausticPaths;
 
 /// How the radiosity solution runs.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -22,6 +23,9 @@ pub struct RadiosityOptions {
     pub gradient: f32,
     /// How a sub-element shooter's form factor is computed.
     pub form_factor: FormFactor,
+    /// The caustic map's paths: all light onto x from a mirror or glass, or
+    /// only light straight from an emitter (form factors stop at both).
+    pub caustic_paths: CausticPaths,
 }
 
 /// A shooter's form factor to a receiving element's centre.
@@ -55,6 +59,7 @@ impl Default for RadiosityOptions {
             subdivide: 1,
             gradient: 0.25,
             form_factor: FormFactor::Polygon,
+            caustic_paths: CausticPaths::All,
         }
     }
 }

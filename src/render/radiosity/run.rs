@@ -26,7 +26,8 @@ impl RadiosityRun {
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let caustics = MapEstimate::caustics(p, with, timings, observer)?;
+        let caustics =
+            MapEstimate::caustics(p, with, with.method.caustic_paths, timings, observer)?;
         let mut radiosity = Radiosity::new(p.gpu, p.scene, p.width, p.height, &with.method)?;
         let report = radiosity.solve(p.scene, p.textures, timings, &mut |_shot, unshot| {
             observer.progress(&Progress::stage(

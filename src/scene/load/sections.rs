@@ -283,6 +283,7 @@ fn read_photon_map(t: &Table) -> Result<PhotonMapDraft, SceneError> {
             max_bounces,
             store_direct: store_direct.into_inner(),
             caustics_only: *caustics_only.get_ref(),
+            specular_last_only: false,
             projection_resolution,
         },
         table: t.span.clone(),

@@ -3,7 +3,7 @@
 
 use photonmap::photon::{BuildMethod, GridKind};
 use photonmap::render::radiance_estimate::LeakTest;
-use photonmap::render::{DifferentialsOptions, IgiOptions, Kernel, RadiosityOptions};
+use photonmap::render::{CausticPaths, DifferentialsOptions, IgiOptions, Kernel, RadiosityOptions};
 use photonmap::scene::{Light, Scene};
 
 use super::report::{AccuracyRun, RunMethod};
@@ -174,6 +174,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     out.push(igi("IGI, all three accelerations", &all_three));
     if !quick {
         out.push(igi("IGI 256 paths", &|o| o.vpl_paths = 256));
+        out.push(igi("IGI, caustics from lights", &|o| {
+            o.caustic_paths = CausticPaths::FromLights
+        }));
         out.push(igi("IGI, imperfect visibility", &|o| {
             o.imperfect_visibility = true
         }));
@@ -241,6 +244,11 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     };
     let mut out = vec![rad("radiosity", 16, 1)];
     if !quick {
+        let mut from_lights = rad("radiosity, caustics from lights", 16, 1);
+        if let RunMethod::Radiosity(o) = &mut from_lights.run.method {
+            o.caustic_paths = CausticPaths::FromLights;
+        }
+        out.push(from_lights);
         out.push(rad("radiosity, 32 elements", 32, 1));
         out.push(rad("radiosity, 4 spp", 16, 4));
     }
