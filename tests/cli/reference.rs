@@ -1,6 +1,7 @@
 //! `photonmap reference` writes an SPPM reference and its error model, and
 //! `bench accuracy` measures run time against error with it (`--only` runs
-//! the matching rows; without a reference it says how to make one).
+//! the matching rows, `--regions` scores surfaces and rectangles; without a
+//! reference it says how to make one).
 
 use std::path::Path;
 
@@ -84,6 +85,7 @@ fn reference_and_accuracy_bench_write_their_results() {
         .unwrap()
         .contains("<polyline"));
     accuracy_only_runs_the_matching_rows(&reference, &d.join("only"));
+    accuracy_scores_regions(&reference, &d);
     // Without a reference it says how to make one.
     Run::new(["bench", "accuracy", "--scene"])
         .scene("ring")
@@ -112,4 +114,58 @@ fn accuracy_only_runs_the_matching_rows(reference: &Path, out: &Path) {
         "no defaults run, no bias map"
     );
     only(&["no such run"]).refused_with("scene defaults, photons x");
+}
+
+/// `bench accuracy --regions --mask`: the regions are the surfaces seen first
+/// and the named rectangles, each cut to the mask; a rectangle over every
+/// compared pixel scores the run's own energy.
+fn accuracy_scores_regions(reference: &Path, d: &Path) {
+    let mask = d.join("left.png");
+    image::GrayImage::from_fn(64, 48, |x, _| image::Luma([if x < 48 { 255 } else { 0 }]))
+        .save(&mask)
+        .unwrap();
+    let out = d.join("regions");
+    let bench = |regions: &[&str]| {
+        Run::new([
+            "bench", "accuracy", "--quiet", "--json", "--seeds", "2", "--only",
+        ])
+        .arg("=scene defaults")
+        .args(["--scene", "glass_ball", "--mask"])
+        .arg(&mask)
+        .arg("--reference")
+        .arg(reference)
+        .writing("--out", &out)
+        .args(regions.iter().flat_map(|r| ["--region", r]))
+    };
+    let v = bench(&["whole=0:64:0:48", "right=48:64:0:48"]).json();
+    assert_eq!(v["pixels_compared"], 48 * 48, "{v}");
+    let sizes = v["regions"].as_array().unwrap();
+    let names: Vec<&str> = sizes.iter().map(|r| r["name"].as_str().unwrap()).collect();
+    assert!(!names.contains(&"right"), "outside the mask: {names:?}");
+    let whole = names.iter().position(|&n| n == "whole").unwrap();
+    assert_eq!(sizes[whole]["pixels"], 48 * 48);
+    let surfaces: u64 = sizes[..whole]
+        .iter()
+        .map(|r| r["pixels"].as_u64().unwrap())
+        .sum();
+    assert!(whole > 0 && surfaces <= 48 * 48, "{sizes:?}");
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 1, "{v}");
+    let scores = runs[0]["regions"].as_array().unwrap();
+    assert_eq!(scores.len(), sizes.len());
+    let energy = runs[0]["energy"].as_f64().unwrap();
+    let whole_energy = scores[whole]["energy"].as_f64().unwrap();
+    assert!(
+        (whole_energy - energy).abs() < 1e-9 * energy,
+        "{whole_energy} vs {energy}"
+    );
+    for s in scores {
+        assert!(s["energy"].as_f64().unwrap() > 0.0 && s["rel_rmse"].as_f64().unwrap() > 0.0);
+        assert!(s["energy_noise"].as_f64().unwrap() >= 0.0, "{s}");
+    }
+    for f in ["regions.csv", "regions.md", "bias/scene-defaults.png"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    bench(&["past=0:65:0:10"]).refused_with("outside the reference's 64 x 48");
+    bench(&["no bounds"]).refused_with("NAME=X0:X1:Y0:Y1");
 }

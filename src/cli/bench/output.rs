@@ -84,3 +84,19 @@ pub fn slug(label: &str) -> String {
         .collect::<Vec<_>>()
         .join("_")
 }
+
+/// This run's command line as a user would retype it (arguments with spaces
+/// or quotes quoted), for a result file's heading.
+pub fn command_line() -> String {
+    let quoted = std::env::args().skip(1).map(|a| {
+        if a.is_empty() || a.contains([' ', '"', '\'', '|']) {
+            format!("\"{}\"", a.replace('"', "\\\""))
+        } else {
+            a
+        }
+    });
+    std::iter::once("photonmap".to_string())
+        .chain(quoted)
+        .collect::<Vec<_>>()
+        .join(" ")
+}

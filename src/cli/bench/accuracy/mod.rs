@@ -27,7 +27,7 @@ use photonmap::render::{
 };
 use photonmap::scene::{embedded, Scene};
 
-use super::output::{folder, stem, write_json, BenchOutput};
+use super::output::{command_line, folder, stem, write_json, BenchOutput};
 use super::reference::{read_reference, reference_options, ReferenceInfo};
 use super::scene::{default_reference, reference_scale, SEED};
 use plot::{bias_map, csv, png_plot, svg_plot};
@@ -120,6 +120,7 @@ pub fn run_bench(a: &AccuracyArgs, platform: Platform) -> Result<()> {
     }
     if !report.regions.is_empty() {
         write("regions.csv", regions::csv(&report).as_bytes())?;
+        write("regions.md", regions::markdown(&report).as_bytes())?;
         std::fs::create_dir_all(dir.join("bias"))?;
         for (label, map) in &report.bias_maps {
             write(
@@ -303,6 +304,7 @@ pub fn bench_accuracy(
         .map(|r| r.label.clone())
         .unwrap_or_default();
     Ok(AccuracyReport {
+        command: command_line(),
         scene: scene.name.clone(),
         reference_file: sweep.reference.display().to_string(),
         reference: info,

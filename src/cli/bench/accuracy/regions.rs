@@ -1,6 +1,6 @@
 //! `bench accuracy --regions`: each run's energy and error on every diffuse
 //! surface the pixels see first (from the ray tracer's first-hit record) and
-//! on rectangles named with `--region`, as a table, `regions.csv` and the
+//! on rectangles named with `--region`, as a table, `regions.csv`, `regions.md` and the
 //! runs' JSON.
 
 use anyhow::{bail, Result};
@@ -18,7 +18,7 @@ use super::report::{AccuracyReport, RegionScore, RegionSize};
 pub struct RegionArgs {
     /// Report every run's energy and error on each diffuse surface the
     /// pixels see first, and write every run's bias map (bias/<run>.png)
-    /// and regions.csv.
+    /// and regions.csv and regions.md (a table a row a run).
     #[arg(long)]
     pub regions: bool,
     /// A rectangle to report as a region too (implies --regions):
@@ -181,6 +181,33 @@ pub fn csv(report: &AccuracyReport) -> String {
                 run.seconds
             );
         }
+    }
+    s
+}
+
+/// `regions.md`: the command, then a Markdown table, a row a run and a
+/// column a region, of energy (image over reference) with its standard
+/// error from the seeds.
+pub fn markdown(report: &AccuracyReport) -> String {
+    let mut s = format!(
+        "`{}`\n\n{} seeds a run; {}.\n\n| run | seconds | rel RMSE | energy |",
+        report.command, report.seeds, report.renderer
+    );
+    let mut rule = String::from("|---|---|---|---|");
+    for r in &report.regions {
+        s += &format!(" {} ({} px) |", r.name, r.pixels);
+        rule += "---|";
+    }
+    s += &format!("\n{rule}\n");
+    for run in &report.runs {
+        s += &format!(
+            "| {} | {:.2} | {:.3} | {:.3} |",
+            run.label, run.seconds, run.rel_rmse, run.energy
+        );
+        for score in &run.regions {
+            s += &format!(" {:.3} ± {:.3} |", score.energy, score.energy_noise);
+        }
+        s.push('\n');
     }
     s
 }

@@ -83,6 +83,8 @@ pub struct AccuracyRun {
 
 #[derive(Serialize)]
 pub struct AccuracyReport {
+    /// The command that wrote it.
+    pub command: String,
     pub scene: String,
     /// The reference's file.
     pub reference_file: String,

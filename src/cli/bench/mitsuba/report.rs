@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use photonmap::image::write_atomically;
 
-use crate::cli::bench::output::write_json;
+use crate::cli::bench::output::{command_line, write_json};
 use crate::cli::bench::plot::LogLog;
 
 #[derive(Serialize, Clone, Debug)]
@@ -92,12 +92,6 @@ pub(super) fn write(dir: &Path, report: &MitsubaBench) -> Result<()> {
     let table = markdown_table(report, &command_line());
     write_atomically(&dir.join(TABLE_FILE), table.as_bytes())?;
     Ok(())
-}
-
-/// This run's command line, for the table's heading (arguments as given).
-fn command_line() -> String {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    format!("photonmap {}", args.join(" "))
 }
 
 /// The rows as a Markdown table, headed by the command that made them, for
