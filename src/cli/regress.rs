@@ -131,6 +131,9 @@ fn jobs(a: &RegressArgs) -> Result<Vec<Job>> {
 }
 
 pub fn run(a: &RegressArgs, platform: Platform) -> Result<()> {
+    if a.update && (a.junit.is_some() || a.html.is_some()) {
+        bail!("--junit and --html report a test; --update makes references and tests nothing");
+    }
     ci_report::check_paths(a.junit.as_deref(), a.html.as_deref())?;
     let jobs = jobs(a)?;
     let gpu = super::gpu(platform)?;

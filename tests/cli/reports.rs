@@ -141,4 +141,9 @@ fn regress_writes_one_report_for_many_scenes() {
         .arg(common::scene_file("ring"))
         .arg(&bright)
         .refused_with("--name");
+    Run::new(["regress", "--update", "--reference"])
+        .arg(&refs)
+        .arg(common::scene_file("ring"))
+        .writing("--junit", d.join("update.xml"))
+        .refused_with("--update");
 }
