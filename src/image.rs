@@ -109,12 +109,7 @@ impl Image {
                 buf.push((linear_to_srgb(*c) * 255.0 + 0.5) as u8);
             }
         }
-        let img = image::RgbImage::from_raw(self.width, self.height, buf)
-            .ok_or_else(|| Error::Image("image buffer size mismatch".into()))?;
-        let mut out = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut out, image::ImageFormat::Png)
-            .map_err(|e| Error::Image(format!("encoding a PNG: {e}")))?;
-        Ok(out.into_inner())
+        srgb8_png(self.width, self.height, buf)
     }
 
     /// Linear float RGB OpenEXR, the same orientation as the PNG.
@@ -207,6 +202,16 @@ impl Image {
             pixels,
         })
     }
+}
+
+/// A PNG of 8-bit sRGB pixels, three bytes each, top row first.
+pub fn srgb8_png(width: u32, height: u32, rgb: Vec<u8>) -> Result<Vec<u8>> {
+    let img = image::RgbImage::from_raw(width, height, rgb)
+        .ok_or_else(|| Error::Image("image buffer size mismatch".into()))?;
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .map_err(|e| Error::Image(format!("encoding a PNG: {e}")))?;
+    Ok(out.into_inner())
 }
 
 /// Writes `bytes` to `path` all or nothing (see `write_all_atomically`).

@@ -197,11 +197,21 @@ pub fn false_colour(a: &Image, b: &Image) -> Image {
     }
 }
 
-/// Mean LDR-FLIP (Andersson et al. 2020, NVIDIA's implementation through the
-/// nv-flip crate, as wgpu's tests use it) of the two images' sRGB 8-bit
-/// encodings, at FLIP's default 67 pixels per degree: 0 is identical, 1 the
-/// most different; `b` is the reference.
-pub fn flip(a: &Image, b: &Image) -> Result<f64> {
+/// NVIDIA's LDR-FLIP (Andersson et al. 2020, through the nv-flip crate, as
+/// wgpu's tests use it) of two images' sRGB 8-bit encodings at FLIP's
+/// default 67 pixels per degree: the per-pixel error map (0 identical .. 1
+/// the most different) and the figures pooled from it.
+pub struct FlipMap {
+    map: nv_flip::FlipImageFloat,
+    /// The map's mean.
+    pub mean: f64,
+}
+
+/// The FLIP percentiles `compare` and `regress` report, in percent.
+pub const FLIP_PERCENTILES: [f64; 4] = [50.0, 90.0, 95.0, 99.0];
+
+/// FLIP's error map of `a` against the reference `b`.
+pub fn flip_map(a: &Image, b: &Image) -> Result<FlipMap> {
     same_size(a, b)?;
     let srgb = |img: &Image| -> Vec<u8> {
         img.pixels
@@ -213,7 +223,40 @@ pub fn flip(a: &Image, b: &Image) -> Result<f64> {
     let test = nv_flip::FlipImageRgb8::with_data(a.width, a.height, &ta);
     let reference = nv_flip::FlipImageRgb8::with_data(b.width, b.height, &tb);
     let map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
-    Ok(nv_flip::FlipPool::from_image(&map).mean() as f64)
+    let mean = nv_flip::FlipPool::from_image(&map).mean() as f64;
+    Ok(FlipMap { map, mean })
+}
+
+impl FlipMap {
+    /// FLIP's weighted percentile (`percent` in 0..=100), the one wgpu's
+    /// tests gate on: the smallest error e such that the pixels with errors
+    /// up to e, in ascending order, hold more than `percent`% of the map's
+    /// summed error (0 where the map is all 0).
+    pub fn percentile(&self, percent: f64) -> f64 {
+        let mut pool = nv_flip::FlipPool::from_image(&self.map);
+        pool.get_percentile((percent / 100.0) as f32, true) as f64
+    }
+
+    /// The per-pixel errors, row 0 at the top.
+    pub fn values(&self) -> Vec<f32> {
+        self.map.to_vec()
+    }
+
+    /// The map through FLIP's magma colour map (black 0 .. pale yellow 1), as
+    /// FLIP's own tool shows it: 8-bit sRGB, three bytes a pixel.
+    pub fn magma_srgb8(&self) -> Vec<u8> {
+        self.map.apply_color_lut(&nv_flip::magma_lut()).to_vec()
+    }
+
+    /// [`FlipMap::magma_srgb8`] as a PNG.
+    pub fn magma_png(&self) -> Result<Vec<u8>> {
+        crate::image::srgb8_png(self.map.width(), self.map.height(), self.magma_srgb8())
+    }
+}
+
+/// The mean of [`flip_map`].
+pub fn flip(a: &Image, b: &Image) -> Result<f64> {
+    Ok(flip_map(a, b)?.mean)
 }
 
 /// The fraction of pixels with a channel differing by more than `threshold`
@@ -257,5 +300,55 @@ mod tests {
         assert_eq!(left.pixels_compared, 30);
         assert!(left.rmse < d.rmse / 10.0);
         assert!(compare(&a, &gradient(41, 30, 1.0), None).is_err());
+    }
+
+    /// The plain computation of FLIP's weighted percentile over the map's
+    /// own values: sorted ascending, the first whose running sum passes p of
+    /// the total.
+    fn weighted_percentile(values: &[f32], percent: f64) -> f64 {
+        let mut v: Vec<f64> = values.iter().map(|&x| x as f64).collect();
+        v.sort_by(f64::total_cmp);
+        let total: f64 = v.iter().sum();
+        let mut running = 0.0;
+        for x in &v {
+            running += x;
+            if running > percent / 100.0 * total {
+                return *x;
+            }
+        }
+        0.0
+    }
+
+    #[test]
+    fn flip_percentiles_match_a_plain_computation() {
+        let a = gradient(24, 16, 1.0);
+        let mut b = gradient(24, 16, 1.0);
+        // A few bright defects over a mild global change: a long tail.
+        for (i, p) in b.pixels.iter_mut().enumerate() {
+            p[0] *= 1.05;
+            if i % 37 == 0 {
+                *p = [1.0, 1.0, 1.0];
+            }
+        }
+        let f = flip_map(&b, &a).unwrap();
+        let values = f.values();
+        assert_eq!(values.len(), 24 * 16);
+        let mean = values.iter().map(|&x| x as f64).sum::<f64>() / values.len() as f64;
+        assert!((f.mean - mean).abs() < 1e-6, "{} against {mean}", f.mean);
+        let mut last = 0.0;
+        for p in FLIP_PERCENTILES {
+            let (got, plain) = (f.percentile(p), weighted_percentile(&values, p));
+            assert!((got - plain).abs() < 1e-6, "p{p}: {got} against {plain}");
+            assert!(got >= last, "p{p} {got} below {last}");
+            last = got;
+        }
+        assert!(f.percentile(99.0) > f.percentile(50.0) && f.percentile(50.0) > 0.0);
+        // Identical images: an all-zero map, every figure 0, a black picture.
+        let same = flip_map(&a, &a).unwrap();
+        assert_eq!((same.mean, same.percentile(99.0)), (0.0, 0.0));
+        let magma = same.magma_srgb8();
+        assert_eq!(magma.len(), 24 * 16 * 3);
+        assert!(magma.iter().all(|&c| c < 8), "magma at 0 is near black");
+        assert!(f.magma_srgb8().iter().any(|&c| c > 128));
     }
 }

@@ -522,7 +522,7 @@ pub struct SceneArgs {
     pub set: Vec<(String, String)>,
 }
 
-fn key_value(s: &str) -> Result<(String, String), String> {
+pub fn key_value(s: &str) -> Result<(String, String), String> {
     match s.split_once('=') {
         Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.trim().to_string())),
         _ => Err(format!("{s}: give KEY=VALUE, as in photon_map.k=64")),

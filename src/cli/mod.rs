@@ -5,6 +5,7 @@
 
 pub mod args;
 pub mod bench;
+pub mod ci_report;
 pub mod compare;
 pub mod convert;
 pub mod info;

@@ -125,3 +125,113 @@ fn compare_fails_a_perturbed_image_and_passes_an_identical_one() {
         "the difference image is written on failure"
     );
 }
+
+/// The two tiers, as idiff has them: a --warn-* threshold that does not hold
+/// prints a warning and exits 0, a --fail-* one exits 1; FLIP's percentiles
+/// gate through --fail-flip-percentile P:X; with a FLIP threshold the
+/// difference image is FLIP's magma map.
+#[test]
+fn compare_warns_with_exit_0_and_fails_with_exit_1() {
+    let d = TempDir::new("tiers");
+    let exr = |seed: &str| {
+        let p = d.join(format!("{seed}.exr"));
+        Run::new(["render", "glass_ball", "--quiet", "--direct-only"])
+            .args(["--width", "40", "--height", "30", "--seed", seed])
+            .output_to(&p)
+            .succeeds();
+        p
+    };
+    let (a, b) = (exr("1"), exr("2"));
+    let compare = |extra: &[String]| {
+        Run::new(["compare", "--json"])
+            .arg(&a)
+            .arg(&b)
+            .args(extra)
+            .run()
+    };
+    let base = compare(&[]).json();
+    let rmse = base["rmse"].as_f64().unwrap();
+    let p99 = base["flip_percentiles"]["p99"].as_f64().unwrap();
+    let p50 = base["flip_percentiles"]["p50"].as_f64().unwrap();
+    assert!(p99 > p50 && p50 > 0.0, "{base}");
+    let s = |v: f64| format!("{v}");
+    // (flags, exit code, warned)
+    let cases: Vec<(Vec<String>, i32, bool)> = vec![
+        (vec!["--warn-rmse".into(), s(rmse / 2.0)], 0, true),
+        (vec!["--warn-rmse".into(), s(rmse * 2.0)], 0, false),
+        (vec!["--fail-rmse".into(), s(rmse / 2.0)], 1, false),
+        (
+            vec![
+                "--warn-rmse".into(),
+                s(rmse / 2.0),
+                "--fail-rmse".into(),
+                s(rmse * 2.0),
+            ],
+            0,
+            true,
+        ),
+        (vec!["--warn".into(), "0".into()], 0, true),
+        (
+            vec!["--warn-flip-percentile".into(), format!("99:{}", p99 * 0.9)],
+            0,
+            true,
+        ),
+        (
+            vec!["--fail-flip-percentile".into(), format!("99:{}", p99 * 0.9)],
+            1,
+            false,
+        ),
+        (
+            vec![
+                "--fail-flip-percentile".into(),
+                format!("99:{}", p99 * 1.01),
+            ],
+            0,
+            false,
+        ),
+        (
+            vec![
+                "--fail-flip-percentile".into(),
+                format!("50:{}", p50 * 1.01),
+            ],
+            0,
+            false,
+        ),
+    ];
+    for (flags, code, warned) in cases {
+        let out = compare(&flags);
+        assert_eq!(
+            out.status.code(),
+            Some(code),
+            "{flags:?}: {}",
+            out.stderr_text()
+        );
+        let v = out.json();
+        assert_eq!(v["warned"], warned, "{flags:?}: {v}");
+        assert_eq!(v["passed"], code == 0, "{flags:?}: {v}");
+        assert_eq!(out.stderr_text().contains("warning:"), warned, "{flags:?}");
+    }
+    for (bad, says) in [("150:0.1", "(0, 100)"), ("99", "P:X"), ("99:2", "[0, 1]")] {
+        Run::new(["compare", "--fail-flip-percentile", bad])
+            .arg(&a)
+            .arg(&b)
+            .refused_with(says);
+    }
+    // A FLIP threshold makes --diff FLIP's error map through magma.
+    let diff = d.join("flip.png");
+    let out = compare(&[
+        "--fail-flip-percentile".into(),
+        "99:1".into(),
+        "--diff".into(),
+        diff.display().to_string(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let (ia, ib) = (
+        photonmap::render::Image::read_exr(&a).unwrap(),
+        photonmap::render::Image::read_exr(&b).unwrap(),
+    );
+    let magma = photonmap::metrics::flip_map(&ia, &ib)
+        .unwrap()
+        .magma_srgb8();
+    assert_eq!(image::open(&diff).unwrap().to_rgb8().into_raw(), magma);
+}

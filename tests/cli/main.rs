@@ -15,5 +15,6 @@ mod photons;
 mod reference;
 mod regress;
 mod render;
+mod reports;
 mod scenes;
 mod tables;

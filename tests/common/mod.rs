@@ -4,6 +4,7 @@
 //! binary run as a user runs it (`run`), scenes (the paper's and the test
 //! fixtures in scenes/tests/), image metrics and the one random source.
 
+pub mod browser;
 mod context;
 mod run;
 mod temp;
