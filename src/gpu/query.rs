@@ -24,10 +24,7 @@ impl Query {
 
     fn new(gpu: &Gpu, target: u32) -> Result<Self> {
         // SAFETY: gpu module doc.
-        let raw = unsafe { gpu.gl().create_query() }.map_err(|message| Error::Create {
-            what: "a query".into(),
-            message,
-        })?;
+        let raw = unsafe { gpu.gl().create_query() }.map_err(Error::creating("a query"))?;
         Ok(Self {
             gpu: gpu.clone(),
             raw,

@@ -206,6 +206,37 @@ impl PhotonMap {
         }
     }
 
+    /// Each photon's direction of arrival.
+    pub fn incoming(&self) -> &crate::gpu::Texture {
+        match self {
+            PhotonMap::Sorted(m) => &m.incoming,
+            PhotonMap::Routed(m) => &m.incoming,
+        }
+    }
+
+    /// The map and its grid as glsl/common/photon_map.glsl declares them
+    /// (the build's layout: sorted, or ROUTED).
+    pub fn bind(&self, b: &mut Bindings<'_>) {
+        match self {
+            PhotonMap::Sorted(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_grid_first", &m.grid_first)
+                    .int("u_grid_width", m.grid_width as i32)
+                    .int("u_sorted_width", m.position.width as i32);
+            }
+            PhotonMap::Routed(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_counts", &m.counts)
+                    .int("u_count_width", m.count_width as i32)
+                    .int("u_block", m.block as i32)
+                    .int("u_blocks_per_row", m.blocks_per_row as i32);
+            }
+        }
+        self.grid().bind(b);
+    }
+
     /// Texels of the grid's own structure: the sorted map's first-index
     /// texture (slots + 1 entries, as laid out), or stencil routing's
     /// routing buffer plus its count textures (the memory §4.4 is about).

@@ -748,4 +748,25 @@ impl PhotonFrames {
         f.photons_used = photons_used;
         Ok(f)
     }
+
+    /// One frame of `n` photons, `width` texels a row, photon i's position,
+    /// power and incoming direction (RGBA each) given by `record(i)`; the
+    /// rest of the last row holds none.
+    pub fn one_frame(
+        gpu: &Gpu,
+        width: u32,
+        n: u32,
+        mut record: impl FnMut(usize) -> [[f32; 4]; 3],
+    ) -> Result<Self> {
+        let frame_height = n.div_ceil(width);
+        let texels = (width * frame_height) as usize;
+        let mut records = [(); 3].map(|_| vec![0f32; texels * 4]);
+        for i in 0..n as usize {
+            for (channel, v) in records.iter_mut().zip(record(i)) {
+                channel[4 * i..4 * i + 4].copy_from_slice(&v);
+            }
+        }
+        let [position, power, incoming] = &records;
+        Self::from_records(gpu, width, frame_height, 1, position, power, incoming, n)
+    }
 }

@@ -45,7 +45,7 @@ pub fn trace_eye_paths(
         query.end();
         result?;
         gpu.finish();
-        timings.add_both(name, query.seconds(), stage_wall.elapsed().as_secs_f64(), 1);
+        timings.add_since(name, query.seconds(), stage_wall, 1);
         stage_wall = std::time::Instant::now();
         done += 1;
         observer.progress(&Progress::at("ray tracing", done, total, at));

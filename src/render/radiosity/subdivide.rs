@@ -74,10 +74,6 @@ impl Radiosity {
             self.queries.push(Query::occlusion(&self.gpu)?);
         }
         self.gpu.texture_barrier();
-        let state = DrawState {
-            color_writes: false,
-            ..DrawState::PLAIN
-        };
         for (&t, q) in tiles.iter().zip(&self.queries) {
             let (x, y) = self.elements.tile_base(t);
             q.begin();
@@ -92,7 +88,11 @@ impl Radiosity {
                 .int("u_res", self.elements.res as i32)
                 .float("u_gradient", self.options.gradient)
                 .float("u_floor", floor)
-                .draw_region(&self.residual_target, &state, self.elements.tile_region(t));
+                .draw_region(
+                    &self.residual_target,
+                    &DrawState::NO_COLOR,
+                    self.elements.tile_region(t),
+                );
             q.end();
             drawn?;
         }
