@@ -11,7 +11,7 @@ pub mod projection;
 pub mod stencil_routing;
 pub mod trace;
 
-use glam::Vec3;
+use glam::{IVec3, Vec3};
 
 use crate::gpu::Bindings;
 use crate::scene::Scene;
@@ -138,6 +138,16 @@ impl Grid {
         }
     }
 
+    /// Cells along x, y and z.
+    pub fn sides(&self) -> IVec3 {
+        IVec3::from_array(self.resolution.map(|r| r as i32))
+    }
+
+    /// A cell's extent along each axis.
+    pub fn cell_size(&self) -> Vec3 {
+        (self.max - self.min) / self.sides().as_vec3()
+    }
+
     pub fn cell_count(&self) -> u32 {
         self.resolution.iter().product()
     }
@@ -166,10 +176,9 @@ impl Grid {
     }
 
     pub fn bind(&self, b: &mut Bindings<'_>) {
-        let r = self.resolution.map(|v| v as i32);
         b.vec3("u_grid_min", self.min.to_array())
             .vec3("u_grid_max", self.max.to_array())
-            .ivec3("u_grid_resolution", r)
+            .ivec3("u_grid_resolution", self.sides().to_array())
             .int("u_hash_buckets", self.buckets().unwrap_or(0) as i32);
     }
 }
