@@ -42,6 +42,15 @@ impl Query {
         unsafe { self.gpu.gl().end_query(self.target) }
     }
 
+    /// Runs `work` as the query's span: begun before it, ended after it
+    /// whatever it returns, then its result.
+    pub fn around<T>(&self, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        self.begin();
+        let result = work();
+        self.end();
+        result
+    }
+
     /// The result of the last span; waits for it.
     pub fn count(&self) -> u64 {
         // SAFETY: gpu module doc; the query is this value's own and has ended.

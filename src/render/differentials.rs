@@ -246,10 +246,7 @@ impl FootprintEstimate {
                     "u_epanechnikov",
                     i32::from(self.kernel == Kernel::Epanechnikov),
                 );
-            hits.begin();
-            let drawn = b.draw_fullscreen(&self.state_target, &DrawState::PLAIN);
-            hits.end();
-            drawn?;
+            hits.around(|| b.draw_fullscreen(&self.state_target, &DrawState::PLAIN))?;
             drop(b);
             // The fragments drawn are the pixels that were still walking.
             let walking = hits.count();

@@ -199,10 +199,7 @@ impl FinalGather {
             let rays = self.batch.min(options.rays - done);
             self.gpu.finish();
             let t0 = std::time::Instant::now();
-            timer.begin();
-            let traced = self.trace_batch(scene, first, done..done + rays, max_depth, seed);
-            timer.end();
-            traced?;
+            timer.around(|| self.trace_batch(scene, first, done..done + rays, max_depth, seed))?;
             self.gpu.finish();
             timings.add_since("gather rays", timer.seconds(), t0, 1);
             let run = self.estimate.run(
@@ -221,11 +218,9 @@ impl FinalGather {
                 run.passes as usize,
             );
             let t0 = std::time::Instant::now();
-            timer.begin();
-            let added =
-                self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays);
-            timer.end();
-            added?;
+            timer.around(|| {
+                self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays)
+            })?;
             self.gpu.finish();
             timings.add_since("gather sum", timer.seconds(), t0, 1);
             stats.batches += 1;

@@ -364,10 +364,7 @@ impl RadianceEstimate {
         };
         let mut b = search.bind();
         self.bind_search(&mut b, query);
-        counter.begin();
-        let drawn = b.draw_fullscreen(&self.target, &state);
-        counter.end();
-        drawn?;
+        counter.around(|| b.draw_fullscreen(&self.target, &state))?;
         Ok(counter.count())
     }
 
@@ -459,10 +456,7 @@ impl Tiles {
             .int("u_tiles_per_row", self.per_row as i32)
             .ivec2("u_target_size", [target.width as i32, target.height as i32]);
         for (q, &t) in queries.iter().zip(&self.active) {
-            q.begin();
-            let drawn = b.draw_points(target, &DrawState::PLAIN, t as i32, 1);
-            q.end();
-            drawn?;
+            q.around(|| b.draw_points(target, &DrawState::PLAIN, t as i32, 1))?;
         }
         stats.tile_draws += self.active.len() as u64;
         let counts: Vec<u64> = queries

@@ -405,21 +405,19 @@ impl Radiosity {
     fn select(&self, threshold: f32, occlusion: &Query) -> Result<Option<usize>> {
         self.pick_target.clear([-1.0; 4]);
         self.pick_target.clear_depth_stencil(1.0, 0);
-        occlusion.begin();
-        let drawn = self
-            .programs
-            .select
-            .bind()
-            .texture("u_power", &self.power)
-            .float("u_threshold", threshold)
-            .draw_points(
-                &self.pick_target,
-                &DrawState::Z_BUFFER,
-                0,
-                self.elements.tiles.len() as i32,
-            );
-        occlusion.end();
-        drawn?;
+        occlusion.around(|| {
+            self.programs
+                .select
+                .bind()
+                .texture("u_power", &self.power)
+                .float("u_threshold", threshold)
+                .draw_points(
+                    &self.pick_target,
+                    &DrawState::Z_BUFFER,
+                    0,
+                    self.elements.tiles.len() as i32,
+                )
+        })?;
         if occlusion.count() == 0 {
             return Ok(None);
         }
