@@ -114,30 +114,34 @@ rows = [json.loads(l) for l in open(runs)]
 scenes = list(dict.fromkeys(r["scene"] for r in rows))
 configs = list(dict.fromkeys(r["config"] for r in rows))
 at = {(r["scene"], r["config"]): r for r in rows}
-t = [f"`{command}`\n",
-     f"Relative RMSE (energy; iterations) after {seconds} s at the reference's size, "
-     "on its mask's pixels, one seed each; llvmpipe.\n",
-     "| configuration | " + " | ".join(scenes) + " |",
-     "|---|" + "---|" * len(scenes)]
-for c in configs:
-    cells = []
-    for s in scenes:
-        r = at.get((s, c))
-        cells.append("-" if r is None else
-                     f"{r['rel_rmse']:.4f} ({r['energy']:.4f}; {r['iterations']})")
-    t.append(f"| {c} | " + " | ".join(cells) + " |")
+
+
+def table(caption, first, keys, cell):
+    """The command, `caption`, then a row a key and a column a scene."""
+    t = [f"`{command}`\n", caption,
+         f"| {first} | " + " | ".join(scenes) + " |",
+         "|---|" + "---|" * len(scenes)]
+    for k in keys:
+        t.append(f"| {k} | " + " | ".join(cell(s, k) for s in scenes) + " |")
+    return t
+
+
+def rmse_cell(s, c):
+    r = at.get((s, c))
+    return "-" if r is None else f"{r['rel_rmse']:.4f} ({r['energy']:.4f}; {r['iterations']})"
+
+
+def stage_cell(s, n):
+    r = at[(s, "defaults")]
+    return f"{1000 * r['stages'].get(n, 0.0) / r['iterations']:.1f}"
+
+
+t = table(f"Relative RMSE (energy; iterations) after {seconds} s at the reference's size, "
+          "on its mask's pixels, one seed each; llvmpipe.\n", "configuration", configs, rmse_cell)
 open(f"{out}/table.md", "w").write("\n".join(t) + "\n")
 names = list(dict.fromkeys(n for r in rows for n in r["stages"]))
-st = [f"`{command}`\n",
-      "Milliseconds an iteration by stage, at the defaults (wall clock between glFinish calls).\n",
-      "| stage | " + " | ".join(scenes) + " |",
-      "|---|" + "---|" * len(scenes)]
-for n in names:
-    cells = []
-    for s in scenes:
-        r = at[(s, "defaults")]
-        cells.append(f"{1000 * r['stages'].get(n, 0.0) / r['iterations']:.1f}")
-    st.append(f"| {n} | " + " | ".join(cells) + " |")
+st = table("Milliseconds an iteration by stage, at the defaults (wall clock between glFinish calls).\n",
+           "stage", names, stage_cell)
 totals = [f"{1000 * sum(at[(s, 'defaults')]['stages'].values()) / at[(s, 'defaults')]['iterations']:.1f}"
           for s in scenes]
 st.append("| **total** | " + " | ".join(f"**{x}**" for x in totals) + " |")

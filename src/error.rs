@@ -121,6 +121,13 @@ impl Error {
         }
     }
 
+    /// For `map_err` on a GL object's creation: the driver's `message` on
+    /// creating `what`.
+    pub fn creating(what: impl Into<String>) -> impl FnOnce(String) -> Self {
+        let what = what.into();
+        move |message| Error::Create { what, message }
+    }
+
     /// `option` (a field path, `igi.vpl_paths`) is `value`, outside what is
     /// `allowed` (a range, or what to give instead).
     pub fn out_of_range(
@@ -133,6 +140,32 @@ impl Error {
             value: value.to_string(),
             allowed: allowed.into(),
         }
+    }
+
+    /// Nothing if `value` is a positive (finite) number; else `option` out
+    /// of range, with what to give instead.
+    pub fn check_positive(option: &'static str, value: f32, allowed: &str) -> Result<()> {
+        if value > 0.0 && value.is_finite() {
+            return Ok(());
+        }
+        Err(Error::out_of_range(option, value, allowed))
+    }
+
+    /// Nothing if `range` holds `value`; else `option` out of range, the
+    /// allowed range named as `lo..=hi`.
+    pub fn check_range<T>(
+        option: &'static str,
+        value: T,
+        range: std::ops::RangeInclusive<T>,
+    ) -> Result<()>
+    where
+        T: PartialOrd + std::fmt::Display,
+    {
+        if range.contains(&value) {
+            return Ok(());
+        }
+        let allowed = format!("the allowed range is {}..={}", range.start(), range.end());
+        Err(Error::out_of_range(option, value, allowed))
     }
 }
 

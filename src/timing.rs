@@ -3,6 +3,8 @@
 //! GL_TIME_ELAPSED misses work in some pass patterns (it read 0.2 s of a 7.5 s
 //! radiance estimate), so wall clock is the figure to trust on llvmpipe.
 
+use std::time::Instant;
+
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct StageTiming {
     pub name: String,
@@ -41,6 +43,21 @@ impl Timings {
         }
     }
 
+    /// Adds GPU time, the wall time since `start` and passes to the stage `name`.
+    pub fn add_since(&mut self, name: &str, gpu_seconds: f64, start: Instant, passes: usize) {
+        self.add_both(name, gpu_seconds, start.elapsed().as_secs_f64(), passes);
+    }
+
+    /// Folds `stages` (a sub-task's own timings) into the one stage `name`:
+    /// their GPU time and passes, and the wall time since `start`.
+    pub fn add_folded(&mut self, name: &str, stages: &Timings, start: Instant) {
+        self.add_since(name, stages.gpu_total(), start, stages.passes_total());
+    }
+
+    pub fn passes_total(&self) -> usize {
+        self.stages.iter().map(|s| s.passes).sum()
+    }
+
     pub fn gpu_total(&self) -> f64 {
         self.stages.iter().map(|s| s.gpu_seconds).sum()
     }
@@ -67,7 +84,7 @@ impl Timings {
         out += &format!(
             "{:<18} {:>7} {:>11.2} {:>11.2}   (whole render, wall: {:.2} ms)\n",
             "total",
-            self.stages.iter().map(|s| s.passes).sum::<usize>(),
+            self.passes_total(),
             self.gpu_total() * 1e3,
             self.wall_total() * 1e3,
             self.wall_seconds * 1e3

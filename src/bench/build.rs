@@ -47,17 +47,9 @@ pub fn synthetic_frames(gpu: &Gpu, n: u64, seed: u32) -> Result<PhotonFrames> {
     let (width, height) = sort_texture_size(n);
     let mut state = seed;
     let mut next = || crate::random::rng_next(&mut state);
-    let texels = (width * height) as usize;
-    let (mut pos, mut pow, inc) = (
-        vec![0f32; texels * 4],
-        vec![0f32; texels * 4],
-        vec![0f32; texels * 4],
-    );
-    for i in 0..texels {
-        pos[4 * i..4 * i + 4].copy_from_slice(&[next(), next(), next(), 0.0]);
-        pow[4 * i..4 * i + 4].copy_from_slice(&[1.0, 1.0, 1.0, 1.0]);
-    }
-    PhotonFrames::from_records(gpu, width, height, 1, &pos, &pow, &inc, width * height)
+    PhotonFrames::one_frame(gpu, width, width * height, |_| {
+        [[next(), next(), next(), 0.0], [1.0; 4], [0.0; 4]]
+    })
 }
 
 fn stage(t: &Timings, name: &str) -> f64 {

@@ -397,21 +397,11 @@ fn sort_errors(gpu: &Gpu, n: usize) -> Result<usize> {
     let keys: Vec<i32> = (0..n as u32)
         .map(|i| (crate::random::pcg_hash(99u32.wrapping_add(i + 1)) % 100_000) as i32)
         .collect();
-    let data: Vec<i32> = keys
-        .iter()
-        .enumerate()
-        .flat_map(|(i, &key)| [key, i as i32])
-        .collect();
+    let data = crate::photon::bitonic::key_records(&keys);
     let tex = Texture::from_i32_format(gpu, w, h, TexFormat::Rg32I, &data)?;
     let (sorted, _) = BitonicBuild::new(gpu)?.sort(tex)?;
     let got = sorted.read_i32();
-    let mut cpu: Vec<(i32, i32)> = keys
-        .iter()
-        .enumerate()
-        .map(|(i, &k)| (k, i as i32))
-        .collect();
-    cpu.sort_unstable();
-    Ok(cpu
+    Ok(crate::photon::bitonic::sorted_pairs(&keys)
         .iter()
         .enumerate()
         .filter(|(i, p)| got[2 * i] != p.0 || got[2 * i + 1] != p.1)

@@ -71,10 +71,10 @@ impl Gpu {
         let ctx = GlContext::new(platform)?;
         // SAFETY: the context was just made current on this thread (module doc).
         let (empty_vao, max_texture_size) = unsafe {
-            let vao = ctx.gl.create_vertex_array().map_err(|e| Error::Create {
-                what: "the empty vertex array".into(),
-                message: e,
-            })?;
+            let vao = ctx
+                .gl
+                .create_vertex_array()
+                .map_err(Error::creating("the empty vertex array"))?;
             // Rasterised points keep their size from the vertex stage (tiles, routing).
             ctx.gl.enable(glow::PROGRAM_POINT_SIZE);
             ctx.gl.stencil_mask(0xff);

@@ -21,12 +21,16 @@ fn source_of(name: &str) -> Option<&'static str> {
         .map(|(_, s)| *s)
 }
 
+/// A file of the embedded GLSL tree, as a program's source lookup.
+fn embedded(name: &str) -> Option<String> {
+    source_of(name).map(str::to_string)
+}
+
 /// The source a driver receives for `name` (includes resolved, the layout
 /// constants and `defines` after #version), for offline compilers; None if a
 /// file is missing.
 pub fn preprocessed_source(name: &str, defines: &[(&str, String)]) -> Option<String> {
-    let lookup = |n: &str| source_of(n).map(str::to_string);
-    preprocess(&lookup, name, &with_layout(defines))
+    preprocess(&embedded, name, &with_layout(defines))
         .ok()
         .map(|p| p.text)
 }
@@ -234,8 +238,7 @@ impl Program {
         fragment: &str,
         defines: &[(&str, String)],
     ) -> Result<Self> {
-        let lookup = |n: &str| source_of(n).map(str::to_string);
-        Self::from_lookup(gpu, &lookup, vertex, fragment, defines)
+        Self::from_lookup(gpu, &embedded, vertex, fragment, defines)
     }
 
     /// A program with a geometry stage between the vertex and fragment ones.
@@ -246,8 +249,7 @@ impl Program {
         fragment: &str,
         defines: &[(&str, String)],
     ) -> Result<Self> {
-        let lookup = |n: &str| source_of(n).map(str::to_string);
-        Self::build(gpu, &lookup, [vertex, fragment], Some(geometry), defines)
+        Self::build(gpu, &embedded, [vertex, fragment], Some(geometry), defines)
     }
 
     /// Builds from any source lookup: the embedded tree, or (in tests) a tree
@@ -309,10 +311,9 @@ impl Program {
         // SAFETY: gpu module doc; both shaders compiled on this context, and
         // each object is deleted on every path that does not return it.
         unsafe {
-            let raw = gl.create_program().map_err(|message| Error::Create {
-                what: format!("the program glsl/{fragment}"),
-                message,
-            })?;
+            let raw = gl
+                .create_program()
+                .map_err(Error::creating(format!("the program glsl/{fragment}")))?;
             gl.attach_shader(raw, vs);
             gl.attach_shader(raw, fs);
             if let Some(gs) = gs {
@@ -374,10 +375,9 @@ fn compile(gpu: &Gpu, stage: u32, name: &str, pre: &Preprocessed) -> Result<glow
     let gl = gpu.gl();
     // SAFETY: gpu module doc; the shader is deleted if it does not compile.
     let log = unsafe {
-        let sh = gl.create_shader(stage).map_err(|message| Error::Create {
-            what: format!("a shader for glsl/{name}"),
-            message,
-        })?;
+        let sh = gl
+            .create_shader(stage)
+            .map_err(Error::creating(format!("a shader for glsl/{name}")))?;
         gl.shader_source(sh, &pre.text);
         gl.compile_shader(sh);
         if gl.get_shader_compile_status(sh) {

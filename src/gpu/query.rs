@@ -24,10 +24,7 @@ impl Query {
 
     fn new(gpu: &Gpu, target: u32) -> Result<Self> {
         // SAFETY: gpu module doc.
-        let raw = unsafe { gpu.gl().create_query() }.map_err(|message| Error::Create {
-            what: "a query".into(),
-            message,
-        })?;
+        let raw = unsafe { gpu.gl().create_query() }.map_err(Error::creating("a query"))?;
         Ok(Self {
             gpu: gpu.clone(),
             raw,
@@ -43,6 +40,15 @@ impl Query {
     pub fn end(&self) {
         // SAFETY: gpu module doc.
         unsafe { self.gpu.gl().end_query(self.target) }
+    }
+
+    /// Runs `work` as the query's span: begun before it, ended after it
+    /// whatever it returns, then its result.
+    pub fn around<T>(&self, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        self.begin();
+        let result = work();
+        self.end();
+        result
     }
 
     /// The result of the last span; waits for it.

@@ -81,6 +81,16 @@ impl DrawState {
         ..Self::PLAIN
     };
 
+    /// A z-buffer: colour written where the fragment is nearer (LESS) than
+    /// what the depth buffer holds, which it then replaces.
+    pub const Z_BUFFER: DrawState = DrawState {
+        depth: DepthTest::On {
+            compare: Compare::Less,
+            write: true,
+        },
+        ..Self::PLAIN
+    };
+
     /// Counting only (occlusion queries): no colour written.
     pub const NO_COLOR: DrawState = DrawState {
         color_writes: false,

@@ -39,16 +39,12 @@ impl Target {
             "all attachments of a target must have one size"
         );
         let gl = gpu.gl();
-        let create = |what: &str, message: String| Error::Create {
-            what: what.into(),
-            message,
-        };
         // SAFETY: gpu module doc; the framebuffer and renderbuffer are made here
         // over textures of this context, and deleted again if incomplete.
         unsafe {
             let raw = gl
                 .create_framebuffer()
-                .map_err(|m| create("a framebuffer", m))?;
+                .map_err(Error::creating("a framebuffer"))?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(raw));
             let mut bufs = Vec::new();
             for (i, t) in colors.iter().enumerate() {
@@ -67,7 +63,7 @@ impl Target {
             if depth_stencil {
                 let r = gl
                     .create_renderbuffer()
-                    .map_err(|m| create("a depth-stencil buffer", m))?;
+                    .map_err(Error::creating("a depth-stencil buffer"))?;
                 gl.bind_renderbuffer(glow::RENDERBUFFER, Some(r));
                 gl.renderbuffer_storage(
                     glow::RENDERBUFFER,

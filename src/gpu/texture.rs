@@ -107,10 +107,9 @@ impl Texture {
         let (internal, _, _) = format.gl();
         // SAFETY: gpu module doc; the texture is created, bound and sized here.
         let (raw, code) = unsafe {
-            let raw = gl.create_texture().map_err(|message| Error::Create {
-                what: format!("a {width} x {height} {format:?} texture"),
-                message,
-            })?;
+            let raw = gl.create_texture().map_err(Error::creating(format!(
+                "a {width} x {height} {format:?} texture"
+            )))?;
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
             gl.tex_storage_2d(
                 glow::TEXTURE_2D,
@@ -200,6 +199,18 @@ impl Texture {
         self.upload(data)
     }
 
+    /// Binds the texture with rows aligned to 4 bytes for a transfer
+    /// (`store`: UNPACK_ALIGNMENT to upload, PACK_ALIGNMENT to read back).
+    fn bind_aligned(&self, store: u32) -> &glow::Context {
+        let gl = self.gpu.gl();
+        // SAFETY: gpu module doc; the texture is this value's own.
+        unsafe {
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.pixel_store_i32(store, 4);
+        }
+        gl
+    }
+
     /// Replaces the `[x, y, width, height]` region of level 0 with `data`.
     pub fn upload_region<T: Texel>(&self, region: [u32; 4], data: &[T]) -> Result<()> {
         assert_eq!(T::INTEGER, self.is_integer(), "texel type against format");
@@ -214,11 +225,9 @@ impl Texture {
             "region data size"
         );
         let (_, fmt, ty) = self.format.gl();
+        let gl = self.bind_aligned(glow::UNPACK_ALIGNMENT);
         // SAFETY: gpu module doc; `data` holds exactly the region's texels.
         unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
             gl.tex_sub_image_2d(
                 glow::TEXTURE_2D,
                 0,
@@ -251,11 +260,9 @@ impl Texture {
         let (w, h) = ((self.width >> level).max(1), (self.height >> level).max(1));
         let mut out = vec![T::default(); (w * h) as usize * self.format.channels()];
         let (_, fmt, ty) = self.format.gl();
+        let gl = self.bind_aligned(glow::PACK_ALIGNMENT);
         // SAFETY: gpu module doc; `out` has room for every texel of the level.
         unsafe {
-            let gl = self.gpu.gl();
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
             gl.get_tex_image(
                 glow::TEXTURE_2D,
                 level as i32,

@@ -19,19 +19,15 @@ impl VertexBuffer {
         let stride: i32 = components.iter().sum();
         assert_eq!(data.len() % stride as usize, 0, "vertex data size");
         let gl = gpu.gl();
-        let create = |what: &str, message: String| Error::Create {
-            what: what.into(),
-            message,
-        };
         // SAFETY: gpu module doc; the buffer is filled from `data`'s own bytes
         // (f32 has no padding) and its attributes lie within each vertex.
         unsafe {
             let vao = gl
                 .create_vertex_array()
-                .map_err(|m| create("a vertex array", m))?;
+                .map_err(Error::creating("a vertex array"))?;
             let vbo = gl
                 .create_buffer()
-                .map_err(|m| create("a vertex buffer", m))?;
+                .map_err(Error::creating("a vertex buffer"))?;
             gl.bind_vertex_array(Some(vao));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
             let bytes =

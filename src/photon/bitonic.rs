@@ -35,6 +35,26 @@ pub fn sort_texture_size(n: u64) -> (u32, u32) {
     (1 << k.div_ceil(2), 1 << (k / 2))
 }
 
+/// `keys` as the sort's RG32I records: (key, record index) a texel.
+pub fn key_records(keys: &[i32]) -> Vec<i32> {
+    keys.iter()
+        .enumerate()
+        .flat_map(|(i, &key)| [key, i as i32])
+        .collect()
+}
+
+/// The order the sort must leave `keys` in: (key, record index) pairs by
+/// key, ties broken on the index (plain Rust, for checking it).
+pub fn sorted_pairs(keys: &[i32]) -> Vec<(i32, i32)> {
+    let mut pairs: Vec<(i32, i32)> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| (k, i as i32))
+        .collect();
+    pairs.sort_unstable();
+    pairs
+}
+
 /// Passes of a bitonic sort of n = 2^k elements: k (k + 1) / 2.
 pub fn pass_count(n: u64) -> u32 {
     let k = n.max(2).next_power_of_two().trailing_zeros();

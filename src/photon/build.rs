@@ -148,10 +148,10 @@ pub fn trace_timed(
     let t0 = std::time::Instant::now();
     let (frames, trace) = tracer.trace_to_stored(scene, textures, seed)?;
     gpu.finish();
-    timings.add_both(
+    timings.add_since(
         "trace photons",
         trace.gpu_seconds,
-        t0.elapsed().as_secs_f64(),
+        t0,
         frames.frames as usize,
     );
     Ok((frames, trace))
@@ -192,12 +192,7 @@ pub fn build_map(
         )?),
     };
     gpu.finish();
-    timings.add_both(
-        "build map",
-        build_stages.gpu_total(),
-        t0.elapsed().as_secs_f64(),
-        build_stages.stages.iter().map(|s| s.passes).sum(),
-    );
+    timings.add_folded("build map", &build_stages, t0);
     Ok(BuiltMap {
         map,
         trace,

@@ -11,7 +11,7 @@ pub mod projection;
 pub mod stencil_routing;
 pub mod trace;
 
-use glam::Vec3;
+use glam::{IVec3, Vec3};
 
 use crate::gpu::Bindings;
 use crate::scene::Scene;
@@ -138,6 +138,16 @@ impl Grid {
         }
     }
 
+    /// Cells along x, y and z.
+    pub fn sides(&self) -> IVec3 {
+        IVec3::from_array(self.resolution.map(|r| r as i32))
+    }
+
+    /// A cell's extent along each axis.
+    pub fn cell_size(&self) -> Vec3 {
+        (self.max - self.min) / self.sides().as_vec3()
+    }
+
     pub fn cell_count(&self) -> u32 {
         self.resolution.iter().product()
     }
@@ -166,10 +176,9 @@ impl Grid {
     }
 
     pub fn bind(&self, b: &mut Bindings<'_>) {
-        let r = self.resolution.map(|v| v as i32);
         b.vec3("u_grid_min", self.min.to_array())
             .vec3("u_grid_max", self.max.to_array())
-            .ivec3("u_grid_resolution", r)
+            .ivec3("u_grid_resolution", self.sides().to_array())
             .int("u_hash_buckets", self.buckets().unwrap_or(0) as i32);
     }
 }
@@ -204,6 +213,37 @@ impl PhotonMap {
             PhotonMap::Sorted(m) => &m.grid,
             PhotonMap::Routed(m) => &m.grid,
         }
+    }
+
+    /// Each photon's direction of arrival.
+    pub fn incoming(&self) -> &crate::gpu::Texture {
+        match self {
+            PhotonMap::Sorted(m) => &m.incoming,
+            PhotonMap::Routed(m) => &m.incoming,
+        }
+    }
+
+    /// The map and its grid as glsl/common/photon_map.glsl declares them
+    /// (the build's layout: sorted, or ROUTED).
+    pub fn bind(&self, b: &mut Bindings<'_>) {
+        match self {
+            PhotonMap::Sorted(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_grid_first", &m.grid_first)
+                    .int("u_grid_width", m.grid_width as i32)
+                    .int("u_sorted_width", m.position.width as i32);
+            }
+            PhotonMap::Routed(m) => {
+                b.texture("u_map_position", &m.position)
+                    .texture("u_map_power", &m.power)
+                    .texture("u_map_counts", &m.counts)
+                    .int("u_count_width", m.count_width as i32)
+                    .int("u_block", m.block as i32)
+                    .int("u_blocks_per_row", m.blocks_per_row as i32);
+            }
+        }
+        self.grid().bind(b);
     }
 
     /// Texels of the grid's own structure: the sorted map's first-index

@@ -22,8 +22,8 @@
 
 use crate::error::Error;
 use crate::gpu::{
-    Blend, Compare, DepthTest, DrawState, Gpu, Program, Query, Result, StencilOp, StencilTest,
-    Target, TexFormat, Texture, VertexBuffer,
+    Compare, DrawState, Gpu, Program, Query, Result, StencilOp, StencilTest, Target, TexFormat,
+    Texture, VertexBuffer,
 };
 use crate::timing::Timings;
 
@@ -225,12 +225,6 @@ impl StencilRouting {
         // Route: write where the stencil is m^2-1 (and the slot was never
         // written: depth LESS against the clear), always increment.
         let route = DrawState {
-            color_writes: true,
-            blend: Blend::Off,
-            depth: DepthTest::On {
-                compare: Compare::Less,
-                write: true,
-            },
             stencil: StencilTest::On {
                 compare: Compare::Equal,
                 reference: (block * block - 1) as i32,
@@ -238,6 +232,7 @@ impl StencilRouting {
                 depth_fail: StencilOp::Incr,
                 pass: StencilOp::Incr,
             },
+            ..DrawState::Z_BUFFER
         };
         let program = match &vertices {
             Some(_) => &self.route_readback,
@@ -364,7 +359,7 @@ impl StencilRouting {
             data.extend_from_slice(&i[4 * k..4 * k + 4]);
         }
         let vb = VertexBuffer::from_f32(&self.gpu, &data, &[4, 4, 4])?;
-        timings.add_both("read-back (wall)", 0.0, wall.elapsed().as_secs_f64(), 1);
+        timings.add_since("read-back (wall)", 0.0, wall, 1);
         Ok(vb)
     }
 }

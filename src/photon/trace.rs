@@ -470,14 +470,13 @@ impl PhotonTracer {
         b.uint("u_seed", seed)
             .int("u_emitted", f.emitted as i32)
             .int("u_width", f.width as i32);
-        pass.timer.begin();
-        let drawn = b.draw_region(
-            &f.target,
-            &DrawState::PLAIN,
-            [0, 0, f.width as i32, f.frame_height as i32],
-        );
-        pass.timer.end();
-        drawn?;
+        pass.timer.around(|| {
+            b.draw_region(
+                &f.target,
+                &DrawState::PLAIN,
+                [0, 0, f.width as i32, f.frame_height as i32],
+            )
+        })?;
         Ok(pass.timer.seconds())
     }
 
@@ -497,14 +496,13 @@ impl PhotonTracer {
         bind_bounce_inputs(&mut b, scene, textures, pass, seed);
         let fh = f.frame_height as i32;
         b.int("u_bounce", bounce as i32);
-        pass.timer.begin();
-        let drawn = b.draw_region(
-            &f.target,
-            &DrawState::PLAIN,
-            [0, bounce as i32 * fh, f.width as i32, fh],
-        );
-        pass.timer.end();
-        drawn?;
+        pass.timer.around(|| {
+            b.draw_region(
+                &f.target,
+                &DrawState::PLAIN,
+                [0, bounce as i32 * fh, f.width as i32, fh],
+            )
+        })?;
         Ok(pass.timer.seconds())
     }
 
@@ -554,10 +552,9 @@ impl PhotonTracer {
             .image("u_incoming_out", &f.incoming)
             .image("u_outgoing_out", &f.outgoing)
             .int("u_frames", f.frames as i32);
-        batch.timer.begin();
-        let drawn = b.draw_fullscreen(&targets.last_target, &DrawState::PLAIN);
-        batch.timer.end();
-        drawn?;
+        batch
+            .timer
+            .around(|| b.draw_fullscreen(&targets.last_target, &DrawState::PLAIN))?;
         self.gpu.image_barrier();
         let last = targets.last.read_f32().into_iter().fold(-1.0f32, f32::max);
         Ok((batch.timer.seconds(), last as i32))
@@ -576,10 +573,8 @@ impl PhotonTracer {
         let mut b = self.probe.bind();
         b.texture("u_incoming", &pass.frames.incoming)
             .int("u_frame_row", (bounce * frame_height) as i32);
-        pass.alive.begin();
-        let drawn = b.draw_fullscreen(probe, &DrawState::NO_COLOR);
-        pass.alive.end();
-        drawn?;
+        pass.alive
+            .around(|| b.draw_fullscreen(probe, &DrawState::NO_COLOR))?;
         Ok(pass.alive.count())
     }
 
@@ -751,5 +746,26 @@ impl PhotonFrames {
         )?;
         f.photons_used = photons_used;
         Ok(f)
+    }
+
+    /// One frame of `n` photons, `width` texels a row, photon i's position,
+    /// power and incoming direction (RGBA each) given by `record(i)`; the
+    /// rest of the last row holds none.
+    pub fn one_frame(
+        gpu: &Gpu,
+        width: u32,
+        n: u32,
+        mut record: impl FnMut(usize) -> [[f32; 4]; 3],
+    ) -> Result<Self> {
+        let frame_height = n.div_ceil(width);
+        let texels = (width * frame_height) as usize;
+        let mut records = [(); 3].map(|_| vec![0f32; texels * 4]);
+        for i in 0..n as usize {
+            for (channel, v) in records.iter_mut().zip(record(i)) {
+                channel[4 * i..4 * i + 4].copy_from_slice(&v);
+            }
+        }
+        let [position, power, incoming] = &records;
+        Self::from_records(gpu, width, frame_height, 1, position, power, incoming, n)
     }
 }

@@ -79,31 +79,20 @@ impl Default for DifferentialsOptions {
 
 impl DifferentialsOptions {
     pub fn check(&self) -> Result<()> {
-        let positive = |v: f32| v > 0.0 && v.is_finite();
         if let Some(s) = self.smoothing {
-            if !positive(s) {
-                return Err(Error::out_of_range(
-                    "differentials.smoothing",
-                    s,
-                    "give a factor above 0, or auto",
-                ));
-            }
+            Error::check_positive(
+                "differentials.smoothing",
+                s,
+                "give a factor above 0, or auto",
+            )?;
         }
-        if !positive(self.caustic_smoothing) {
-            return Err(Error::out_of_range(
-                "differentials.caustic_smoothing",
-                self.caustic_smoothing,
-                "give a factor above 0",
-            ));
-        }
+        Error::check_positive(
+            "differentials.caustic_smoothing",
+            self.caustic_smoothing,
+            "give a factor above 0",
+        )?;
         if let Some(r) = self.max_radius {
-            if !positive(r) {
-                return Err(Error::out_of_range(
-                    "differentials.max_radius",
-                    r,
-                    "give a radius above 0",
-                ));
-            }
+            Error::check_positive("differentials.max_radius", r, "give a radius above 0")?;
         }
         if let Some(t) = self.leaf_size {
             if !(1..=1024).contains(&t) {
@@ -149,12 +138,7 @@ impl DifferentialPhotons {
         let t0 = std::time::Instant::now();
         let differentials = trace_differentials(gpu, scene, textures, &frames)?;
         gpu.finish();
-        timings.add_both(
-            "photon differentials",
-            0.0,
-            t0.elapsed().as_secs_f64(),
-            frames.frames as usize,
-        );
+        timings.add_since("photon differentials", 0.0, t0, frames.frames as usize);
         Ok(Self {
             frames,
             differentials,
@@ -262,10 +246,7 @@ impl FootprintEstimate {
                     "u_epanechnikov",
                     i32::from(self.kernel == Kernel::Epanechnikov),
                 );
-            hits.begin();
-            let drawn = b.draw_fullscreen(&self.state_target, &DrawState::PLAIN);
-            hits.end();
-            drawn?;
+            hits.around(|| b.draw_fullscreen(&self.state_target, &DrawState::PLAIN))?;
             drop(b);
             // The fragments drawn are the pixels that were still walking.
             let walking = hits.count();
@@ -281,9 +262,8 @@ impl FootprintEstimate {
         gpu.texture_barrier();
         let mut b = self.compose.bind();
         textures.bind(&mut b);
+        direct.bind_weights(&mut b);
         b.texture("u_state_sum", &self.sum)
-            .texture("u_diffuse_normal", &direct.diffuse_normal)
-            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
             .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
         drop(b);
         gpu.finish();
@@ -423,12 +403,7 @@ impl DifferentialsRun {
                     )?;
                     if pilot.diffuse == 0 {
                         // Caustics only: s touches no footprint, the pilot is the map.
-                        timings.add_both(
-                            "footprint map",
-                            pilot_timings.gpu_total(),
-                            t0.elapsed().as_secs_f64(),
-                            pilot_timings.stages.iter().map(|s| s.passes).sum(),
-                        );
+                        timings.add_folded("footprint map", &pilot_timings, t0);
                         self.map = Some(pilot);
                         return Ok(());
                     }
@@ -439,12 +414,7 @@ impl DifferentialsRun {
                         &mut pilot_timings,
                         &mut |_, _| {},
                     )?;
-                    timings.add_both(
-                        "smoothing pilot",
-                        0.0,
-                        t0.elapsed().as_secs_f64(),
-                        pilot_timings.stages.iter().map(|s| s.passes).sum(),
-                    );
+                    timings.add_since("smoothing pilot", 0.0, t0, pilot_timings.passes_total());
                     self.pilot_mean = Some((stats.mean_footprints, stats.mean_diffuse_footprints));
                     smoothing_for(
                         f.scene.photon_map.k,
@@ -464,12 +434,7 @@ impl DifferentialsRun {
                 &options,
                 &mut stages,
             )?;
-            timings.add_both(
-                "footprint map",
-                stages.gpu_total(),
-                t0.elapsed().as_secs_f64(),
-                stages.stages.iter().map(|s| s.passes).sum(),
-            );
+            timings.add_folded("footprint map", &stages, t0);
             self.map = Some(map);
         }
         Ok(())

@@ -1,7 +1,7 @@
 //! Direct illumination by shadow rays, emitters seen along eye paths, and the
 //! record of each eye path's first diffuse hit (what the radiance estimate reads).
 
-use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
+use crate::gpu::{Bindings, DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::scene::pack::SceneTextures;
 
 use super::plan::PassPlan;
@@ -85,6 +85,14 @@ impl DirectLight {
             &self.radiance_target
         };
         b.draw_fullscreen(target, &DrawState::ADDITIVE)
+    }
+
+    /// What turns light at the first diffuse hits into the pixel's: their
+    /// normal (w = material + 1) and the path's throughput up to them, as
+    /// `u_diffuse_normal` and `u_diffuse_throughput`.
+    pub fn bind_weights(&self, b: &mut Bindings<'_>) {
+        b.texture("u_diffuse_normal", &self.diffuse_normal)
+            .texture("u_diffuse_throughput", &self.diffuse_throughput);
     }
 
     /// The first diffuse hits, as the radiance estimate's queries.

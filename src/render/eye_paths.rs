@@ -40,12 +40,9 @@ pub fn trace_eye_paths(
     gpu.finish();
     let mut stage_wall = std::time::Instant::now();
     let mut timed = |name: &str, pass: &dyn Fn() -> Result<()>| -> Result<()> {
-        query.begin();
-        let result = pass();
-        query.end();
-        result?;
+        query.around(pass)?;
         gpu.finish();
-        timings.add_both(name, query.seconds(), stage_wall.elapsed().as_secs_f64(), 1);
+        timings.add_since(name, query.seconds(), stage_wall, 1);
         stage_wall = std::time::Instant::now();
         done += 1;
         observer.progress(&Progress::at("ray tracing", done, total, at));

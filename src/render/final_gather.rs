@@ -158,14 +158,10 @@ impl FinalGather {
     ) -> Result<()> {
         let mut b = self.accumulate.bind();
         scene.bind(&mut b);
-        b.texture("u_diffuse_normal", &direct.diffuse_normal)
-            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
-            .texture("u_gather_normal", &self.normal)
+        direct.bind_weights(&mut b);
+        self.estimate.bind_result(&mut b, k, max_radius);
+        b.texture("u_gather_normal", &self.normal)
             .texture("u_gather_throughput", &self.throughput)
-            .texture("u_state_flux", &self.estimate.flux)
-            .texture("u_state_cursor", &self.estimate.cursor)
-            .int("u_k", k as i32)
-            .float("u_max_radius", max_radius)
             .int("u_batch", rays as i32)
             .int("u_image_height", self.height as i32)
             .float("u_total_rays", total_rays as f32)
@@ -203,17 +199,9 @@ impl FinalGather {
             let rays = self.batch.min(options.rays - done);
             self.gpu.finish();
             let t0 = std::time::Instant::now();
-            timer.begin();
-            let traced = self.trace_batch(scene, first, done..done + rays, max_depth, seed);
-            timer.end();
-            traced?;
+            timer.around(|| self.trace_batch(scene, first, done..done + rays, max_depth, seed))?;
             self.gpu.finish();
-            timings.add_both(
-                "gather rays",
-                timer.seconds(),
-                t0.elapsed().as_secs_f64(),
-                1,
-            );
+            timings.add_since("gather rays", timer.seconds(), t0, 1);
             let run = self.estimate.run(
                 scene,
                 global,
@@ -230,13 +218,11 @@ impl FinalGather {
                 run.passes as usize,
             );
             let t0 = std::time::Instant::now();
-            timer.begin();
-            let added =
-                self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays);
-            timer.end();
-            added?;
+            timer.around(|| {
+                self.accumulate_batch(scene, direct, rays, options.k, max_radius, options.rays)
+            })?;
             self.gpu.finish();
-            timings.add_both("gather sum", timer.seconds(), t0.elapsed().as_secs_f64(), 1);
+            timings.add_since("gather sum", timer.seconds(), t0, 1);
             stats.batches += 1;
             stats.queries += run.query_pixels;
             stats.estimate_passes += run.passes;

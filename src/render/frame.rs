@@ -105,7 +105,7 @@ pub fn render_views(
         image = Some(view_image);
     }
     timings.wall_seconds = wall.elapsed().as_secs_f64();
-    let passes = timings.stages.iter().map(|s| s.passes).sum();
+    let passes = timings.passes_total();
     Ok(RenderOutput {
         image: image.expect("at least one camera"),
         timings,

@@ -282,7 +282,7 @@ impl PhotonMapRun {
             let plan = pyramid.select(f.direct, level, &self.adaptive_options)?;
             let (computed, interpolated) =
                 (plan.computed.len() as u64, plan.interpolated.len() as u64);
-            timings.add_both("adaptive plan", 0.0, t0.elapsed().as_secs_f64(), 2);
+            timings.add_since("adaptive plan", 0.0, t0, 2);
             if computed > 0 {
                 // The estimate and gather run on the packed first hits.
                 let packed = SampleFrame {
@@ -296,7 +296,7 @@ impl PhotonMapRun {
                 self.first.as_ref().map(|m| &m.estimate.image),
                 self.gather.as_ref().map(|g| &g.gather.indirect),
             )?;
-            timings.add_both("adaptive plan", 0.0, t0.elapsed().as_secs_f64(), 1);
+            timings.add_since("adaptive plan", 0.0, t0, 1);
             stats.computed += computed;
             stats.interpolated += interpolated;
             stats
@@ -401,9 +401,10 @@ impl EstimateRun<'_> {
     ) -> Result<(Option<Image>, EstimateStats)> {
         let (k, max_radius) = (self.scene.photon_map.k, self.scene.photon_map.max_radius);
         let options = self.options;
-        let compose = || {
+        let compose = || -> Result<Image> {
             self.estimate
-                .compose(self.textures, self.direct, k, max_radius, true, true)
+                .draw_composed(self.textures, self.direct, k, max_radius, true, true)?;
+            Ok(self.estimate.composed_image())
         };
         let mut observed = 0.0;
         let mut failure = None;

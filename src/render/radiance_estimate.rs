@@ -320,26 +320,10 @@ impl RadianceEstimate {
 
     /// The photon map, the queries and the search state, as knn_search.frag declares them.
     fn bind_search(&self, b: &mut Bindings<'_>, q: &SearchQuery<'_>) {
-        let grid = q.map.grid();
-        match q.map {
-            PhotonMap::Sorted(m) => {
-                b.texture("u_map_position", &m.position)
-                    .texture("u_map_power", &m.power)
-                    .texture("u_grid_first", &m.grid_first)
-                    .int("u_grid_width", m.grid_width as i32)
-                    .int("u_sorted_width", m.position.width as i32)
-                    .int("u_cell_runs", q.runs as i32);
-            }
-            PhotonMap::Routed(m) => {
-                b.texture("u_map_position", &m.position)
-                    .texture("u_map_power", &m.power)
-                    .texture("u_map_counts", &m.counts)
-                    .int("u_count_width", m.count_width as i32)
-                    .int("u_block", m.block as i32)
-                    .int("u_blocks_per_row", m.blocks_per_row as i32);
-            }
+        q.map.bind(b);
+        if let PhotonMap::Sorted(_) = q.map {
+            b.int("u_cell_runs", q.runs as i32);
         }
-        grid.bind(b);
         if q.leak != LeakTest::None {
             b.texture("u_query_normal", q.queries.normal);
         }
@@ -380,41 +364,28 @@ impl RadianceEstimate {
         };
         let mut b = search.bind();
         self.bind_search(&mut b, query);
-        counter.begin();
-        let drawn = b.draw_fullscreen(&self.target, &state);
-        counter.end();
-        drawn?;
+        counter.around(|| b.draw_fullscreen(&self.target, &state))?;
         Ok(counter.count())
     }
 
-    /// The image from the current state (final or running): direct light plus
-    /// the estimate at each first diffuse hit, as chosen.
-    pub fn compose(
-        &self,
-        scene: &SceneTextures,
-        direct: &DirectLight,
-        k: u32,
-        max_radius: f32,
-        include_direct: bool,
-        include_indirect: bool,
-    ) -> Result<Image> {
-        self.draw_composed(
-            scene,
-            direct,
-            k,
-            max_radius,
-            include_direct,
-            include_indirect,
-        )?;
-        Ok(Image::from_gl_rgba(
-            self.width,
-            self.height,
-            &self.image.read_f32(),
-        ))
+    /// The finished search as the passes that turn it into light read it
+    /// (compose.frag, gather_accumulate.frag): each query's flux and
+    /// radius, its accepted photons, and the k and radius of the estimate.
+    pub fn bind_result(&self, b: &mut Bindings<'_>, k: u32, max_radius: f32) {
+        b.texture("u_state_flux", &self.flux)
+            .texture("u_state_cursor", &self.cursor)
+            .int("u_k", k as i32)
+            .float("u_max_radius", max_radius);
     }
 
-    /// The same image left in `image`, not read back (adaptive sampling's
-    /// packed levels read it on the GPU).
+    /// The image `draw_composed` left in `image`, read back.
+    pub fn composed_image(&self) -> Image {
+        Image::from_gl_rgba(self.width, self.height, &self.image.read_f32())
+    }
+
+    /// The image from the current state (final or running), left in `image`
+    /// (adaptive sampling's packed levels read it there, on the GPU): direct
+    /// light plus the estimate at each first diffuse hit, as chosen.
     pub fn draw_composed(
         &self,
         scene: &SceneTextures,
@@ -426,13 +397,9 @@ impl RadianceEstimate {
     ) -> Result<()> {
         let mut b = self.compose.bind();
         scene.bind(&mut b);
+        direct.bind_weights(&mut b);
+        self.bind_result(&mut b, k, max_radius);
         b.texture("u_direct", &direct.radiance)
-            .texture("u_diffuse_normal", &direct.diffuse_normal)
-            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
-            .texture("u_state_flux", &self.flux)
-            .texture("u_state_cursor", &self.cursor)
-            .int("u_k", k as i32)
-            .float("u_max_radius", max_radius)
             .int("u_include_direct", include_direct as i32)
             .int("u_include_indirect", include_indirect as i32)
             .draw_fullscreen(&self.image_target, &DrawState::PLAIN)
@@ -489,10 +456,7 @@ impl Tiles {
             .int("u_tiles_per_row", self.per_row as i32)
             .ivec2("u_target_size", [target.width as i32, target.height as i32]);
         for (q, &t) in queries.iter().zip(&self.active) {
-            q.begin();
-            let drawn = b.draw_points(target, &DrawState::PLAIN, t as i32, 1);
-            q.end();
-            drawn?;
+            q.around(|| b.draw_points(target, &DrawState::PLAIN, t as i32, 1))?;
         }
         stats.tile_draws += self.active.len() as u64;
         let counts: Vec<u64> = queries

@@ -49,13 +49,7 @@ pub fn knn_grid_counted(
 ) -> (KnnResult, u64) {
     let mut examined = 0u64;
     let g = &map.grid;
-    let res = [
-        g.resolution[0] as i32,
-        g.resolution[1] as i32,
-        g.resolution[2] as i32,
-    ];
-    let resf = Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
-    let cell_size = (g.max - g.min) / resf;
+    let (res, cell_size) = (g.sides(), g.cell_size());
     let f = ((x - g.min) / cell_size).floor();
     let c0 = [0, 1, 2].map(|a| (f[a] as i32).clamp(0, res[a] - 1));
     let max_r2 = max_radius * max_radius;

@@ -16,7 +16,7 @@ use glam::{DVec3, Vec3};
 use crate::sampling::sample_cosine;
 use crate::scene::{triangle_area, Geometry, Light, Material, Scene};
 
-use super::ray_trace::{closest_hit, eye_ray_at, occluded, offset_scale};
+use super::ray_trace::{closest_hit, eye_ray_at, offset_scale, point_light, toward_emitter};
 use super::shading::facing_shading_normal;
 
 /// A small, fast generator for the path tracer's own numbers (xorshift64*).
@@ -162,13 +162,7 @@ fn direct(
                 position,
                 intensity,
             } => {
-                let to = position - origin;
-                let dist = to.length();
-                let wi = to / dist;
-                let c = nf.dot(wi);
-                if c > 0.0 && !occluded(scene, origin, wi, dist) {
-                    e += intensity * cosine(wi, c) / (dist * dist);
-                }
+                e += point_light(scene, origin, nf, (position, intensity), cosine);
                 continue;
             }
             Light::Area {
@@ -188,12 +182,7 @@ fn direct(
                 (q, normal, radiance, light.area(&scene.shapes))
             }
         };
-        let to = q - origin;
-        let dist = to.length();
-        let wi = to / dist;
-        let (c, cl) = (nf.dot(wi), -normal.dot(wi));
-        if c > 0.0 && cl > 0.0 && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor))
-        {
+        if let Some((wi, c, cl, dist)) = toward_emitter(scene, origin, nf, (q, normal), floor) {
             e += radiance * cosine(wi, c) * cl / (dist * dist) * area;
         }
     }

@@ -73,6 +73,47 @@ pub fn occluded(scene: &Scene, o: Vec3, d: Vec3, t_max: f32) -> bool {
         .any(|s| intersect_geometry(&s.geometry, o, d).is_some_and(|h| h.0 < t_max))
 }
 
+/// A point light's I cos / r^2 at `origin` (facing normal `nf`), the
+/// cosine by `cosine(wi, cos_x)` (the shading normal's where one is given);
+/// zero behind `nf` or shadowed.
+pub fn point_light(
+    scene: &Scene,
+    origin: Vec3,
+    nf: Vec3,
+    (position, intensity): (Vec3, Vec3),
+    cosine: impl Fn(Vec3, f32) -> f32,
+) -> Vec3 {
+    let to = position - origin;
+    let dist = to.length();
+    let wi = to / dist;
+    let cos_x = nf.dot(wi);
+    if cos_x > 0.0 && !occluded(scene, origin, wi, dist) {
+        intensity * cosine(wi, cos_x) / (dist * dist)
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// Toward point `q` of an emitter (normal `normal`) from `origin` (facing
+/// normal `nf`): (wi, cos_x, cos_l, dist) when each faces the other and
+/// nothing lies between (the shadow ray stops short of q by its offsets).
+pub fn toward_emitter(
+    scene: &Scene,
+    origin: Vec3,
+    nf: Vec3,
+    (q, normal): (Vec3, Vec3),
+    floor: f32,
+) -> Option<(Vec3, f32, f32, f32)> {
+    let to = q - origin;
+    let dist = to.length();
+    let wi = to / dist;
+    let (cos_x, cos_l) = (nf.dot(wi), -normal.dot(wi));
+    let seen = cos_x > 0.0
+        && cos_l > 0.0
+        && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor));
+    seen.then_some((wi, cos_x, cos_l, dist))
+}
+
 /// Expected radiance along a ray: direct light (area lights by a `grid` x `grid`
 /// midpoint rule; a `Triangles` light by that rule on each of its triangles),
 /// emitters, and every specular branch, to `depth_left` bounces.
@@ -196,16 +237,10 @@ fn direct_irradiance(
     let cosine = |wi: Vec3, cos_x: f32| shading.map_or(cos_x, |ms| ms.dot(wi).max(0.0));
     // L cos_s cos_l / r^2 from point q of a surface of normal `normal`.
     let from = |q: Vec3, normal: Vec3, radiance: Vec3| {
-        let to = q - origin;
-        let dist = to.length();
-        let wi = to / dist;
-        let (cx, cl) = (nf.dot(wi), -normal.dot(wi));
-        if cx > 0.0 && cl > 0.0 && !occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor))
-        {
-            radiance * (cosine(wi, cx) * cl / (dist * dist))
-        } else {
-            Vec3::ZERO
-        }
+        toward_emitter(scene, origin, nf, (q, normal), floor)
+            .map_or(Vec3::ZERO, |(wi, cx, cl, dist)| {
+                radiance * (cosine(wi, cx) * cl / (dist * dist))
+            })
     };
     let cells = || {
         let g = grid as f32;
@@ -219,15 +254,7 @@ fn direct_irradiance(
             Light::Point {
                 position,
                 intensity,
-            } => {
-                let to = position - origin;
-                let dist = to.length();
-                let wi = to / dist;
-                let cos_x = nf.dot(wi);
-                if cos_x > 0.0 && !occluded(scene, origin, wi, dist) {
-                    sum += intensity * cosine(wi, cos_x) / (dist * dist);
-                }
-            }
+            } => sum += point_light(scene, origin, nf, (position, intensity), cosine),
             Light::Area {
                 corner,
                 edge1,
@@ -334,13 +361,7 @@ pub fn direct_light_sampled(
             intensity,
         } = *light
         {
-            let to = position - origin;
-            let dist = to.length();
-            let wi = to / dist;
-            let cos_x = nf.dot(wi);
-            if cos_x > 0.0 && !occluded(scene, origin, wi, dist) {
-                sum += intensity * cosine(wi, cos_x) / (dist * dist);
-            }
+            sum += point_light(scene, origin, nf, (position, intensity), cosine);
             continue;
         }
         let emitted = row(l, 4).truncate();
@@ -368,16 +389,11 @@ pub fn direct_light_sampled(
                     )
                 }
             };
-            let to = q - origin;
-            let dist = to.length();
-            let wi = to / dist;
-            let (cos_x, cos_l) = (nf.dot(wi), -light_normal.dot(wi));
-            if cos_x <= 0.0 || cos_l <= 0.0 {
+            let Some((wi, cos_x, cos_l, dist)) =
+                toward_emitter(scene, origin, nf, (q, light_normal), floor)
+            else {
                 continue;
-            }
-            if occluded(scene, origin, wi, dist - 2.0 * offset_scale(q, floor)) {
-                continue;
-            }
+            };
             light_sum += emitted * (cosine(wi, cos_x) * cos_l / (dist * dist));
         }
         sum += light_sum * (area / shadow_rays as f32);

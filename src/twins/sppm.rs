@@ -37,12 +37,7 @@ pub fn gather(
     accept: &dyn Fn(Vec3) -> bool,
 ) -> (Vec3, f32) {
     let g = &map.grid;
-    let res = IVec3::new(
-        g.resolution[0] as i32,
-        g.resolution[1] as i32,
-        g.resolution[2] as i32,
-    );
-    let cell_size = (g.max - g.min) / res.as_vec3();
+    let (res, cell_size) = (g.sides(), g.cell_size());
     let r = radius2.sqrt();
     let lo = ((x - r - g.min) / cell_size)
         .floor()

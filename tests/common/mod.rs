@@ -70,6 +70,11 @@ pub fn rmse(a: &Image, b: &Image) -> f64 {
 }
 
 /// How many channels of two images differ in any bit (sizes must match).
+/// Pixels of `img` exactly `value` (an emitter seen directly shows its own radiance).
+pub fn pixels_equal_to(img: &Image, value: [f32; 3]) -> usize {
+    img.pixels.iter().filter(|p| **p == value).count()
+}
+
 pub fn channels_differing(a: &Image, b: &Image) -> usize {
     a.pixels
         .iter()

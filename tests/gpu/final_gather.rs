@@ -11,7 +11,7 @@ use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::{
     render, EstimateOptions, FinalGatherOptions, Method, PhotonMapOptions, RenderOptions,
 };
-use photonmap::scene::{load_scene_str, Material, Scene};
+use photonmap::scene::{Material, Scene};
 use photonmap::twins::final_gather::{gather_ray, gathered_radiance, GatherHit};
 
 fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -> RenderOptions {
@@ -135,11 +135,7 @@ fn final_gather_equals_its_cpu_twin() {
 #[test]
 fn final_gather_in_the_furnace_is_analytic() {
     let gpu = common::gpu();
-    let scene = load_scene_str(
-        include_str!("../../scenes/tests/furnace.toml"),
-        std::path::Path::new("furnace.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("furnace");
     let expected = 1.0 / std::f64::consts::PI;
     let means: Vec<f64> = (1..=2)
         .map(|seed| {

@@ -8,7 +8,7 @@ use crate::common;
 
 use glam::Vec3;
 use photonmap::render::{render, IgiOptions, Method, RenderOptions, RenderOutput, WithCausticMap};
-use photonmap::scene::{load_scene_str, Material, Scene};
+use photonmap::scene::{Material, Scene};
 use photonmap::twins::igi::{incident, Vpl};
 
 fn options(scene: &Scene, w: u32, h: u32, seed: u32, igi: IgiOptions) -> RenderOptions {
@@ -293,11 +293,7 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
 #[test]
 fn igi_in_the_furnace_converges_to_the_analytic_answer() {
     let gpu = common::gpu();
-    let scene = load_scene_str(
-        include_str!("../../scenes/tests/furnace.toml"),
-        std::path::Path::new("furnace.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("furnace");
     let expected = 1.0 / std::f64::consts::PI;
     let mut errors = Vec::new();
     for paths in [16u32, 256, 4096] {

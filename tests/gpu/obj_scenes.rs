@@ -111,24 +111,17 @@ fn an_emissive_obj_quad_lights_like_the_equivalent_area_light() {
         (pa - pq).abs().max_element() < 1e-5 * pa.max_element(),
         "{pa} {pq}"
     );
-    // Direct light by shadow rays.
-    let direct = |s: &Scene, first| renders(s, 48, 36, true, first);
-    agree(
-        "direct light",
-        &direct(&area, 100),
-        &direct(&quad, 200),
-        &direct(&brighter, 300),
-        4,
-    );
-    // Direct light, and indirect light from the photon map.
-    let full = |s: &Scene, first| renders(s, 48, 36, false, first);
-    agree(
-        "photon map",
-        &full(&area, 100),
-        &full(&quad, 200),
-        &full(&brighter, 300),
-        4,
-    );
+    // Direct light by shadow rays; then with indirect light from the photon map.
+    for (what, direct_only) in [("direct light", true), ("photon map", false)] {
+        let frame = |s: &Scene, first| renders(s, 48, 36, direct_only, first);
+        agree(
+            what,
+            &frame(&area, 100),
+            &frame(&quad, 200),
+            &frame(&brighter, 300),
+            4,
+        );
+    }
     // SPPM with photons carrying direct light too: emission alone lights it.
     agree(
         "SPPM (photons only)",
@@ -228,11 +221,7 @@ fn the_measured_cornell_box_renders() {
         .flatten()
         .all(|v| v.is_finite() && *v >= 0.0));
     // The light, seen from below, shows its Ke.
-    let lit = img
-        .pixels
-        .iter()
-        .filter(|p| **p == [17.0, 12.0, 4.0])
-        .count();
+    let lit = common::pixels_equal_to(&img, [17.0, 12.0, 4.0]);
     assert!(lit >= 4, "{lit} pixels show Ke");
     // Red wall left, green wall right, at mid height.
     let (left, right) = (img.get(4, 32), img.get(59, 32));

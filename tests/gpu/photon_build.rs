@@ -8,7 +8,7 @@ use crate::common::Rng;
 
 use photonmap::gpu::{Gpu, TexFormat, Texture};
 use photonmap::photon::bitonic::{
-    fused_plan, pass_count, sort_texture_size, BitonicBuild, INVALID_KEY,
+    fused_plan, key_records, pass_count, sort_texture_size, sorted_pairs, BitonicBuild, INVALID_KEY,
 };
 use photonmap::photon::{Grid, GridStorage, StencilRouting, VertexFeed};
 use photonmap::render::Timings;
@@ -80,12 +80,7 @@ fn bitonic_sort_equals_a_cpu_sort_for_every_power_of_two_to_2_pow_16() {
             } else {
                 TexFormat::Rgba32I
             };
-            let mut cpu: Vec<(i32, i32)> = keys
-                .iter()
-                .enumerate()
-                .map(|(i, &k)| (k, i as i32))
-                .collect();
-            cpu.sort();
+            let cpu = sorted_pairs(&keys);
             let (gpu_sorted, passes) = sort_on_gpu(&gpu, &faithful, &keys, format);
             assert_eq!(passes, pass_count(n as u64), "n = {n}");
             assert_eq!(
@@ -436,20 +431,11 @@ fn float_addressing_refuses_sorts_past_2_pow_24() {
     // Below the limit it sorts like the integer version.
     let keys: Vec<i32> = (0..4096).map(|i| i * 7919 % 1000).collect();
     let (w, h) = sort_texture_size(keys.len() as u64);
-    let data: Vec<i32> = keys
-        .iter()
-        .enumerate()
-        .flat_map(|(i, &k)| [k, i as i32])
-        .collect();
+    let data = key_records(&keys);
     let (sorted, _) = build
         .sort(Texture::from_i32_format(&gpu, w, h, TexFormat::Rg32I, &data).unwrap())
         .unwrap();
     let got: Vec<(i32, i32)> = sorted.read_i32().chunks(2).map(|c| (c[0], c[1])).collect();
-    let mut cpu: Vec<(i32, i32)> = keys
-        .iter()
-        .enumerate()
-        .map(|(i, &k)| (k, i as i32))
-        .collect();
-    cpu.sort();
+    let cpu = sorted_pairs(&keys);
     assert_eq!(got, cpu);
 }

@@ -247,22 +247,15 @@ fn a_uniform_photon_plane_gives_the_analytic_irradiance() {
     let total_power = 8.0f32;
     let mut state = 12345u32;
     let mut next = || photonmap::twins::random::rng_next(&mut state);
-    let width = 256u32;
-    let frame_height = (n as u32).div_ceil(width);
-    let texels = (width * frame_height) as usize;
-    let (mut pos, mut pow, inc) = (
-        vec![0f32; texels * 4],
-        vec![0f32; texels * 4],
-        vec![0f32; texels * 4],
-    );
-    for i in 0..n {
-        pos[4 * i..4 * i + 4].copy_from_slice(&[next() * 2.0 - 1.0, 0.0, next() * 2.0 - 1.0, 0.0]);
-        let p = total_power / n as f32;
-        pow[4 * i..4 * i + 4].copy_from_slice(&[p, p, p, 1.0]);
-    }
-    let frames =
-        PhotonFrames::from_records(&gpu, width, frame_height, 1, &pos, &pow, &inc, n as u32)
-            .unwrap();
+    let p = total_power / n as f32;
+    let frames = PhotonFrames::one_frame(&gpu, 256, n as u32, |_| {
+        [
+            [next() * 2.0 - 1.0, 0.0, next() * 2.0 - 1.0, 0.0],
+            [p, p, p, 1.0],
+            [0.0; 4],
+        ]
+    })
+    .unwrap();
     let grid = Grid::for_scene(&scene);
     let map = PhotonMap::Sorted(
         photonmap::photon::BitonicBuild::new(&gpu)
@@ -282,16 +275,16 @@ fn a_uniform_photon_plane_gives_the_analytic_irradiance() {
         &mut |_| {},
     )
     .unwrap();
-    let img = est
-        .compose(
-            &out.state.textures,
-            &out.state.direct,
-            k,
-            max_r,
-            false,
-            true,
-        )
-        .unwrap();
+    est.draw_composed(
+        &out.state.textures,
+        &out.state.direct,
+        k,
+        max_r,
+        false,
+        true,
+    )
+    .unwrap();
+    let img = est.composed_image();
     // Pixels seeing the middle of the floor (the estimate's disc stays on it).
     let mut sum = 0f64;
     let mut count = 0;

@@ -128,11 +128,7 @@ fn an_emitter_seen_directly_shows_its_radiance() {
     let mut o = RenderOptions::for_scene(&scene).direct_only();
     (o.width, o.height) = (64, 64);
     let img = render(&gpu, &scene, &o, &mut ()).unwrap().image;
-    let at_light = img
-        .pixels
-        .iter()
-        .filter(|p| **p == [25.0, 25.0, 25.0])
-        .count();
+    let at_light = common::pixels_equal_to(&img, [25.0, 25.0, 25.0]);
     assert!(at_light >= 4, "{at_light} pixels show the light's Le = 25");
     // Nothing else is brighter than the light.
     assert!(img.pixels.iter().flatten().all(|&v| v <= 25.0));

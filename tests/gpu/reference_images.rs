@@ -97,6 +97,13 @@ fn load(name: &str) -> Reference {
     Reference::load(&dir(), name).unwrap_or_else(|e| panic!("{e}: {hint}"))
 }
 
+/// Each scene with its reference (regenerated first when asked), loaded as
+/// the loop reaches it.
+fn references(gpu: &photonmap::gpu::Gpu) -> impl Iterator<Item = (&'static str, Reference)> {
+    ensure_references(gpu);
+    SCENES.into_iter().map(|name| (name, load(name)))
+}
+
 /// Scores a render; the actual image and its |z| map go to target/ for a look.
 fn score(label: &str, actual: &Image, r: &Reference) -> f64 {
     let dir = common::root().join("target").join("reference-images");
@@ -115,9 +122,7 @@ fn score(label: &str, actual: &Image, r: &Reference) -> f64 {
 #[test]
 fn paper_scenes_match_their_references() {
     let gpu = common::gpu();
-    ensure_references(&gpu);
-    for name in SCENES {
-        let r = load(name);
+    for (name, r) in references(&gpu) {
         let scene = common::paper_scene(name);
         let actual = render_seed(&gpu, &scene, TEST_SEED);
         assert!(!actual.has_non_finite(), "{name}: NaN or Inf in the image");
@@ -159,9 +164,7 @@ fn assert_caught(
 #[test]
 fn the_comparison_catches_defects() {
     let gpu = common::gpu();
-    ensure_references(&gpu);
-    for name in SCENES {
-        let r = load(name);
+    for (name, r) in references(&gpu) {
         let mut bright = common::paper_scene(name);
         for l in &mut bright.lights {
             match l {

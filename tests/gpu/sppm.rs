@@ -153,11 +153,7 @@ fn mean_of(img: &Image) -> f64 {
 /// unbiased here at every iteration and all its error is noise.
 #[test]
 fn the_furnace_converges_to_its_analytic_value() {
-    let scene = load_scene_str(
-        include_str!("../../scenes/tests/furnace.toml"),
-        std::path::Path::new("furnace.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("furnace");
     let o = SppmOptions {
         iterations: 64,
         photons_per_iteration: 1 << 14,
@@ -334,11 +330,7 @@ fn the_radiance_of_a_closed_scene_integrates_to_the_lights_power() {
 #[test]
 fn the_error_falls_with_the_slope_theory_predicts() {
     let gpu = common::gpu();
-    let scene = load_scene_str(
-        include_str!("../../scenes/tests/furnace.toml"),
-        std::path::Path::new("furnace.toml"),
-    )
-    .unwrap();
+    let scene = common::fixture("furnace");
     let o = SppmOptions {
         photons_per_iteration: 1 << 11,
         initial_radius: Some(0.25),

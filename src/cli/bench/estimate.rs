@@ -15,7 +15,6 @@ use serde::Serialize;
 
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::photon::BuildMethod;
-use photonmap::render::radiance_estimate::EstimateOptions;
 use photonmap::render::search_work::SearchWork;
 use photonmap::render::{render, EstimateMode, Image};
 use photonmap::scene::{embedded, Scene};
@@ -41,44 +40,35 @@ pub struct EstimateBenchArgs {
 struct Variant {
     label: &'static str,
     what: &'static str,
-    apply: fn(&mut EstimateOptions),
+    /// `EstimateOptions`' cull, runs and budget.
+    search: (bool, bool, u32),
 }
 
 const VARIANTS: [Variant; 5] = [
     Variant {
         label: "paper",
         what: "every cell of every ring opened, one by one (the paper's search)",
-        apply: |o| {
-            (o.cull, o.runs, o.budget) = (false, false, 64);
-        },
+        search: (false, false, 64),
     },
     Variant {
         label: "culled",
         what: "cells, rows and planes beyond the search radius skipped unopened",
-        apply: |o| {
-            (o.cull, o.runs, o.budget) = (true, false, 64);
-        },
+        search: (true, false, 64),
     },
     Variant {
         label: "culled + runs",
         what: "and a face row's cells read as one range of photons (sorted map)",
-        apply: |o| {
-            (o.cull, o.runs, o.budget) = (true, true, 64);
-        },
+        search: (true, true, 64),
     },
     Variant {
         label: "... 128 steps a pass (default)",
         what: "and 128 steps a pixel a pass, not 64: half the passes",
-        apply: |o| {
-            (o.cull, o.runs, o.budget) = (true, true, 128);
-        },
+        search: (true, true, 128),
     },
     Variant {
         label: "... 256 steps a pass",
         what: "and 256 steps a pixel a pass: a quarter of the passes",
-        apply: |o| {
-            (o.cull, o.runs, o.budget) = (true, true, 256);
-        },
+        search: (true, true, 256),
     },
 ];
 
@@ -155,7 +145,7 @@ fn scene_rows(
         let gi = options
             .photon_map_mut()
             .expect("Table 1 renders global light");
-        (v.apply)(&mut gi.estimate);
+        (gi.estimate.cull, gi.estimate.runs, gi.estimate.budget) = v.search;
         let mut times = Vec::new();
         let mut last = None;
         for run in 0..a.runs {

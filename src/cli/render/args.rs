@@ -17,8 +17,8 @@ use photonmap::render::{
 use photonmap::scene::Scene;
 
 use crate::cli::args::{
-    in_range, DifferentialsArgs, EstimateArgs, IgiArgs, Method, PhotonMapArgs, RadiosityArgs,
-    SceneArgs, SppmArgs,
+    in_range, DifferentialsArgs, EstimateArgs, IgiArgs, LoadedScene, Method, PhotonMapArgs,
+    RadiosityArgs, SceneArgs, SppmArgs,
 };
 
 /// Render a scene to images: PNG (sRGB), EXR (linear float RGB, with the
@@ -210,7 +210,30 @@ impl Outputs {
     }
 }
 
+/// What every render starts from, checked before any work: its outputs,
+/// its scene and the options (the method's among them) for that scene.
+pub(super) struct Start {
+    pub outputs: Outputs,
+    pub loaded: LoadedScene,
+    pub options: RenderOptions,
+}
+
 impl RenderArgs {
+    /// The method, the outputs and the scene (with a warning when it lies
+    /// far from the origin), then the options for that scene.
+    pub(super) fn start(&self) -> Result<Start> {
+        let method = self.method()?;
+        let outputs = self.outputs()?;
+        let loaded = self.scene.load()?;
+        warn_far_from_origin(&loaded.scene, self.quiet);
+        let options = self.options(&loaded.scene, method);
+        Ok(Start {
+            outputs,
+            loaded,
+            options,
+        })
+    }
+
     /// Every output, checked before any work: a known extension, a folder
     /// that exists and takes a new file, not a folder itself.
     pub(super) fn outputs(&self) -> Result<Outputs> {
@@ -396,5 +419,15 @@ impl RenderArgs {
             bail!("--snapshots and --reference-software show the one-map estimate: drop them with --final-gather or --adaptive");
         }
         Ok(())
+    }
+}
+
+fn warn_far_from_origin(scene: &Scene, quiet: bool) {
+    let ratio = scene.offset_ratio();
+    if ratio > 1000.0 && !quiet {
+        eprintln!(
+            "warning: coordinates reach {ratio:.0} x the scene's size, even with the scene rebased to its centre; 32-bit floats resolve them only to ~{:.0e} of it, so fine detail (sharp caustics) may blur: bring the camera and the scene's parts closer together",
+            ratio * f32::EPSILON
+        );
     }
 }

@@ -7,21 +7,19 @@ use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::gpu::Platform;
 use photonmap::render::{self, PassPlan, RenderOptions};
 
-use super::args::{Format, RenderArgs};
+use super::args::{Format, RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{
-    print_explain, provenance, warn_far_from_origin, write_images, write_software_reference, Report,
-};
+use super::output::{print_explain, provenance, write_images, write_software_reference, Report};
 use crate::cli::args::Method;
 use crate::cli::progress::Work;
 
 pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
-    let method = args.method()?;
-    let outputs = args.outputs()?;
-    let loaded = args.scene.load()?;
+    let Start {
+        outputs,
+        loaded,
+        options,
+    } = args.start()?;
     let scene = &loaded.scene;
-    warn_far_from_origin(scene, args.quiet);
-    let options = args.options(scene, method);
     let cameras = match &args.camera_path {
         Some(p) => photonmap::scene::camera_path::load_camera_path(p, &scene.camera, scene.origin)?,
         None => vec![scene.camera.clone()],

@@ -40,16 +40,6 @@ pub(super) fn print_explain(lines: &[photonmap::render::ExplainLine]) {
     }
 }
 
-pub(super) fn warn_far_from_origin(scene: &Scene, quiet: bool) {
-    let ratio = scene.offset_ratio();
-    if ratio > 1000.0 && !quiet {
-        eprintln!(
-            "warning: coordinates reach {ratio:.0} x the scene's size, even with the scene rebased to its centre; 32-bit floats resolve them only to ~{:.0e} of it, so fine detail (sharp caustics) may blur: bring the camera and the scene's parts closer together",
-            ratio * f32::EPSILON
-        );
-    }
-}
-
 /// Writes the final image to every output, all or none; returns what was written.
 pub(super) fn write_images(
     image: &Image,

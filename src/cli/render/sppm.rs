@@ -5,19 +5,19 @@ use anyhow::{bail, Result};
 use photonmap::gpu::Platform;
 use photonmap::render::{self, StopReason, WithPhotons};
 
-use super::args::RenderArgs;
+use super::args::{RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{print_explain, provenance, warn_far_from_origin, write_images, Report};
+use super::output::{print_explain, provenance, write_images, Report};
 use crate::cli::progress::Work;
 
 /// `--method sppm`: one view, iterations until --iterations or --time.
 pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
-    let method = args.method()?;
-    let outputs = args.outputs()?;
-    let loaded = args.scene.load()?;
+    let Start {
+        outputs,
+        loaded,
+        options,
+    } = args.start()?;
     let scene = &loaded.scene;
-    warn_far_from_origin(scene, args.quiet);
-    let options = args.options(scene, method);
     let gpu = crate::cli::gpu(platform)?;
     let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
     if args.adaptive

@@ -58,8 +58,7 @@ use glam::Vec3;
 
 use crate::error::Error;
 use crate::gpu::{
-    Compare, DepthTest, DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture,
-    VertexBuffer,
+    Bindings, DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture, VertexBuffer,
 };
 use crate::layout::{SHOOTER_OUTLINE, SHOOTER_TEXELS, TILE_ROW};
 use crate::scene::pack::SceneTextures;
@@ -372,21 +371,25 @@ impl Radiosity {
             .max(f64::MIN_POSITIVE)
     }
 
+    /// The element atlas as its passes address it: each element's position
+    /// (w = area), the elements a tile side and the tiles an atlas row.
+    fn bind_atlas(&self, b: &mut Bindings<'_>) {
+        b.texture("u_element_position", &self.position)
+            .int("u_res", self.elements.res as i32)
+            .int("u_tile_columns", self.elements.tile_columns as i32);
+    }
+
     /// Each tile's power (read back): of its residual, its radiosity and
     /// the last shot.
     fn tile_powers(&self) -> Result<Vec<[f32; 3]>> {
         self.gpu.texture_barrier();
         let tiles = self.elements.tiles.len();
-        self.programs
-            .power
-            .bind()
-            .texture("u_residual", &self.residual)
+        let mut b = self.programs.power.bind();
+        self.bind_atlas(&mut b);
+        b.texture("u_residual", &self.residual)
             .texture("u_radiosity", &self.radiosity)
             .texture("u_shot", &self.shot)
-            .texture("u_element_position", &self.position)
             .int("u_tiles", tiles as i32)
-            .int("u_res", self.elements.res as i32)
-            .int("u_tile_columns", self.elements.tile_columns as i32)
             .draw_fullscreen(&self.power_target, &DrawState::PLAIN)?;
         let all = self.power.read_f32();
         Ok((0..tiles)
@@ -404,28 +407,19 @@ impl Radiosity {
     fn select(&self, threshold: f32, occlusion: &Query) -> Result<Option<usize>> {
         self.pick_target.clear([-1.0; 4]);
         self.pick_target.clear_depth_stencil(1.0, 0);
-        let state = DrawState {
-            depth: DepthTest::On {
-                compare: Compare::Less,
-                write: true,
-            },
-            ..DrawState::PLAIN
-        };
-        occlusion.begin();
-        let drawn = self
-            .programs
-            .select
-            .bind()
-            .texture("u_power", &self.power)
-            .float("u_threshold", threshold)
-            .draw_points(
-                &self.pick_target,
-                &state,
-                0,
-                self.elements.tiles.len() as i32,
-            );
-        occlusion.end();
-        drawn?;
+        occlusion.around(|| {
+            self.programs
+                .select
+                .bind()
+                .texture("u_power", &self.power)
+                .float("u_threshold", threshold)
+                .draw_points(
+                    &self.pick_target,
+                    &DrawState::Z_BUFFER,
+                    0,
+                    self.elements.tiles.len() as i32,
+                )
+        })?;
         if occlusion.count() == 0 {
             return Ok(None);
         }
@@ -443,15 +437,11 @@ impl Radiosity {
         let block = res / sub;
         let base = self.elements.tile_base(tile);
         self.gpu.texture_barrier();
-        self.programs
-            .shooters
-            .bind()
-            .texture("u_residual", &self.residual)
-            .texture("u_element_position", &self.position)
+        let mut b = self.programs.shooters.bind();
+        self.bind_atlas(&mut b);
+        b.texture("u_residual", &self.residual)
             .texture("u_element_normal", &self.normal)
             .int("u_tile", tile as i32)
-            .int("u_res", self.elements.res as i32)
-            .int("u_tile_columns", self.elements.tile_columns as i32)
             .int("u_sub", self.options.substructure as i32)
             .draw_region(
                 &self.shooters_target,
@@ -537,13 +527,6 @@ impl Radiosity {
         // -2: no fragment (a rim texel); -1: a blocker that is no patch.
         self.items_target.clear([-2.0, 0.0, 0.0, 1.0]);
         self.items_target.clear_depth_stencil(1.0, 0);
-        let state = DrawState {
-            depth: DepthTest::On {
-                compare: Compare::Less,
-                write: true,
-            },
-            ..DrawState::PLAIN
-        };
         for (k, s) in shooters.iter().enumerate() {
             let (t, b) = crate::sampling::basis_around(s.normal);
             let k = k as u32;
@@ -563,7 +546,12 @@ impl Radiosity {
                 .vec3("u_normal", s.normal.to_array())
                 .float("u_far", self.far)
                 .float("u_near", self.far * 1e-6)
-                .draw_triangles(&self.items_target, &state, viewport, &self.vertices)?;
+                .draw_triangles(
+                    &self.items_target,
+                    &DrawState::Z_BUFFER,
+                    viewport,
+                    &self.vertices,
+                )?;
         }
         let row = 4 * SHOOTER_TEXELS as usize;
         let mut data = vec![0f32; row * (columns * columns) as usize];
@@ -631,21 +619,18 @@ impl Radiosity {
         let t0 = std::time::Instant::now();
         let mut b = self.programs.lookup.bind();
         textures.bind(&mut b);
+        direct.bind_weights(&mut b);
+        self.bind_atlas(&mut b);
         b.texture("u_diffuse_position", &direct.diffuse_position)
-            .texture("u_diffuse_normal", &direct.diffuse_normal)
-            .texture("u_diffuse_throughput", &direct.diffuse_throughput)
             .texture("u_radiosity", &self.radiosity)
             .texture("u_direct", &self.direct)
-            .texture("u_element_position", &self.position)
             .texture("u_patch_of", &self.patch_of)
             .int("u_patch_of_width", self.patch_of_width as i32)
             .texture("u_nodes", &self.nodes)
-            .int("u_res", self.elements.res as i32)
-            .int("u_tile_columns", self.elements.tile_columns as i32)
             .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
         drop(b);
         self.gpu.finish();
-        timings.add_both("radiosity lookup", 0.0, t0.elapsed().as_secs_f64(), 1);
+        timings.add_since("radiosity lookup", 0.0, t0, 1);
         self.gpu.check("radiosity lookup")
     }
 

@@ -66,13 +66,7 @@ impl Default for RadiosityOptions {
 
 impl RadiosityOptions {
     pub fn check(&self) -> Result<()> {
-        if !(2..=256).contains(&self.resolution) {
-            return Err(Error::out_of_range(
-                "radiosity.resolution",
-                self.resolution,
-                "the allowed range is 2..=256",
-            ));
-        }
+        Error::check_range("radiosity.resolution", self.resolution, 2..=256)?;
         if self.substructure == 0 || !self.resolution.is_multiple_of(self.substructure) {
             return Err(Error::out_of_range(
                 "radiosity.substructure",
@@ -90,13 +84,7 @@ impl RadiosityOptions {
                 "at most 8 (64 item buffers a shot)",
             ));
         }
-        if !(16..=2048).contains(&self.item_buffer) {
-            return Err(Error::out_of_range(
-                "radiosity.item_buffer",
-                self.item_buffer,
-                "the allowed range is 16..=2048",
-            ));
-        }
+        Error::check_range("radiosity.item_buffer", self.item_buffer, 16..=2048)?;
         if !(self.convergence > 0.0 && self.convergence < 1.0) {
             return Err(Error::out_of_range(
                 "radiosity.convergence",
@@ -104,21 +92,12 @@ impl RadiosityOptions {
                 "the allowed range is (0, 1)",
             ));
         }
-        if self.subdivide > MAX_SUBDIVIDE {
-            return Err(Error::out_of_range(
-                "radiosity.subdivide",
-                self.subdivide,
-                format!("the allowed range is 0..={MAX_SUBDIVIDE}"),
-            ));
-        }
-        if !(self.gradient > 0.0 && self.gradient.is_finite()) {
-            return Err(Error::out_of_range(
-                "radiosity.gradient",
-                self.gradient,
-                "give a positive number",
-            ));
-        }
-        Ok(())
+        Error::check_range("radiosity.subdivide", self.subdivide, 0..=MAX_SUBDIVIDE)?;
+        Error::check_positive(
+            "radiosity.gradient",
+            self.gradient,
+            "give a positive number",
+        )
     }
 }
 

@@ -74,27 +74,25 @@ impl Radiosity {
             self.queries.push(Query::occlusion(&self.gpu)?);
         }
         self.gpu.texture_barrier();
-        let state = DrawState {
-            color_writes: false,
-            ..DrawState::PLAIN
-        };
         for (&t, q) in tiles.iter().zip(&self.queries) {
             let (x, y) = self.elements.tile_base(t);
-            q.begin();
-            let drawn = self
-                .programs
-                .discontinuity
-                .bind()
-                .texture("u_radiosity", &self.radiosity)
-                .texture("u_shot", &self.shot)
-                .texture("u_element_position", &self.position)
-                .ivec2("u_tile_base", [x as i32, y as i32])
-                .int("u_res", self.elements.res as i32)
-                .float("u_gradient", self.options.gradient)
-                .float("u_floor", floor)
-                .draw_region(&self.residual_target, &state, self.elements.tile_region(t));
-            q.end();
-            drawn?;
+            q.around(|| {
+                self.programs
+                    .discontinuity
+                    .bind()
+                    .texture("u_radiosity", &self.radiosity)
+                    .texture("u_shot", &self.shot)
+                    .texture("u_element_position", &self.position)
+                    .ivec2("u_tile_base", [x as i32, y as i32])
+                    .int("u_res", self.elements.res as i32)
+                    .float("u_gradient", self.options.gradient)
+                    .float("u_floor", floor)
+                    .draw_region(
+                        &self.residual_target,
+                        &DrawState::NO_COLOR,
+                        self.elements.tile_region(t),
+                    )
+            })?;
         }
         Ok(self.queries[..tiles.len()]
             .iter()

@@ -179,13 +179,11 @@ impl Sppm {
         if sppm.start.photons.is_some() {
             start_defines.push(("START_PHOTONS", "1".to_string()));
         }
-        if !(initial_radius > 0.0 && initial_radius.is_finite()) {
-            return Err(Error::out_of_range(
-                "sppm.initial_radius",
-                initial_radius,
-                "the first radius must be a positive number",
-            ));
-        }
+        Error::check_positive(
+            "sppm.initial_radius",
+            initial_radius,
+            "the first radius must be a positive number",
+        )?;
         let state = SppmState::new(gpu, w, h)?;
         state
             .flux
@@ -227,11 +225,11 @@ impl Sppm {
 
     /// Each pixel's first radius, at this first iteration's visible points
     /// (and map, for `SppmStart::Photons`): `glsl/render/sppm_start.frag`.
-    fn start_radii(&self, map: &PhotonMap, grid: &Grid, start: SppmStart) -> Result<()> {
+    fn start_radii(&self, map: &PhotonMap, start: SppmStart) -> Result<()> {
         let camera = &self.scene.camera;
         let mut b = self.start.bind();
         if let Some(k) = start.photons {
-            self.bind_gather(&mut b, map, grid);
+            self.bind_gather(&mut b, map);
             b.int("u_k", k as i32);
         }
         // 0: no bound by footprints.
@@ -253,28 +251,10 @@ impl Sppm {
 
     /// The photon map, its grid and the leak tests' inputs, as
     /// `render/sppm_gather.glsl` declares them.
-    fn bind_gather(&self, b: &mut crate::gpu::Bindings<'_>, map: &PhotonMap, grid: &Grid) {
+    fn bind_gather(&self, b: &mut crate::gpu::Bindings<'_>, map: &PhotonMap) {
         self.textures.bind(b);
-        match map {
-            PhotonMap::Sorted(m) => {
-                b.texture("u_map_position", &m.position)
-                    .texture("u_map_power", &m.power)
-                    .texture("u_map_incoming", &m.incoming)
-                    .texture("u_grid_first", &m.grid_first)
-                    .int("u_grid_width", m.grid_width as i32)
-                    .int("u_sorted_width", m.position.width as i32);
-            }
-            PhotonMap::Routed(m) => {
-                b.texture("u_map_position", &m.position)
-                    .texture("u_map_power", &m.power)
-                    .texture("u_map_incoming", &m.incoming)
-                    .texture("u_map_counts", &m.counts)
-                    .int("u_count_width", m.count_width as i32)
-                    .int("u_block", m.block as i32)
-                    .int("u_blocks_per_row", m.blocks_per_row as i32);
-            }
-        }
-        grid.bind(b);
+        map.bind(b);
+        b.texture("u_map_incoming", map.incoming());
         if matches!(self.leak, LeakTest::Disc | LeakTest::DiscAndVisibility) {
             b.float("u_disc_radius", self.initial_radius);
         }
@@ -304,7 +284,7 @@ impl Sppm {
             let a = self.adaptive.as_mut().expect("adaptive");
             a.plan(&self.direct, &self.image, &self.state)?;
             self.gpu.finish();
-            timings.add_both("adaptive plan", 0.0, wall.elapsed().as_secs_f64(), 12);
+            timings.add_since("adaptive plan", 0.0, wall, 12);
         }
         let at = At {
             view: 0,
@@ -332,10 +312,10 @@ impl Sppm {
         self.photons
             .trace_batch(&self.scene, &self.textures, &mut self.batch, seed)?;
         let frames = &self.batch.frames;
-        timings.add_both(
+        timings.add_since(
             "trace photons",
             frames.gpu_seconds,
-            wall.elapsed().as_secs_f64(),
+            wall,
             frames.passes as usize,
         );
         let wall = std::time::Instant::now();
@@ -353,29 +333,23 @@ impl Sppm {
             )?),
         };
         self.gpu.finish();
-        let passes = stages.stages.iter().map(|s| s.passes).sum();
-        timings.add_both(
-            "build map",
-            stages.gpu_total(),
-            wall.elapsed().as_secs_f64(),
-            passes,
-        );
+        timings.add_folded("build map", &stages, wall);
         if let Some(start) = self.pending_start.take() {
             let wall = std::time::Instant::now();
-            self.start_radii(&map, &grid, start)?;
+            self.start_radii(&map, start)?;
             self.gpu.finish();
-            timings.add_both("first radii", 0.0, wall.elapsed().as_secs_f64(), 1);
+            timings.add_since("first radii", 0.0, wall, 1);
         }
         let wall = std::time::Instant::now();
-        self.gather_and_update(&map, &grid)?;
+        self.gather_and_update(&map)?;
         self.gpu.finish();
-        timings.add_both("gather + update", 0.0, wall.elapsed().as_secs_f64(), 1);
+        timings.add_since("gather + update", 0.0, wall, 1);
         self.iteration = i;
         if reads_radius(i) {
             let wall = std::time::Instant::now();
             let largest = self.largest_radius()?;
             self.cell = largest.max(0.25 * self.initial_radius).min(self.cell);
-            timings.add_both("largest radius", 0.0, wall.elapsed().as_secs_f64(), 1);
+            timings.add_since("largest radius", 0.0, wall, 1);
         }
         self.map = Some(map);
         self.grid = Some(grid);
@@ -392,25 +366,18 @@ impl Sppm {
     /// The gather at each visible point and the in-place update; adaptive
     /// after the pilot, direct light at every pixel and the gather at the
     /// packed computed pixels.
-    fn gather_and_update(&self, map: &PhotonMap, grid: &Grid) -> Result<()> {
+    fn gather_and_update(&self, map: &PhotonMap) -> Result<()> {
         let planned = self
             .adaptive
             .as_ref()
             .and_then(|a| Some((a, a.planned.as_ref()?)));
         let Some((adaptive, planned)) = planned else {
-            return self.update(map, grid, &self.state, &self.direct, true, None);
+            return self.update(map, &self.state, &self.direct, true, None);
         };
-        self.update(map, grid, &self.state, &self.direct, false, None)?;
+        self.update(map, &self.state, &self.direct, false, None)?;
         adaptive.pyramid.pack_hits(&self.direct)?;
         let rows = Some(planned.rows as i32);
-        self.update(
-            map,
-            grid,
-            &planned.state,
-            &adaptive.pyramid.packed,
-            true,
-            rows,
-        )
+        self.update(map, &planned.state, &adaptive.pyramid.packed, true, rows)
     }
 
     /// One update pass over `state` at the visible points `hits`, on its
@@ -418,21 +385,18 @@ impl Sppm {
     fn update(
         &self,
         map: &PhotonMap,
-        grid: &Grid,
         state: &SppmState,
         hits: &DirectLight,
         gather: bool,
         rows: Option<i32>,
     ) -> Result<()> {
         let mut b = self.update.bind();
-        self.bind_gather(&mut b, map, grid);
-        let d = hits;
+        self.bind_gather(&mut b, map);
+        hits.bind_weights(&mut b);
         b.texture("u_state_flux", &state.flux)
             .texture("u_state_direct", &state.sums)
-            .texture("u_direct", &d.radiance)
-            .texture("u_diffuse_position", &d.diffuse_position)
-            .texture("u_diffuse_normal", &d.diffuse_normal)
-            .texture("u_diffuse_throughput", &d.diffuse_throughput)
+            .texture("u_direct", &hits.radiance)
+            .texture("u_diffuse_position", &hits.diffuse_position)
             .float("u_alpha", self.options.alpha)
             .float("u_first_radius2", self.cell * self.cell)
             .int("u_gather", gather as i32);
