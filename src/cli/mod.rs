@@ -7,6 +7,7 @@ pub mod args;
 pub mod bench;
 pub mod compare;
 pub mod convert;
+pub mod convert_scene;
 pub mod info;
 pub mod photons;
 pub mod progress;
