@@ -117,3 +117,36 @@ fn lenient_maps_what_cannot_be_rendered_with_a_note_each() {
         "{stderr}"
     );
 }
+
+#[test]
+fn mitsuba_scenes_take_d_parameters_and_name_xml_errors_by_line() {
+    let d = TempDir::new("mitsuba");
+    let out = d.join("c.toml");
+    Run::new(["convert-scene", "-D", "res=32"])
+        .arg(fixture("cornell_box.xml"))
+        .arg(&out)
+        .succeeds();
+    assert!(std::fs::read_to_string(&out)
+        .unwrap()
+        .contains("width = 32"));
+    // on render, -D sets the XML's parameter, and a TOML path overrides the TOML
+    Run::new([
+        "render",
+        "--quiet",
+        "-D",
+        "res=16",
+        "-D",
+        "photon_map.photons_stored=2000",
+    ])
+    .arg(fixture("cornell_box.xml"))
+    .output_to(d.join("c.png"))
+    .succeeds();
+    assert_eq!(image::open(d.join("c.png")).unwrap().width(), 16);
+    let bad = d.join("bad.xml");
+    std::fs::write(&bad, "<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n    <float name=\"radius\" value=\"1\">\n  </shape>\n</scene>\n").unwrap();
+    let stderr = Run::new(["render", "--quiet"])
+        .arg(&bad)
+        .output_to(d.join("b.png"))
+        .refused_with("bad.xml:4: ");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+}

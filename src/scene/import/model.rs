@@ -342,10 +342,14 @@ pub fn to_toml(model: &Model) -> String {
         "grid_resolution = [{gx}, {gy}, {gz}]\nmax_bounces = {}",
         depth.max(1)
     );
-    if !model.materials.is_empty() {
+    if !model.surfaces.is_empty() {
         let _ = writeln!(w, "\n[materials]");
     }
-    for (name, m) in &model.materials {
+    let used = |i: usize| model.surfaces.iter().any(|(_, m)| *m == i);
+    for (i, (name, m)) in model.materials.iter().enumerate() {
+        if !used(i) {
+            continue;
+        }
         let _ = match *m {
             Mat::Diffuse(c) => writeln!(
                 w,
@@ -465,9 +469,15 @@ fn toml_string(s: &str) -> String {
 }
 
 /// A number as TOML reads it back exactly (always with a point or exponent).
+/// A value that is an f32 (as PLY files store them) is written as that
+/// f32's shortest decimal.
 pub fn fmt(x: f64) -> String {
     let x = if x == 0.0 { 0.0 } else { x };
-    let s = format!("{x:?}");
+    let s = if f64::from(x as f32) == x {
+        format!("{:?}", x as f32)
+    } else {
+        format!("{x:?}")
+    };
     if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
         s
     } else {

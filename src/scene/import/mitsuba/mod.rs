@@ -1,22 +1,11 @@
-//! Mitsuba 3 XML scenes.
+//! Mitsuba 3 XML scenes (Mitsuba 0.6's camelCase names accepted too):
+//! properties and transforms (`values.rs`, a leaf), the document with its
+//! defaults, includes and ids (`document.rs`), and what each object
+//! becomes (`objects.rs`).
 
-use std::path::Path;
+mod document;
+mod objects;
+mod state;
+mod values;
 
-use super::model::Model;
-use super::source::{Files, ImportOptions};
-use crate::error::SceneError;
-
-/// Reads a Mitsuba 3 XML file into a model.
-pub fn read(
-    _bytes: &[u8],
-    path: &Path,
-    _files: &dyn Files,
-    _opts: &ImportOptions,
-) -> Result<Model, SceneError> {
-    Err(SceneError::new(
-        path,
-        0,
-        "(file)",
-        "Mitsuba scenes are not read yet".into(),
-    ))
-}
+pub use document::read;

@@ -101,3 +101,28 @@ fn the_ply_block_reads_the_same_in_every_encoding() {
         );
     }
 }
+
+#[test]
+fn mitsuba_cornell_box_is_the_obj_one() {
+    assert_cornell(&load("cornell_box.xml"));
+}
+
+#[test]
+fn mitsuba_defines_set_defaults_and_dollar_parameters() {
+    let text = std::fs::read_to_string(dir().join("cornell_box.xml")).unwrap();
+    let opts = ImportOptions {
+        defines: vec![("res".into(), "64".into())],
+        ..ImportOptions::default()
+    };
+    let c = convert_text("cornell_box.xml", &text, &opts).unwrap();
+    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    assert_eq!((s.camera.width, s.camera.height), (64, 64));
+    assert!(c.toml.contains("render with --spp 4."), "{}", c.toml);
+    // Mitsuba 0.6's camelCase names read as Mitsuba 3's
+    let old = text
+        .replace("fov_axis", "fovAxis")
+        .replace("to_world", "toWorld")
+        .replace("sample_count", "sampleCount");
+    let c = convert_text("cornell_box.xml", &old, &ImportOptions::default()).unwrap();
+    assert_cornell(&load_scene_str(&c.toml, Path::new("t")).unwrap());
+}

@@ -141,3 +141,64 @@ fn a_scene_without_camera_or_light_is_refused() {
     .unwrap_err();
     assert!(e.to_string().contains("no light"), "{e}");
 }
+
+const XML_HEAD: &str = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n<emitter type=\"point\"/>\n";
+
+fn xml_error(body: &str) -> SceneError {
+    let text = format!("{XML_HEAD}{body}</scene>\n");
+    convert_text("bad.xml", &text, &ImportOptions::default()).unwrap_err()
+}
+
+#[test]
+fn mitsuba_errors_name_their_line() {
+    assert_at(
+        &xml_error("<shape type=\"sphere\">\n<float name=\"radius\" value=\"1\">\n</shape>\n"),
+        "bad.xml",
+        6,
+        "expected 'float' tag, not 'shape'",
+    );
+    assert_at(
+        &xml_error("<shap type=\"sphere\"/>\n"),
+        "bad.xml",
+        4,
+        "unknown element <shap>",
+    );
+    assert_at(
+        &xml_error("<shape type=\"sphere\">\n<string name=\"radius\" value=\"1\"/>\n</shape>\n"),
+        "bad.xml",
+        5,
+        "it must be a <float>",
+    );
+    assert_at(
+        &xml_error("<shape type=\"sphere\">\n<float name=\"radius\" value=\"$r\"/>\n</shape>\n"),
+        "bad.xml",
+        5,
+        "$r has no value",
+    );
+    assert_at(
+        &xml_error("<shape type=\"sphere\">\n<float name=\"radios\" value=\"1\"/>\n</shape>\n"),
+        "bad.xml",
+        5,
+        "unknown property `radios`",
+    );
+    assert_at(
+        &xml_error(
+            "<shape type=\"ply\">\n<string name=\"filename\" value=\"gone.ply\"/>\n</shape>\n",
+        ),
+        "bad.xml",
+        4,
+        "cannot read",
+    );
+    assert_at(
+        &xml_error("<shape type=\"sphere\"><bsdf type=\"roughplastic\"/></shape>\n"),
+        "bad.xml",
+        4,
+        "--lenient",
+    );
+    assert_at(
+        &xml_error("<emitter type=\"envmap\"/>\n"),
+        "bad.xml",
+        4,
+        "--lenient: left out",
+    );
+}

@@ -89,3 +89,25 @@ fn pbrt_fov_spans_the_shorter_side() {
         s.camera.vfov_degrees
     );
 }
+
+#[test]
+fn the_mitsuba_scene_loads_as_the_same_flattened_toml() {
+    assert_same(&load("transforms.xml"), &flat());
+}
+
+#[test]
+fn mitsuba_fov_axis_x_is_converted_to_the_vertical_fov() {
+    let text = std::fs::read_to_string(dir().join("transforms.xml")).unwrap();
+    let x = text.replace("value=\"y\"", "value=\"x\"");
+    let c = convert_text("transforms.xml", &x, &ImportOptions::default()).unwrap();
+    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    let expected = 2.0
+        * ((15f64.to_radians()).tan() * 48.0 / 64.0)
+            .atan()
+            .to_degrees();
+    assert!(
+        (f64::from(s.camera.vfov_degrees) - expected).abs() < 1e-4,
+        "{}",
+        s.camera.vfov_degrees
+    );
+}
