@@ -280,6 +280,19 @@ fn mirror_of(c: &CameraSpec) -> Option<(DVec3, DVec3)> {
     (c.right.dot(ours) < 0.0).then(|| (c.eye, ours.normalize()))
 }
 
+/// How far along the view the written `look_at` stands: the scene's size
+/// (a power of two, so the sum stays exact where it can), so that the
+/// direction keeps its precision after the loader rounds both points to f32.
+fn look_distance(model: &Model) -> f64 {
+    let (lo, hi) = model.bounds();
+    let size = (hi - lo).max_element();
+    if size.is_finite() && size > 0.0 {
+        2f64.powi(size.log2().ceil() as i32)
+    } else {
+        1.0
+    }
+}
+
 /// Writes the TOML scene (with the derivations and hints as comments).
 pub fn to_toml(model: &Model) -> String {
     let camera = model.camera.expect("importers check the camera");
@@ -304,7 +317,7 @@ pub fn to_toml(model: &Model) -> String {
         w,
         "\n[camera]\nposition = {}\nlook_at = {}\nup = {}",
         p(camera.eye),
-        p(camera.eye + camera.dir),
+        p(camera.eye + camera.dir * look_distance(model)),
         d(camera.up)
     );
     let _ = writeln!(
