@@ -2,8 +2,6 @@
 
 mod cli;
 
-use std::process::ExitCode;
-
 use clap::{Parser, Subcommand};
 use photonmap::gpu::Platform;
 
@@ -31,6 +29,7 @@ enum Command {
     Photons(cli::photons::PhotonsArgs),
     Compare(cli::compare::CompareArgs),
     Convert(cli::convert::ConvertArgs),
+    ConvertScene(cli::convert_scene::ConvertSceneArgs),
     Reference(cli::reference::ReferenceArgs),
     Regress(cli::regress::RegressArgs),
     Tables(cli::tables::TablesArgs),
@@ -40,21 +39,21 @@ enum Command {
     Scenes(cli::scenes::ScenesArgs),
 }
 
-fn main() -> ExitCode {
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     cli::prepare(cli.threads);
-    let p = cli.platform;
     let result = match cli.command {
-        Command::Render(a) => cli::render::run(&a, p),
-        Command::Photons(a) => cli::photons::run(&a, p),
+        Command::Render(a) => cli::render::run(&a, cli.platform),
+        Command::Photons(a) => cli::photons::run(&a, cli.platform),
         Command::Compare(a) => cli::compare::run(&a),
         Command::Convert(a) => cli::convert::run(&a),
-        Command::Reference(a) => cli::reference::run(&a, p),
-        Command::Regress(a) => cli::regress::run(&a, p),
-        Command::Tables(a) => cli::tables::run(&a, p),
-        Command::Bench(b) => cli::bench::run(b, p),
-        Command::Info(a) => cli::info::run(&a, p),
+        Command::ConvertScene(a) => cli::convert_scene::run(&a),
+        Command::Reference(a) => cli::reference::run(&a, cli.platform),
+        Command::Regress(a) => cli::regress::run(&a, cli.platform),
+        Command::Tables(a) => cli::tables::run(&a, cli.platform),
+        Command::Bench(b) => cli::bench::run(b, cli.platform),
+        Command::Info(a) => cli::info::run(&a, cli.platform),
         Command::Scenes(a) => cli::scenes::run(&a),
     };
-    result.map_or_else(cli::fail, |()| ExitCode::SUCCESS)
+    result.map_or_else(cli::fail, |()| std::process::ExitCode::SUCCESS)
 }

@@ -2,6 +2,7 @@
 //! library's options by one conversion. Ranges are checked while parsing.
 
 use clap::Args;
+use photonmap::scene::import::ImportOptions;
 
 use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
@@ -518,8 +519,34 @@ pub struct SceneArgs {
     /// Override a scene field by its path, validated like the file and
     /// recorded in every output: --set photon_map.k=64, -D camera.width=256,
     /// --set 'shape[1].radius=0.5' (repeatable; the value is TOML).
+    /// For a Mitsuba scene (.xml), a KEY without `.` or `[` (other than
+    /// `name`) sets the XML's `$KEY` and `<default name="KEY">`, as
+    /// Mitsuba's -D does.
     #[arg(long = "set", short = 'D', value_name = "KEY=VALUE", value_parser = key_value)]
     pub set: Vec<(String, String)>,
+    /// A pbrt or Mitsuba scene: map what photonmap cannot render (textures,
+    /// rough and coated materials, media, environment lights...) to the
+    /// nearest thing it can, printing one line for each, instead of refusing it.
+    #[arg(long)]
+    pub lenient: bool,
+}
+
+impl SceneArgs {
+    /// The `--set` overrides for the TOML scene, and Mitsuba's `-D` values.
+    pub fn split_overrides(&self) -> (Vec<(String, String)>, ImportOptions) {
+        let mitsuba = photonmap::scene::import::format_of(&self.scene)
+            == Some(photonmap::scene::import::Format::Mitsuba);
+        let (defines, set): (Vec<_>, Vec<_>) = self
+            .set
+            .iter()
+            .cloned()
+            .partition(|(k, _)| mitsuba && k != "name" && !k.contains('.') && !k.contains('['));
+        let opts = ImportOptions {
+            lenient: self.lenient,
+            defines,
+        };
+        (set, opts)
+    }
 }
 
 pub fn key_value(s: &str) -> Result<(String, String), String> {
@@ -537,8 +564,12 @@ pub struct LoadedScene {
 
 impl SceneArgs {
     pub fn load(&self) -> anyhow::Result<LoadedScene> {
-        let (scene, text) =
-            photonmap::scene::embedded::load_with_overrides(&self.scene, &self.set)?;
+        let (set, opts) = self.split_overrides();
+        let (scene, text, notes) =
+            photonmap::scene::embedded::load_imported(&self.scene, &set, &opts)?;
+        for n in notes {
+            eprintln!("note: {n}");
+        }
         let mut provenance = photonmap::provenance::Provenance::program();
         provenance.scene = self.scene.display().to_string();
         provenance.scene_hash = format!("{:016x}", photonmap::provenance::fnv1a64(text.as_bytes()));

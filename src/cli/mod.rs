@@ -8,6 +8,7 @@ pub mod bench;
 pub mod ci_report;
 pub mod compare;
 pub mod convert;
+pub mod convert_scene;
 pub mod info;
 pub mod photons;
 pub mod progress;

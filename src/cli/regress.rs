@@ -30,6 +30,10 @@ pub struct RegressArgs {
     /// Override a field of every scene, as render's --set (repeatable).
     #[arg(long = "set", short = 'D', value_name = "KEY=VALUE", value_parser = key_value)]
     pub set: Vec<(String, String)>,
+    /// pbrt and Mitsuba scenes: map what photonmap cannot render to the
+    /// nearest thing it can, as render's --lenient, instead of refusing it.
+    #[arg(long)]
+    pub lenient: bool,
     /// The folder of the references: <scene>.exr (mean), <scene>.var.exr, <scene>.json.
     #[arg(long, value_name = "DIR")]
     pub reference: PathBuf,
@@ -117,6 +121,7 @@ fn jobs(a: &RegressArgs) -> Result<Vec<Job>> {
             let args = SceneArgs {
                 scene: scene.clone(),
                 set: a.set.clone(),
+                lenient: a.lenient,
             };
             let loaded = args.load()?;
             let name = a.name.clone().unwrap_or_else(|| {

@@ -7,6 +7,7 @@ pub mod defaults;
 pub mod embedded;
 pub mod file;
 pub mod generate;
+pub mod import;
 pub mod load;
 pub mod obj;
 pub mod pack;

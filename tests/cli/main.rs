@@ -9,6 +9,7 @@ mod common;
 mod bench;
 mod compare;
 mod faults;
+mod import;
 mod methods;
 mod outputs;
 mod photons;

@@ -15,6 +15,7 @@ mod fused_eye_path;
 mod gpu_substrate;
 mod hash_grid;
 mod igi;
+mod import;
 mod intersections;
 mod obj_scenes;
 mod photon_build;

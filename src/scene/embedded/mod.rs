@@ -8,5 +8,7 @@
 mod by_name;
 mod files;
 
-pub use by_name::{load, load_path_or_name, load_with_overrides, text_for};
+pub use by_name::{
+    import_text_for, load, load_imported, load_path_or_name, load_with_overrides, text_for,
+};
 pub use files::{file, names, source, PAPER_SCENES};
