@@ -6,8 +6,12 @@
 //! scene's bounds and lights (`derived_photon_map`).
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use glam::DVec3;
+
+use super::source::Cx;
+use crate::error::SceneError;
 
 /// A material photonmap renders.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,6 +99,48 @@ pub struct Model {
 }
 
 impl Model {
+    /// A sphere of `material`; an emitting one (`radiance`) is refused, or
+    /// under --lenient becomes a point light of the same power at its centre.
+    pub fn add_sphere(
+        &mut self,
+        cx: &mut Cx,
+        (file, line, what): (&Path, usize, &str),
+        (center, radius): (DVec3, f64),
+        material: usize,
+        radiance: Option<[f64; 3]>,
+    ) -> Result<(), SceneError> {
+        match radiance {
+            Some(l) => {
+                cx.unsupported(
+                    file,
+                    line,
+                    &format!("{what} emitting"),
+                    "a point light of the same power at its centre",
+                )?;
+                self.emitters.push(Emitter::Point {
+                    position: center,
+                    intensity: l.map(|x| std::f64::consts::PI * radius * radius * x),
+                });
+            }
+            None => self
+                .surfaces
+                .push((Surface::Sphere { center, radius }, material)),
+        }
+        Ok(())
+    }
+
+    /// An empty model named after the scene file it is read from.
+    pub fn for_file(path: &Path) -> Self {
+        Model {
+            name: path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            source: path.display().to_string(),
+            ..Model::default()
+        }
+    }
+
     /// The index of a material, added under `name` (made unique) unless an
     /// equal one exists.
     pub fn material(&mut self, name: &str, m: Mat) -> usize {

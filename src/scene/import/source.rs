@@ -76,7 +76,16 @@ pub struct Cx<'a> {
     pub notes: Vec<String>,
 }
 
-impl Cx<'_> {
+impl<'a> Cx<'a> {
+    /// The context of one import: where it reads, and whether it is lenient.
+    pub fn new(files: &'a dyn Files, opts: &ImportOptions) -> Self {
+        Cx {
+            files,
+            lenient: opts.lenient,
+            notes: Vec::new(),
+        }
+    }
+
     /// Something photonmap cannot render, at `file:line` (`what` names it):
     /// an error, or under --lenient a note that it became `instead`.
     pub fn unsupported(

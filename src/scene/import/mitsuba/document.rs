@@ -25,19 +25,8 @@ pub fn read(
     opts: &ImportOptions,
 ) -> Result<Model, SceneError> {
     let mut r = Reader {
-        cx: Cx {
-            files,
-            lenient: opts.lenient,
-            notes: Vec::new(),
-        },
-        model: Model {
-            name: path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-            source: path.display().to_string(),
-            ..Model::default()
-        },
+        cx: Cx::new(files, opts),
+        model: Model::for_file(path),
         bsdfs: HashMap::new(),
         defines: opts.defines.iter().cloned().collect(),
         depth: 0,

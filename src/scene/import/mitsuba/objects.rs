@@ -3,13 +3,13 @@
 //! (meshes from OBJ and PLY, rectangles, cubes, discs, spheres, cylinders)
 //! with their nested area emitters, and point emitters.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 use glam::{DMat4, DQuat, DVec3};
 use roxmltree::Node;
 
 use super::super::geometry::{self, Emission, Mesh, Xf};
-use super::super::model::{CameraSpec, Emitter, Mat, Surface};
+use super::super::model::{CameraSpec, Emitter, Mat};
 use super::state::Reader;
 use super::values::{At, Props};
 use crate::error::SceneError;
@@ -477,24 +477,14 @@ fn sphere(
             "a sphere's to_world must rotate and scale evenly".into(),
         ));
     };
-    let (center, radius) = (xf.point(c), radius * s);
-    if let Some(l) = radiance {
-        r.cx.unsupported(
-            at.file,
-            at.line(p.node),
-            &format!("{} emitting", p.what),
-            "a point light of the same power at its centre",
-        )?;
-        r.model.emitters.push(Emitter::Point {
-            position: center,
-            intensity: l.map(|x| PI * radius * radius * x),
-        });
-        return Ok(());
-    }
-    r.model
-        .surfaces
-        .push((Surface::Sphere { center, radius }, material));
-    Ok(())
+    let place = (at.file, at.line(p.node), p.what.as_str());
+    r.model.add_sphere(
+        &mut r.cx,
+        place,
+        (xf.point(c), radius * s),
+        material,
+        radiance,
+    )
 }
 
 fn cylinder(

@@ -3,12 +3,10 @@
 //! spheres; discs and bilinear patches as triangles; emitting
 //! parallelograms as area lights).
 
-use std::f64::consts::PI;
-
 use glam::{DMat4, DVec3};
 
 use super::super::geometry::{self, Emission, Mesh, Xf};
-use super::super::model::{Emitter, Mat, Surface};
+use super::super::model::{Emitter, Mat};
 use super::params::{blackbody_rgb, Colour, Params};
 use super::state::{AreaLight, PbrtCamera, PendingShape, Reader};
 use crate::error::SceneError;
@@ -578,25 +576,11 @@ fn sphere(
             (m.x_axis.length() * m.y_axis.length() * m.z_axis.length()).cbrt()
         }
     };
-    let (center, radius) = (xf.point(DVec3::ZERO), radius.abs() * scale);
-    if let Some(e) = emission {
-        r.cx.unsupported(
-            p.file,
-            p.line,
-            &format!("{} emitting", p.what),
-            "a point light of the same power at its centre",
-        )?;
-        let intensity = e.radiance.map(|l| PI * radius * radius * l);
-        r.model.emitters.push(Emitter::Point {
-            position: center,
-            intensity,
-        });
-        return Ok(());
-    }
+    let sphere = (xf.point(DVec3::ZERO), radius.abs() * scale);
+    let place = (p.file, p.line, p.what.as_str());
+    let radiance = emission.map(|e| e.radiance);
     r.model
-        .surfaces
-        .push((Surface::Sphere { center, radius }, material));
-    Ok(())
+        .add_sphere(&mut r.cx, place, sphere, material, radiance)
 }
 
 fn cylinder(
