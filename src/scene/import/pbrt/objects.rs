@@ -244,12 +244,7 @@ fn roughness(p: &Params) -> Result<f64, SceneError> {
 pub fn material(r: &mut Reader, kind: &str, p: &Params) -> Result<Option<Mat>, SceneError> {
     p.ignore(&["type"]);
     if p.has("displacement") || p.has("normalmap") {
-        r.cx.unsupported(
-            p.file,
-            p.line,
-            &format!("{} displacement or normal map", p.what),
-            "ignored",
-        )?;
+        p.unsupported(&mut r.cx, "displacement or normal map", "ignored")?;
     }
     let rough = |r: &mut Reader, p: &Params, what: &str, instead: &str| -> Result<(), SceneError> {
         if roughness(p)? > 0.0 {
@@ -316,10 +311,9 @@ pub fn material(r: &mut Reader, kind: &str, p: &Params) -> Result<Option<Mat>, S
             }
         }
         "interface" => {
-            r.cx.unsupported(
-                p.file,
-                p.line,
-                &format!("{} (a medium's boundary)", p.what),
+            p.unsupported(
+                &mut r.cx,
+                "(a medium's boundary)",
                 "its shapes are left out",
             )?;
             return Ok(None);
@@ -348,10 +342,9 @@ pub fn area_light(r: &mut Reader, kind: &str, p: &Params) -> Result<AreaLight, S
     let l = rgb(r, p, "L", [1.0; 3])?;
     let scale = p.float("scale", 1.0)?;
     if p.has("filename") || p.has("power") {
-        r.cx.unsupported(
-            p.file,
-            p.line,
-            &format!("{} filename or power", p.what),
+        p.unsupported(
+            &mut r.cx,
+            "filename or power",
             "ignored: L and scale give the radiance",
         )?;
     }
@@ -542,12 +535,7 @@ fn full_turn(r: &mut Reader, p: &Params) -> Result<(), SceneError> {
     let phi = p.float("phimax", 360.0)?;
     let (zmin, zmax) = (p.has("zmin"), p.has("zmax"));
     if phi < 360.0 || (p.what.contains("sphere") && (zmin || zmax)) {
-        r.cx.unsupported(
-            p.file,
-            p.line,
-            &format!("{} cut (phimax, zmin, zmax)", p.what),
-            "the whole shape",
-        )?;
+        p.unsupported(&mut r.cx, "cut (phimax, zmin, zmax)", "the whole shape")?;
     }
     Ok(())
 }
@@ -566,10 +554,9 @@ fn sphere(
     let scale = match xf.uniform_scale() {
         Some(s) => s,
         None => {
-            r.cx.unsupported(
-                p.file,
-                p.line,
-                &format!("{} scaled unevenly (an ellipsoid)", p.what),
+            p.unsupported(
+                &mut r.cx,
+                "scaled unevenly (an ellipsoid)",
                 "a sphere of the mean scale",
             )?;
             let m = glam::DMat3::from_mat4(xf.0);
@@ -594,12 +581,7 @@ fn cylinder(
     let (z0, z1) = (p.float("zmin", -1.0)?, p.float("zmax", 1.0)?);
     full_turn(r, p)?;
     if emission.is_some() {
-        r.cx.unsupported(
-            p.file,
-            p.line,
-            &format!("{} emitting", p.what),
-            "kept without emission",
-        )?;
+        p.unsupported(&mut r.cx, "emitting", "kept without emission")?;
     }
     match geometry::cylinder(radius, z0, z1, xf) {
         Ok(s) => r.model.surfaces.push((s, material)),

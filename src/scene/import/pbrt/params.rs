@@ -7,6 +7,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::super::source::Cx;
 use super::lexer::{Param, Val};
 use crate::error::SceneError;
 
@@ -29,6 +30,18 @@ pub enum Colour {
 }
 
 impl<'a> Params<'a> {
+    /// Something of this directive photonmap cannot render (`detail`, after
+    /// the directive's name): refused at its line, or under --lenient noted
+    /// as becoming `instead`.
+    pub fn unsupported(&self, cx: &mut Cx, detail: &str, instead: &str) -> Result<(), SceneError> {
+        cx.unsupported(
+            self.file,
+            self.line,
+            &format!("{} {detail}", self.what),
+            instead,
+        )
+    }
+
     pub fn new(list: Vec<Param>, file: &'a Path, what: String, line: usize) -> Self {
         let used = list.iter().map(|_| Cell::new(false)).collect();
         Params {
