@@ -95,8 +95,7 @@ vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int pr
             float cos_x = dot(nf, wi);
             float cos_l = -dot(light_normal, wi);
             if (cos_x <= 0.0 || cos_l <= 0.0) continue;
-            // Stop short of the light's own surface by its offset scale.
-            if (occluded(origin, wi, dist - 2.0 * offset_scale(q))) continue;
+            if (occluded_toward(origin, q)) continue;
             float cos_s = shaded ? max(dot(nsf, wi), 0.0) : cos_x;
             light_sum += emitted * (cos_s * cos_l / (dist * dist));
         }

@@ -240,6 +240,16 @@ bool occluded(vec3 o, vec3 d, float t_max) {
     return bvh_trace(scene_ray(o, d), true, h) >= 0;
 }
 
+// Whether anything blocks a shadow ray from `origin`, already lifted off its
+// own surface, to the point q on another surface: aimed at q itself, so it
+// meets q's plane at q whatever the two surfaces' angle, and stopped short
+// of q's surface by its offset scale.
+bool occluded_toward(vec3 origin, vec3 q) {
+    vec3 to = q - origin;
+    float reach = length(to);
+    return occluded(origin, to / reach, reach - 2.0 * offset_scale(q));
+}
+
 vec4 material_texel(int m, int i) { return texelFetch(u_materials, ivec2(i, m), 0); }
 int material_kind(int m) { return int(material_texel(m, 0).x); }
 vec4 light_texel(int l, int i) { return texelFetch(u_lights, ivec2(i, l), 0); }

@@ -62,14 +62,10 @@ void main() {
         if (cos_x <= 0.0 || cos_y <= 0.0) continue;
         float g = cos_x * cos_y / d2 * bound(d);
         if (g <= 0.0) continue;
-        // The shadow ray aims from the lifted origin at y itself: along w from
-        // the origin it would meet y's plane early wherever that plane faces
-        // x's (a floor seen from the ceiling), by the lift over the cosine,
-        // and y's own surface would block it.
-        vec3 origin = offset_origin(x, nx, w);
-        vec3 to_y = y - origin;
-        float reach = length(to_y);
-        if (occluded(origin, to_y / reach, reach - 2.0 * offset_scale(y))) continue;
+        // Along w from the lifted origin the ray would meet y's plane early
+        // wherever it faces x's (a floor seen from the ceiling), and y's own
+        // surface would block it; occluded_toward aims at y itself.
+        if (occluded_toward(offset_origin(x, nx, w), y)) continue;
         sum += texelFetch(u_vpl_intensity, t, 0).rgb * g;
     }
     o_incident = vec4(sum * float(subsets), 0.0);
