@@ -9,6 +9,7 @@
 #include "common/scene.glsl"
 #include "common/sampling.glsl"
 #include "radiosity/parameterisation.glsl"
+#include "radiosity/leaf.glsl"
 
 uniform sampler2D u_diffuse_position;   // w > 0 where a first diffuse hit
 uniform sampler2D u_diffuse_normal;     // facing the eye
@@ -16,9 +17,6 @@ uniform sampler2D u_diffuse_throughput; // w = the primitive hit
 uniform sampler2D u_radiosity;
 uniform sampler2D u_direct;
 uniform sampler2D u_element_position;   // w = area
-uniform isampler2D u_patch_of;
-uniform int u_patch_of_width;
-uniform isampler2D u_nodes;  // node n at (n mod TILE_ROW, n / TILE_ROW): tile t >= 0, -1 empty, -(first child + 2)
 uniform int u_res;
 uniform int u_tile_columns;
 
@@ -32,26 +30,10 @@ void main() {
     vec3 nf = texelFetch(u_diffuse_normal, px, 0).xyz;
     vec4 throughput = texelFetch(u_diffuse_throughput, px, 0);
     int prim = int(throughput.w);
-    int side = dot(geometric_normal(prim, x.xyz), nf) >= 0.0 ? 0 : 1;
-    int k = 2 * prim + side;
-    int pid = texelFetch(u_patch_of, ivec2(k % u_patch_of_width, k / u_patch_of_width), 0).x;
-    if (pid < 0) return;
-    vec2 uv = patch_uv(prim, x.xyz);
-    // Down the quadtree: children in the order (0, 0), (1, 0), (0, 1), (1, 1).
-    int node = pid, tile = -1, depth = 0;
-    for (; depth < 16; ++depth) {
-        int v = texelFetch(u_nodes, ivec2(node % TILE_ROW, node / TILE_ROW), 0).x;
-        if (v == -1) return;
-        if (v >= 0) {
-            tile = v;
-            break;
-        }
-        ivec2 q = ivec2(greaterThanEqual(uv, vec2(0.5)));
-        node = -v - 2 + q.x + 2 * q.y;
-        uv = 2.0 * uv - vec2(q);
-    }
-    if (tile < 0) return;
-    uv = uv * float(u_res) - 0.5;
+    Leaf leaf = leaf_at(prim, x.xyz, nf);
+    if (leaf.tile < 0) return;
+    int tile = leaf.tile, depth = leaf.depth;
+    vec2 uv = leaf.uv * float(u_res) - 0.5;
     // Longitude wraps around a sphere and a cylinder (a whole patch's tile).
     int kind = int(primitive_texel(prim, 0).x);
     bool wraps = depth == 0 && (kind == PRIM_SPHERE || kind == PRIM_CYLINDER);

@@ -401,6 +401,12 @@ pub struct RadiosityArgs {
     /// point-to-polygon one, or the chapter's oriented disc.
     #[arg(long, value_enum, default_value_t = FormFactor::Polygon)]
     pub form_factor: FormFactor,
+    /// Radiosity: deposit the caustic map's photons into the elements before
+    /// the first shot, so that light from a mirror or glass bounces on from
+    /// the diffuse surface it reached (L S+ D D+); false: shots start from
+    /// the emitters alone.
+    #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    pub shoot_caustics: bool,
 }
 
 fn open_fraction(s: &str) -> Result<f32, String> {
@@ -421,6 +427,7 @@ impl RadiosityArgs {
             || self.subdivide != d.subdivide
             || self.gradient != d.gradient
             || self.form_factor != d.form_factor
+            || self.shoot_caustics != d.shoot_caustics
     }
 }
 
@@ -435,6 +442,7 @@ impl From<&RadiosityArgs> for RadiosityOptions {
             subdivide: a.subdivide,
             gradient: a.gradient,
             form_factor: a.form_factor,
+            shoot_caustics: a.shoot_caustics,
             ..RadiosityOptions::default()
         }
     }

@@ -8,7 +8,7 @@ use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 use crate::timing::Timings;
 
-use super::trace::{TraceConfig, TraceReport};
+use super::trace::{PhotonFrames, TraceConfig, TraceReport};
 use super::{
     fit, BitonicBuild, BuildMethod, Grid, GridKind, GridStorage, PhotonMap, PhotonTracer,
     RandomSource, StencilRouting, VertexFeed,
@@ -132,6 +132,9 @@ pub struct BuiltMap {
     /// The build's own stages (keys or compaction, sort, search, gather; or
     /// pattern, route, count, redistribute).
     pub build_stages: Timings,
+    /// The traced records the map was built from, for passes that want each
+    /// stored photon's primitive (radiosity's caustic deposit).
+    pub frames: PhotonFrames,
 }
 
 /// `PhotonTracer::trace_to_stored`, added to `timings` as "trace photons":
@@ -201,5 +204,6 @@ pub fn build_map(
         grid,
         grid_fitted: scene.photon_map.grid_bounds.is_none(),
         build_stages,
+        frames,
     })
 }

@@ -197,7 +197,7 @@ impl RenderOutput {
                 0,
                 true,
                 format!(
-                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; light that leaves a mirror or glass onto a diffuse surface never bounces on from there (L S+ D D+ is missing)",
+                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; {}",
                     r.patches,
                     r.elements,
                     r.element_resolution,
@@ -208,7 +208,8 @@ impl RenderOutput {
                     o.item_buffer,
                     if r.converged { "converged" } else { "stopped at --max-shots" },
                     100.0 * r.unshot_fraction,
-                    caustic_map(o.caustic_paths)
+                    caustic_map(o.caustic_paths),
+                    caustic_shots(r.caustic_shot_fraction)
                 ),
             ));
         }
@@ -386,6 +387,17 @@ impl RenderOutput {
             ));
         }
         lines
+    }
+}
+
+/// Whether radiosity's shots carry the caustic map's light on (L S+ D D+).
+fn caustic_shots(fraction: Option<f64>) -> String {
+    match fraction {
+        Some(f) => format!(
+            "the caustic map's photons were deposited into the elements first ({:.2}% of the emitted power), so that light bounces on from the diffuse surface it reached (L S+ D D+)",
+            100.0 * f
+        ),
+        None => "light that leaves a mirror or glass onto a diffuse surface never bounces on from there (L S+ D D+ is missing; --shoot-caustics true carries it)".into(),
     }
 }
 

@@ -7,7 +7,7 @@
 
 use crate::gpu::{Gpu, Result};
 use crate::image::Image;
-use crate::photon::{self, BuiltMap, PhotonConfig, PhotonMap};
+use crate::photon::{self, BuiltMap, PhotonConfig, PhotonFrames, PhotonMap};
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 use crate::timing::Timings;
@@ -62,13 +62,26 @@ impl MapEstimate {
         photons: &PhotonConfig,
         estimate: &EstimateOptions,
     ) -> Result<Self> {
-        Ok(Self {
-            report: PhotonReport::of(&built, photons),
+        Ok(Self::with_frames(gpu, (w, h), built, photons, estimate)?.0)
+    }
+
+    /// The map, and the traced records it was built from.
+    fn with_frames(
+        gpu: &Gpu,
+        (w, h): (u32, u32),
+        built: BuiltMap,
+        photons: &PhotonConfig,
+        estimate: &EstimateOptions,
+    ) -> Result<(Self, PhotonFrames)> {
+        let report = PhotonReport::of(&built, photons);
+        let map = Self {
+            report,
             map: built.map,
             estimate: RadianceEstimate::new(gpu, w, h)?,
             stats: Vec::new(),
             options: estimate.under(photons),
-        })
+        };
+        Ok((map, built.frames))
     }
 
     /// A caustic map (IGI's and radiosity's): the paths through mirrors or
@@ -82,6 +95,17 @@ impl MapEstimate {
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Option<Self>> {
+        Ok(Self::caustics_with_records(p, o, paths, timings, observer)?.map(|(map, _)| map))
+    }
+
+    /// The caustic map and the traced records it was built from.
+    pub fn caustics_with_records<T>(
+        p: &Prepare<'_>,
+        o: &WithCausticMap<T>,
+        paths: CausticPaths,
+        timings: &mut Timings,
+        observer: &mut dyn RenderObserver,
+    ) -> Result<Option<(Self, PhotonFrames)>> {
         observer.progress(&Progress::stage("photons", 0, 1));
         if !p.scene.has_specular() {
             return Ok(None);
@@ -92,13 +116,7 @@ impl MapEstimate {
         caustic.photon_map.store_direct = false;
         let built = photon::build_map(p.gpu, &caustic, p.textures, &o.photons, p.seed, timings)?;
         let size = (p.width, p.height);
-        Ok(Some(Self::new(
-            p.gpu,
-            size,
-            built,
-            &o.photons,
-            &o.estimate,
-        )?))
+        Self::with_frames(p.gpu, size, built, &o.photons, &o.estimate).map(Some)
     }
 
     /// The estimate at `queries`, its image read back unless `packed`.

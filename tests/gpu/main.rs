@@ -23,6 +23,7 @@ mod photon_trace;
 mod platforms;
 mod radiance_estimate;
 mod radiosity;
+mod radiosity_caustics;
 mod ray_tracer;
 mod reference_images;
 mod sppm;

@@ -50,7 +50,7 @@ fn scene(text: &str) -> Scene {
     load_scene_str(text, std::path::Path::new("r.toml")).unwrap()
 }
 
-fn solve(scene: &Scene, o: RadiosityOptions) -> RenderOutput {
+pub(crate) fn solve(scene: &Scene, o: RadiosityOptions) -> RenderOutput {
     let mut options = RenderOptions::for_scene(scene);
     (options.width, options.height) = (16, 16);
     options.method = Method::Radiosity(WithCausticMap {
@@ -140,9 +140,11 @@ fn patch_seen(s: &Scene, patch_of: &[i32], o: Vec3, d: Vec3) -> i32 {
 #[test]
 fn the_item_buffer_sees_what_shadow_rays_see() {
     let s = common::paper_scene("cornell_box");
+    // The light's shot alone in the direct part: no caustic deposit.
     let o = RadiosityOptions {
         max_shots: 1,
         subdivide: 0,
+        shoot_caustics: false,
         ..RadiosityOptions::default()
     };
     let out = solve(&s, o.clone());
@@ -522,7 +524,7 @@ fn closed_box(light: &str) -> Scene {
 
 /// Over the elements of diffuse patches: the sums of direct x area,
 /// radiosity x area and residual x area (red channel).
-fn box_sums(out: &RenderOutput) -> (f64, f64, f64) {
+pub(crate) fn box_sums(out: &RenderOutput) -> (f64, f64, f64) {
     let r = &out.radiosity_run().unwrap().radiosity;
     let e = &r.elements;
     let (direct, b, residual) = (

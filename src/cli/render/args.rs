@@ -353,7 +353,7 @@ impl RenderArgs {
             || self.radiosity.any_given()
             || self.caustic_paths.is_some()
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
         }
         Ok(())
     }
@@ -383,7 +383,7 @@ impl RenderArgs {
             (
                 Method::Radiosity,
                 self.radiosity.any_given(),
-                "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient and --form-factor are radiosity's: add --method radiosity",
+                "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor and --shoot-caustics are radiosity's: add --method radiosity",
                 "--method radiosity computes the diffuse interreflection itself",
             ),
         ];

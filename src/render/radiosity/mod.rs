@@ -36,8 +36,10 @@
 //!    down the quadtree to the leaf), and from a caustic photon map the light
 //!    that reaches x from a mirror or glass, which shots (stopped by both)
 //!    cannot carry: by default every such path (`CausticPaths::All`), light
-//!    a diffuse surface sends through them included. Light that leaves a
-//!    mirror or glass onto a diffuse surface does not bounce on from there.
+//!    a diffuse surface sends through them included. With `shoot_caustics`
+//!    that light also bounces on: before the first shot each caustic
+//!    record's reflected power is deposited into its element (`deposit`),
+//!    and the lookup leaves that first reflection to the caustic map.
 
 mod elements;
 mod options;
@@ -61,6 +63,7 @@ use crate::gpu::{
     Bindings, DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture, VertexBuffer,
 };
 use crate::layout::{SHOOTER_OUTLINE, SHOOTER_TEXELS, TILE_ROW};
+use crate::photon::PhotonFrames;
 use crate::scene::pack::SceneTextures;
 use crate::scene::{Light, Scene};
 
@@ -115,6 +118,8 @@ pub struct Radiosity {
     indirect_target: Target,
     width: u32,
     height: u32,
+    /// Power deposited from a caustic trace (`deposit`), luminance.
+    deposited: f64,
 }
 
 struct Programs {
@@ -128,6 +133,32 @@ struct Programs {
     inherit: Program,
     zero: Program,
     lookup: Program,
+    deposit: Program,
+}
+
+impl Programs {
+    fn new(gpu: &Gpu) -> Result<Self> {
+        let p = |name: &str| Program::fullscreen(gpu, name);
+        Ok(Self {
+            power: p("radiosity/tile_power.frag")?,
+            select: Program::new(gpu, "radiosity/select.vert", "radiosity/select.frag", &[])?,
+            shooters: p("radiosity/shooters.frag")?,
+            items: Program::with_geometry(
+                gpu,
+                "radiosity/item_buffer.vert",
+                "radiosity/item_buffer.geom",
+                "radiosity/item_buffer.frag",
+                &[],
+            )?,
+            shoot: p("radiosity/shoot.frag")?,
+            accumulate: p("radiosity/accumulate.frag")?,
+            discontinuity: p("radiosity/discontinuity.frag")?,
+            inherit: p("radiosity/inherit.frag")?,
+            zero: p("radiosity/zero.frag")?,
+            lookup: p("radiosity/lookup.frag")?,
+            deposit: Program::new(gpu, "radiosity/deposit.vert", "radiosity/deposit.frag", &[])?,
+        })
+    }
 }
 
 /// A texture of `count` records of one i32 or RGBA32F, TILE_ROW a row.
@@ -198,7 +229,6 @@ impl Radiosity {
         let shooters_target = Target::new(gpu, &[&shooters])?;
         let vertices = VertexBuffer::from_f32(gpu, &tessellate(scene), &[3, 1])?;
         let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
-        let p = |name: &str| Program::fullscreen(gpu, name);
         let r = Self {
             gpu: gpu.clone(),
             options: options.clone(),
@@ -226,29 +256,13 @@ impl Radiosity {
             vertices,
             far: 4.0 * scene.size(),
             queries: Vec::new(),
-            programs: Programs {
-                power: p("radiosity/tile_power.frag")?,
-                select: Program::new(gpu, "radiosity/select.vert", "radiosity/select.frag", &[])?,
-                shooters: p("radiosity/shooters.frag")?,
-                items: Program::with_geometry(
-                    gpu,
-                    "radiosity/item_buffer.vert",
-                    "radiosity/item_buffer.geom",
-                    "radiosity/item_buffer.frag",
-                    &[],
-                )?,
-                shoot: p("radiosity/shoot.frag")?,
-                accumulate: p("radiosity/accumulate.frag")?,
-                discontinuity: p("radiosity/discontinuity.frag")?,
-                inherit: p("radiosity/inherit.frag")?,
-                zero: p("radiosity/zero.frag")?,
-                lookup: p("radiosity/lookup.frag")?,
-            },
+            programs: Programs::new(gpu)?,
             indirect_target: Target::new(gpu, &[&indirect])?,
             indirect,
             elements,
             width,
             height,
+            deposited: 0.0,
         };
         r.upload_nodes()?;
         Ok(r)
@@ -277,7 +291,7 @@ impl Radiosity {
             ..Default::default()
         };
         let point_power = point_light_power(scene);
-        let emitted = self.unshot()?;
+        let emitted = self.unshot()? - self.deposited;
         let total = emitted + point_power;
         if total <= 0.0 {
             return Err(Error::InvalidOption(format!(
@@ -347,6 +361,7 @@ impl Radiosity {
         self.gpu.finish();
         self.gpu.check("radiosity solve")?;
         report.unshot_fraction = unshot / total;
+        report.caustic_shot_fraction = (self.deposited > 0.0).then(|| self.deposited / total);
         report.seconds = t0.elapsed().as_secs_f64();
         report.elements = self.elements.elements;
         report.tiles = self.elements.tiles.iter().filter(|t| t.alive).count();
@@ -632,6 +647,40 @@ impl Radiosity {
         self.gpu.finish();
         timings.add_since("radiosity lookup", 0.0, t0, 1);
         self.gpu.check("radiosity lookup")
+    }
+
+    /// Deposits the caustic trace's stored records into the elements they
+    /// landed on (`deposit.vert`), before `solve`: the power added, as
+    /// luminance.
+    pub fn deposit(&mut self, textures: &SceneTextures, records: &PhotonFrames) -> Result<()> {
+        let before = self.unshot()?;
+        let e = &self.elements;
+        let mut b = self.programs.deposit.bind();
+        textures.bind(&mut b);
+        self.bind_atlas(&mut b);
+        b.texture("u_position", &records.position)
+            .texture("u_power", &records.power)
+            .texture("u_incoming", &records.incoming)
+            .texture("u_outgoing", &records.outgoing)
+            .int("u_record_width", records.width as i32)
+            .int("u_frame_height", records.frame_height as i32)
+            .int("u_photons_used", records.photons_used as i32)
+            .float("u_power_scale", records.power_scale)
+            .texture("u_albedo", &self.albedo)
+            .texture("u_patch_of", &self.patch_of)
+            .int("u_patch_of_width", self.patch_of_width as i32)
+            .texture("u_nodes", &self.nodes)
+            .ivec2("u_atlas_size", [e.width as i32, e.height as i32])
+            .draw_points(
+                &self.atlas_target,
+                &DrawState::ADDITIVE,
+                0,
+                records.record_count() as i32,
+            )?;
+        drop(b);
+        self.gpu.check("radiosity caustic deposit")?;
+        self.deposited += self.unshot()? - before;
+        Ok(())
     }
 
     pub fn read_indirect(&self) -> Image {

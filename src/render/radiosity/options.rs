@@ -26,6 +26,10 @@ pub struct RadiosityOptions {
     /// The caustic map's paths: all light onto x from a mirror or glass, or
     /// only light straight from an emitter (form factors stop at both).
     pub caustic_paths: CausticPaths,
+    /// Whether the caustic map's records are deposited into the elements
+    /// before the first shot, so that light from a mirror or glass bounces
+    /// on from the diffuse surface it reached (L S+ D D+).
+    pub shoot_caustics: bool,
 }
 
 /// A shooter's form factor to a receiving element's centre.
@@ -60,6 +64,7 @@ impl Default for RadiosityOptions {
             gradient: 0.25,
             form_factor: FormFactor::Polygon,
             caustic_paths: CausticPaths::All,
+            shoot_caustics: true,
         }
     }
 }
@@ -148,4 +153,7 @@ pub struct RadiosityReport {
     pub unshot_fraction: f64,
     pub seconds: f64,
     pub convergence: Vec<ConvergencePoint>,
+    /// Power deposited from the caustic map before the first shot (luminance,
+    /// as a fraction of the emitted power), None when nothing was deposited.
+    pub caustic_shot_fraction: Option<f64>,
 }

@@ -26,9 +26,16 @@ impl RadiosityRun {
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
-        let caustics =
-            MapEstimate::caustics(p, with, with.method.caustic_paths, timings, observer)?;
-        let mut radiosity = Radiosity::new(p.gpu, p.scene, p.width, p.height, &with.method)?;
+        let o = &with.method;
+        let found =
+            MapEstimate::caustics_with_records(p, with, o.caustic_paths, timings, observer)?;
+        let (caustics, records) = found.unzip();
+        let mut radiosity = Radiosity::new(p.gpu, p.scene, p.width, p.height, o)?;
+        if let Some(records) = records.filter(|_| o.shoot_caustics) {
+            let t0 = std::time::Instant::now();
+            radiosity.deposit(p.textures, &records)?;
+            timings.add_since("caustic deposit", 0.0, t0, 1);
+        }
         let report = radiosity.solve(p.scene, p.textures, timings, &mut |_shot, unshot| {
             observer.progress(&Progress::stage(
                 "radiosity",

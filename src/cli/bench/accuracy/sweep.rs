@@ -232,7 +232,8 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     out
 }
 
-/// Progressive radiosity: its defaults, the chapter's ~10,000 elements of
+/// Progressive radiosity: its defaults, its caustic map from lights only and
+/// not shot on, the chapter's ~10,000 elements of
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, resolution: u32, spp: u32| {
@@ -249,6 +250,11 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
             o.caustic_paths = CausticPaths::FromLights;
         }
         out.push(from_lights);
+        let mut not_shot = rad("radiosity, caustics not shot", 16, 1);
+        if let RunMethod::Radiosity(o) = &mut not_shot.run.method {
+            o.shoot_caustics = false;
+        }
+        out.push(not_shot);
         out.push(rad("radiosity, 32 elements", 32, 1));
         out.push(rad("radiosity, 4 spp", 16, 4));
     }
