@@ -201,6 +201,7 @@ fn every_glsl_file_compiles() {
             }
             "render/knn_search.frag" => vec!["common/fullscreen.vert", "render/tile.vert"],
             "radiosity/select.frag" => vec!["radiosity/select.vert"],
+            "radiosity/deposit.frag" => vec!["radiosity/deposit.vert"],
             "radiosity/item_buffer.frag" => vec!["radiosity/item_buffer.vert"],
             _ => vec!["common/fullscreen.vert"],
         }
