@@ -60,7 +60,8 @@ impl RenderOutput {
             (Some(estimate), Some(p)) => {
                 let caustic = views.as_ref().map_or(scene, |v| &v.0);
                 lines.extend(self.photon_lines(caustic, p));
-                let (k, r) = (scene.photon_map.k, scene.photon_map.max_radius);
+                let k = method.first_hit_k(scene.photon_map.k);
+                let r = scene.photon_map.max_radius;
                 let pixels = options.width as u64 * options.height as u64;
                 let many = self.estimates().len() > 1;
                 for (i, s) in self.estimates().iter().enumerate() {

@@ -36,7 +36,7 @@ use crate::scene::Scene;
 use super::direct::DirectLight;
 use super::observer::{Progress, RenderObserver};
 use super::photon_map::MapEstimate;
-use super::photon_options::{CausticPaths, WithCausticMap};
+use super::photon_options::{CausticMap, CausticPaths, WithCausticMap, MAX_K};
 use super::sample::{FrameMethod, Prepare, SampleFrame};
 use super::{Image, Timings};
 
@@ -61,6 +61,9 @@ pub struct IgiOptions {
     /// The caustic map's paths: all light onto x from a mirror or glass, or
     /// only light straight from an emitter (the paper's).
     pub caustic_paths: CausticPaths,
+    /// k of the caustic map's estimate; None: the scene's, at most
+    /// `CAUSTIC_K`.
+    pub caustic_k: Option<u32>,
 }
 
 impl Default for IgiOptions {
@@ -75,11 +78,20 @@ impl Default for IgiOptions {
             interleave: 1,
             downsample: 1,
             caustic_paths: CausticPaths::All,
+            caustic_k: None,
         }
     }
 }
 
 impl IgiOptions {
+    /// The caustic map's paths and k.
+    pub fn caustic_map(&self) -> CausticMap {
+        CausticMap {
+            paths: self.caustic_paths,
+            k: self.caustic_k,
+        }
+    }
+
     /// The bounding distance in use for `scene`.
     pub fn min_distance_for(&self, scene: &Scene) -> f32 {
         self.min_distance.unwrap_or(scene.photon_map.max_radius)
@@ -113,6 +125,9 @@ impl IgiOptions {
                 self.downsample,
                 "the allowed range is 1..=16",
             ));
+        }
+        if let Some(k) = self.caustic_k {
+            Error::check_range("igi.caustic_k", k, 1..=MAX_K)?;
         }
         if let Some(m) = self.min_distance {
             if !(m >= 0.0 && m.is_finite()) {
@@ -478,7 +493,7 @@ impl IgiRun {
         observer: &mut dyn RenderObserver,
     ) -> Result<Self> {
         let (o, scene) = (&with.method, p.scene);
-        let caustics = MapEstimate::caustics(p, with, o.caustic_paths, timings, observer)?;
+        let caustics = MapEstimate::caustics(p, with, o.caustic_map(), timings, observer)?;
         let igi = Igi::new(p.gpu, scene, p.width, p.height, o)?;
         observer.progress(&Progress::stage("VPLs", 0, 1));
         let vpl_seed = crate::random::pcg_hash(p.seed ^ crate::layout::VPL_STREAM);

@@ -87,6 +87,16 @@ impl Method {
         }
     }
 
+    /// The k of the kNN-grid estimate at the first hits under a scene whose
+    /// own is `scene_k`: a caustic map's for IGI and radiosity.
+    pub fn first_hit_k(&self, scene_k: u32) -> u32 {
+        match self {
+            Method::Igi(o) => o.method.caustic_map().k_for(scene_k),
+            Method::Radiosity(o) => o.method.caustic_map().k_for(scene_k),
+            _ => scene_k,
+        }
+    }
+
     /// The photon-map method's options, if this is it.
     pub fn photon_map(&self) -> Option<&PhotonMapOptions> {
         match self {

@@ -16,7 +16,7 @@ use super::adaptive::{self, Adaptive, AdaptiveOptions, AdaptiveStats};
 use super::direct::DirectLight;
 use super::final_gather::{self, FinalGather, FinalGatherOptions, GatherStats};
 use super::observer::{At, EstimatePass, Progress, RenderObserver};
-use super::photon_options::{CausticPaths, PhotonMapOptions, WithCausticMap};
+use super::photon_options::{CausticMap, CausticPaths, PhotonMapOptions, WithCausticMap};
 use super::radiance_estimate::{EstimateOptions, EstimateStats, QueryPoints, RadianceEstimate};
 use super::sample::{FrameMethod, Prepare, SampleFrame};
 
@@ -52,6 +52,8 @@ pub struct MapEstimate {
     pub estimate: RadianceEstimate,
     pub stats: Vec<EstimateStats>,
     options: EstimateOptions,
+    /// The estimate's k where it is not the scene's (a caustic map's).
+    k: Option<u32>,
 }
 
 impl MapEstimate {
@@ -80,32 +82,34 @@ impl MapEstimate {
             estimate: RadianceEstimate::new(gpu, w, h)?,
             stats: Vec::new(),
             options: estimate.under(photons),
+            k: None,
         };
         Ok((map, built.frames))
     }
 
     /// A caustic map (IGI's and radiosity's): the paths through mirrors or
     /// glass onto a diffuse surface, which their own diffuse light cannot
-    /// carry, from an emitter only or from anywhere (`paths`); none in a
-    /// scene with nothing specular.
+    /// carry, from an emitter only or from anywhere (`caustic.paths`), read
+    /// with the caustic map's k; none in a scene with nothing specular.
     pub fn caustics<T>(
         p: &Prepare<'_>,
         o: &WithCausticMap<T>,
-        paths: CausticPaths,
+        caustic: CausticMap,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Option<Self>> {
-        Ok(Self::caustics_with_records(p, o, paths, timings, observer)?.map(|(map, _)| map))
+        Ok(Self::caustics_with_records(p, o, caustic, timings, observer)?.map(|(map, _)| map))
     }
 
     /// The caustic map and the traced records it was built from.
     pub fn caustics_with_records<T>(
         p: &Prepare<'_>,
         o: &WithCausticMap<T>,
-        paths: CausticPaths,
+        caustic: CausticMap,
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<Option<(Self, PhotonFrames)>> {
+        let (paths, k) = (caustic.paths, caustic.k_for(p.scene.photon_map.k));
         observer.progress(&Progress::stage("photons", 0, 1));
         if !p.scene.has_specular() {
             return Ok(None);
@@ -116,7 +120,9 @@ impl MapEstimate {
         caustic.photon_map.store_direct = false;
         let built = photon::build_map(p.gpu, &caustic, p.textures, &o.photons, p.seed, timings)?;
         let size = (p.width, p.height);
-        Self::with_frames(p.gpu, size, built, &o.photons, &o.estimate).map(Some)
+        let (mut map, frames) = Self::with_frames(p.gpu, size, built, &o.photons, &o.estimate)?;
+        map.k = Some(k);
+        Ok(Some((map, frames)))
     }
 
     /// The estimate at `queries`, its image read back unless `packed`.
@@ -137,6 +143,7 @@ impl MapEstimate {
             map: &self.map,
             estimate: &self.estimate,
             options: &self.options,
+            k: self.k.unwrap_or(f.scene.photon_map.k),
             at: f.at,
         };
         let (image, stats) = run.estimate(timings, observer)?;
@@ -405,6 +412,7 @@ struct EstimateRun<'a> {
     map: &'a PhotonMap,
     estimate: &'a RadianceEstimate,
     options: &'a EstimateOptions,
+    k: u32,
     at: At,
 }
 
@@ -417,7 +425,7 @@ impl EstimateRun<'_> {
         timings: &mut Timings,
         observer: &mut dyn RenderObserver,
     ) -> Result<(Option<Image>, EstimateStats)> {
-        let (k, max_radius) = (self.scene.photon_map.k, self.scene.photon_map.max_radius);
+        let (k, max_radius) = (self.k, self.scene.photon_map.max_radius);
         let options = self.options;
         let compose = || -> Result<Image> {
             self.estimate

@@ -44,6 +44,30 @@ pub enum CausticPaths {
     FromLights,
 }
 
+/// k of a caustic map's estimate when a method gives none and the scene's
+/// is larger: the paper's k for its caustic scene, GLASS BALL. A caustic is
+/// sharp, so a larger k blurs it more than it cuts the noise, and the
+/// scene's k may be a global map's (CORNELL BOX's 500).
+pub const CAUSTIC_K: u32 = 32;
+
+/// The largest k a caustic map's estimate may be given: the scene's limit.
+pub const MAX_K: u32 = crate::scene::defaults::MAX_K as u32;
+
+/// What a method's caustic map carries, and the k of its estimate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CausticMap {
+    pub paths: CausticPaths,
+    /// None: the scene's k, at most `CAUSTIC_K`.
+    pub k: Option<u32>,
+}
+
+impl CausticMap {
+    /// The k in use under a scene whose own is `scene_k`.
+    pub fn k_for(&self, scene_k: u32) -> u32 {
+        self.k.unwrap_or(scene_k.min(CAUSTIC_K))
+    }
+}
+
 /// A method's own options beside those of the caustic photon map it
 /// visualises at the first hits.
 #[derive(Clone, Debug, Default)]

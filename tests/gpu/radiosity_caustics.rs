@@ -4,6 +4,7 @@
 //! the image leaves to the caustic map.
 
 use photonmap::photon::PhotonMap;
+use photonmap::render::photon_options::CAUSTIC_K;
 use photonmap::render::RadiosityOptions;
 
 use super::radiosity::{box_sums, solve};
@@ -16,29 +17,7 @@ fn the_caustic_deposit_adds_the_reflected_power_of_every_caustic_photon() {
     // shot (the light's, the tile of most power, the same with and
     // without the deposit) and no subdivision, so what the deposit adds is
     // the difference of the two solutions.
-    let light = r#"
-[[light]]
-type = "area"
-corner = [-0.2, 0.98, -0.2]
-edge1 = [0.4, 0.0, 0.0]
-edge2 = [0.0, 0.0, 0.4]
-normal = [0.0, -1.0, 0.0]
-radiance = [1.0, 1.0, 1.0]
-
-[[shape]]
-type = "sphere"
-center = [0.0, -0.4, 0.0]
-radius = 0.4
-material = "mirror"
-"#;
-    let text = common::fixture_text("closed_box");
-    let (walls, _point_light) = text.split_once("[[light]]").unwrap();
-    let text = common::replace_once(
-        &format!("{walls}{light}"),
-        "wall = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }",
-        "wall = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\nmirror = { type = \"mirror\", reflectance = [1.0, 1.0, 1.0] }",
-    );
-    let scene = photonmap::scene::load_scene_str(&text, std::path::Path::new("r.toml")).unwrap();
+    let scene = mirror_ball_box("");
     let run = |shoot_caustics| {
         solve(
             &scene,
@@ -93,4 +72,60 @@ material = "mirror"
                 .caustic_shot_fraction
                 .is_none()
     );
+}
+
+/// The closed box of albedo 0.5 (scenes/tests/closed_box.toml) lit by a
+/// 0.4 x 0.4 area light under its ceiling, with a mirror ball under the
+/// light; `photon_map` holds the lines of its photon-map section.
+fn mirror_ball_box(photon_map: &str) -> photonmap::scene::Scene {
+    let light = r#"
+[[light]]
+type = "area"
+corner = [-0.2, 0.98, -0.2]
+edge1 = [0.4, 0.0, 0.0]
+edge2 = [0.0, 0.0, 0.4]
+normal = [0.0, -1.0, 0.0]
+radiance = [1.0, 1.0, 1.0]
+
+[[shape]]
+type = "sphere"
+center = [0.0, -0.4, 0.0]
+radius = 0.4
+material = "mirror"
+"#;
+    let text = common::fixture_text("closed_box");
+    let (walls, _point_light) = text.split_once("[[light]]").unwrap();
+    let text = common::replace_once(
+        &format!("{walls}{light}"),
+        "wall = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }",
+        "wall = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\nmirror = { type = \"mirror\", reflectance = [1.0, 1.0, 1.0] }",
+    );
+    let text = format!("{text}\n[photon_map]\n{photon_map}\n");
+    photonmap::scene::load_scene_str(&text, std::path::Path::new("r.toml")).unwrap()
+}
+
+#[test]
+fn the_caustic_map_reads_its_own_k_by_default_at_most_caustic_k() {
+    // A scene k above CAUSTIC_K: by default the caustic map's estimate reads
+    // CAUSTIC_K photons, and given one it reads that many.
+    let scene = mirror_ball_box("k = 200");
+    assert_eq!(scene.photon_map.k, 200);
+    let image = |caustic_k| {
+        solve(
+            &scene,
+            RadiosityOptions {
+                max_shots: 1,
+                subdivide: 0,
+                caustic_k,
+                ..RadiosityOptions::default()
+            },
+        )
+        .image
+    };
+    let by_default = image(None);
+    assert_eq!(
+        common::channels_differing(&by_default, &image(Some(CAUSTIC_K))),
+        0
+    );
+    assert!(common::channels_differing(&by_default, &image(Some(200))) > 0);
 }

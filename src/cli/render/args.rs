@@ -98,6 +98,12 @@ pub struct RenderArgs {
     /// straight from an emitter only (L S+ D).
     #[arg(long, value_enum, value_name = "PATHS")]
     pub caustic_paths: Option<CausticPaths>,
+    /// IGI and radiosity: k of their caustic map's estimate (1..=4096).
+    /// Default: the scene's photon_map.k, at most 32 (the paper's k for its
+    /// caustic scene): a caustic is sharp, and the scene's k may be a global
+    /// map's.
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub caustic_k: Option<u32>,
     #[command(flatten)]
     pub differentials: DifferentialsArgs,
     #[command(flatten)]
@@ -314,6 +320,7 @@ impl RenderArgs {
                 estimate,
                 method: IgiOptions {
                     caustic_paths: self.caustic_paths.unwrap_or_default(),
+                    caustic_k: self.caustic_k,
                     ..(&self.igi).into()
                 },
             }),
@@ -326,6 +333,7 @@ impl RenderArgs {
                 estimate,
                 method: RadiosityOptions {
                     caustic_paths: self.caustic_paths.unwrap_or_default(),
+                    caustic_k: self.caustic_k,
                     ..(&self.radiosity).into()
                 },
             }),
@@ -352,8 +360,9 @@ impl RenderArgs {
             || self.differentials.any_given()
             || self.radiosity.any_given()
             || self.caustic_paths.is_some()
+            || self.caustic_k.is_some()
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
         }
         Ok(())
     }
@@ -387,8 +396,10 @@ impl RenderArgs {
                 "--method radiosity computes the diffuse interreflection itself",
             ),
         ];
-        if self.caustic_paths.is_some() && !matches!(self.method, Method::Igi | Method::Radiosity) {
-            bail!("--caustic-paths chooses the caustic map of IGI and radiosity: add --method igi or --method radiosity");
+        if (self.caustic_paths.is_some() || self.caustic_k.is_some())
+            && !matches!(self.method, Method::Igi | Method::Radiosity)
+        {
+            bail!("--caustic-paths and --caustic-k choose the caustic map of IGI and radiosity: add --method igi or --method radiosity");
         }
         for (method, given, theirs, cannot) in methods {
             if self.method != method && given {

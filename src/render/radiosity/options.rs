@@ -2,7 +2,7 @@
 
 use crate::error::Error;
 use crate::gpu::Result;
-use crate::render::photon_options::CausticPaths;
+use crate::render::photon_options::{CausticMap, CausticPaths, MAX_K};
 
 /// How the radiosity solution runs.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -26,6 +26,9 @@ pub struct RadiosityOptions {
     /// The caustic map's paths: all light onto x from a mirror or glass, or
     /// only light straight from an emitter (form factors stop at both).
     pub caustic_paths: CausticPaths,
+    /// k of the caustic map's estimate; None: the scene's, at most
+    /// `CAUSTIC_K`.
+    pub caustic_k: Option<u32>,
     /// Whether the caustic map's records are deposited into the elements
     /// before the first shot, so that light from a mirror or glass bounces
     /// on from the diffuse surface it reached (L S+ D D+).
@@ -64,13 +67,25 @@ impl Default for RadiosityOptions {
             gradient: 0.25,
             form_factor: FormFactor::Polygon,
             caustic_paths: CausticPaths::All,
+            caustic_k: None,
             shoot_caustics: true,
         }
     }
 }
 
 impl RadiosityOptions {
+    /// The caustic map's paths and k.
+    pub fn caustic_map(&self) -> CausticMap {
+        CausticMap {
+            paths: self.caustic_paths,
+            k: self.caustic_k,
+        }
+    }
+
     pub fn check(&self) -> Result<()> {
+        if let Some(k) = self.caustic_k {
+            Error::check_range("radiosity.caustic_k", k, 1..=MAX_K)?;
+        }
         Error::check_range("radiosity.resolution", self.resolution, 2..=256)?;
         if self.substructure == 0 || !self.resolution.is_multiple_of(self.substructure) {
             return Err(Error::out_of_range(

@@ -28,7 +28,7 @@ impl RadiosityRun {
     ) -> Result<Self> {
         let o = &with.method;
         let found =
-            MapEstimate::caustics_with_records(p, with, o.caustic_paths, timings, observer)?;
+            MapEstimate::caustics_with_records(p, with, o.caustic_map(), timings, observer)?;
         let (caustics, records) = found.unzip();
         let mut radiosity = Radiosity::new(p.gpu, p.scene, p.width, p.height, o)?;
         if let Some(records) = records.filter(|_| o.shoot_caustics) {

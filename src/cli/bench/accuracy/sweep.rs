@@ -153,7 +153,8 @@ pub(super) fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     out
 }
 
-/// Instant global illumination: the canonical version, more VPLs, each of
+/// Instant global illumination: the canonical version, more VPLs, its
+/// caustic map from lights only and at the scene's k, each of
 /// Marques and Santos's accelerations alone, all three together, the remedy
 /// they suggest for the combination's artefacts (a 2 x 2 interleave), and 4
 /// spp (at 1 spp every method's error is mostly aliasing against the
@@ -176,6 +177,10 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
         out.push(igi("IGI 256 paths", &|o| o.vpl_paths = 256));
         out.push(igi("IGI, caustics from lights", &|o| {
             o.caustic_paths = CausticPaths::FromLights
+        }));
+        let scene_k = base.run.k;
+        out.push(igi("IGI, caustic map at the scene's k", &|o| {
+            o.caustic_k = Some(scene_k)
         }));
         out.push(igi("IGI, imperfect visibility", &|o| {
             o.imperfect_visibility = true
@@ -232,8 +237,8 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     out
 }
 
-/// Progressive radiosity: its defaults, its caustic map from lights only and
-/// not shot on, the chapter's ~10,000 elements of
+/// Progressive radiosity: its defaults, its caustic map from lights only,
+/// not shot on and at the scene's k, the chapter's ~10,000 elements of
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, resolution: u32, spp: u32| {
@@ -255,6 +260,11 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
             o.shoot_caustics = false;
         }
         out.push(not_shot);
+        let mut scene_k = rad("radiosity, caustic map at the scene's k", 16, 1);
+        if let RunMethod::Radiosity(o) = &mut scene_k.run.method {
+            o.caustic_k = Some(base.run.k);
+        }
+        out.push(scene_k);
         out.push(rad("radiosity, 32 elements", 32, 1));
         out.push(rad("radiosity, 4 spp", 16, 4));
     }
