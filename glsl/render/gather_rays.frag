@@ -10,12 +10,18 @@
 // caustic map's. Rays are cosine-distributed about the geometric normal, as
 // the estimate's albedo / pi at the first hit assumes: on a mesh with vertex
 // normals the gathered light follows the photon estimate's convention, not
-// the shadow rays' shading-normal cosine. src/reference/final_gather.rs is the twin.
+// the shadow rays' shading-normal cosine. src/twins/final_gather.rs is the twin.
+// With u_fade_distance = m > 0 the rays are IGI's bias compensation: a ray
+// queries only where it meets a diffuse surface straight from the pixel's
+// hit, weighted by 1 - f(d), the share of that connection IGI's bounded
+// geometry term leaves out; paths through mirrors and glass are the caustic
+// map's.
 #include "common/scene.glsl"
 #include "common/random.glsl"
 #include "common/sampling.glsl"
 #include "common/specular.glsl"
 #include "common/addressing.glsl"
+#include "common/vpl_bound.glsl"
 
 uniform sampler2D u_diffuse_position;   // the pixel's first diffuse hit, w = 1 where one exists
 uniform sampler2D u_diffuse_normal;     // facing the viewer, w = material + 1
@@ -26,6 +32,7 @@ uniform int u_first_ray;                // index of this batch's ray 0 among the
 uniform int u_batch_rays;               // rays in this batch: slots past them hold no query
 uniform int u_image_height;
 uniform int u_max_depth;                // specular bounces a gather ray may take
+uniform float u_fade_distance;          // IGI's bound m: gather only what it leaves out (0: off)
 
 layout(location = 0) out vec4 o_position;   // the gather hit, w = 1 where it is a query
 layout(location = 1) out vec4 o_normal;     // facing the gather ray, w = material + 1
@@ -61,6 +68,12 @@ void main() {
         vec3 p = surface_point(prim, o, d, hit, n);
         bool entering = dot(n, d) < 0.0;
         vec3 nf = entering ? n : -n;
+        if (u_fade_distance > 0.0) {
+            if (kind != MAT_DIFFUSE) return;
+            float left_out = 1.0 - vpl_bound(length(p - first.xyz), u_fade_distance);
+            if (left_out <= 0.0) return;
+            throughput = vec3(left_out);
+        }
         if (kind == MAT_DIFFUSE) {
             o_position = vec4(p, 1.0);
             o_normal = vec4(nf, float(mat + 1));

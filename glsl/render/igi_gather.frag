@@ -13,6 +13,7 @@
 // n (p.y mod n), scaled by the n^2 subsets.
 #include "common/scene.glsl"
 #include "render/igi_shading.glsl"
+#include "common/vpl_bound.glsl"
 
 uniform sampler2D u_diffuse_position;  // full resolution, w = 1 where a hit
 uniform sampler2D u_diffuse_normal;    // facing the viewer, w = material + 1
@@ -27,13 +28,6 @@ uniform int u_interleave;              // n: n x n subsets (1: none)
 uniform float u_min_distance;
 
 layout(location = 0) out vec4 o_incident;
-
-// Marques and Santos's f(a, b, d): 0 below a, 1 above b, quadratic between.
-float bound(float d) {
-    if (u_min_distance <= 0.0) return 1.0;
-    float s = clamp((d - 0.8 * u_min_distance) / (0.4 * u_min_distance), 0.0, 1.0);
-    return s * s;
-}
 
 void main() {
     ivec2 q = ivec2(gl_FragCoord.xy);
@@ -60,7 +54,7 @@ void main() {
         vec3 w = to / d;
         float cos_x = dot(nx, w), cos_y = -dot(ny, w);
         if (cos_x <= 0.0 || cos_y <= 0.0) continue;
-        float g = cos_x * cos_y / d2 * bound(d);
+        float g = cos_x * cos_y / d2 * vpl_bound(d, u_min_distance);
         if (g <= 0.0) continue;
         // Along w from the lifted origin the ray would meet y's plane early
         // wherever it faces x's (a floor seen from the ceiling), and y's own

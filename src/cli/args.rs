@@ -294,7 +294,7 @@ impl From<&SppmArgs> for SppmOptions {
 #[derive(Args, Clone, Debug)]
 pub struct IgiArgs {
     /// IGI: light paths traced for VPLs, one VPL at each diffuse hit (1..=1048576).
-    #[arg(long, default_value_t = 64, value_parser = in_range(1, 1 << 20))]
+    #[arg(long, default_value_t = IgiOptions::default().vpl_paths, value_parser = in_range(1, 1 << 20))]
     pub vpl_paths: u32,
     /// IGI: bounces of a VPL path at most (1..=64; Russian roulette ends most far sooner).
     #[arg(long, default_value_t = 32, value_parser = in_range(1, 64))]
@@ -314,17 +314,23 @@ pub struct IgiArgs {
     /// upsampled (1..=16; 1: off; the paper's 4).
     #[arg(long, value_name = "F", default_value_t = 1, value_parser = in_range(1, 16))]
     pub downsample: u32,
+    /// IGI: bias compensation's gather rays a pixel, which add the light the
+    /// bounded geometry term leaves out, read from a global photon map
+    /// (0..=1024; 0: off).
+    #[arg(long, value_name = "RAYS", default_value_t = IgiOptions::default().bias_compensation, value_parser = in_range(0, 1024))]
+    pub bias_compensation: u32,
 }
 
 impl IgiArgs {
     /// Whether any IGI switch differs from its default.
     pub fn any_given(&self) -> bool {
-        self.vpl_paths != 64
+        self.vpl_paths != IgiOptions::default().vpl_paths
             || self.vpl_bounces != 32
             || self.vpl_min_distance.is_some()
             || self.imperfect_visibility
             || self.interleave != 1
             || self.downsample != 1
+            || self.bias_compensation != IgiOptions::default().bias_compensation
     }
 }
 
@@ -337,6 +343,7 @@ impl From<&IgiArgs> for IgiOptions {
             imperfect_visibility: a.imperfect_visibility,
             interleave: a.interleave,
             downsample: a.downsample,
+            bias_compensation: a.bias_compensation,
             ..IgiOptions::default()
         }
     }

@@ -171,6 +171,37 @@ impl RenderOutput {
                 ),
             ));
         }
+        if let (Method::Igi(o), Some(run)) = (&options.method, self.igi_run()) {
+            let m = o.method.min_distance_for(scene);
+            lines.push(match &run.compensation {
+                Some(c) => {
+                    let passes: u32 = c.stats.iter().map(|s| s.batches + s.estimate_passes).sum();
+                    let hits: u64 = c.stats.iter().map(|s| s.queries).sum();
+                    line(
+                        "IGI bias compensation",
+                        passes as usize,
+                        true,
+                        format!(
+                            "the bound leaves out 1 - f(d) of each connection nearer than {:.4}; {} gather rays a pixel add it back from the diffuse surface each meets straight from the first hit ({hits} met one that near), estimated there by a global map of {} photons at k = {}",
+                            1.2 * m,
+                            c.rays(),
+                            c.photons_stored,
+                            c.k()
+                        ),
+                    )
+                }
+                None => line(
+                    "IGI bias compensation",
+                    0,
+                    false,
+                    if m > 0.0 {
+                        format!("off (--bias-compensation 0): the light between diffuse surfaces nearer than {:.4} is darkened by the bound, and below {:.4} missing", 1.2 * m, 0.8 * m)
+                    } else {
+                        "not needed: the geometry term is unbounded".to_string()
+                    },
+                ),
+            });
+        }
         lines.extend(self.method_lines(&options.method));
         if let Some(a) = photon_map.and_then(|o| o.adaptive.as_ref()) {
             let computed: u64 = self.adaptive().iter().map(|s| s.computed).sum();

@@ -123,13 +123,15 @@ impl FinalGather {
     }
 
     /// Traces gather rays `rays` (at most `batch` of them) of every pixel from
-    /// its first diffuse hit; the batch's unused slots hold no query.
+    /// its first diffuse hit; the batch's unused slots hold no query. With
+    /// `fade` = IGI's bound m > 0, only what that bound leaves out is
+    /// gathered (`gather_rays.frag`).
     pub fn trace_batch(
         &self,
         scene: &SceneTextures,
         first: QueryPoints<'_>,
         rays: std::ops::Range<u32>,
-        max_depth: u32,
+        (max_depth, fade): (u32, f32),
         seed: u32,
     ) -> Result<()> {
         let mut b = self.rays.bind();
@@ -143,6 +145,7 @@ impl FinalGather {
             .int("u_batch_rays", rays.len() as i32)
             .int("u_image_height", self.height as i32)
             .int("u_max_depth", max_depth as i32)
+            .float("u_fade_distance", fade)
             .draw_fullscreen(&self.rays_target, &DrawState::PLAIN)
     }
 
@@ -170,8 +173,8 @@ impl FinalGather {
 
     /// All gather rays of one eye sample from the first hits `first` (all of
     /// them, or the pixels adaptive sampling computes): the indirect light of
-    /// each, left in `indirect`. Adds the stages "gather rays", "gather
-    /// estimate" and "gather sum" to `timings`.
+    /// each, left in `indirect`; `fade` as `trace_batch` takes it. Adds the
+    /// stages "gather rays", "gather estimate" and "gather sum" to `timings`.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
@@ -182,7 +185,7 @@ impl FinalGather {
         options: &FinalGatherOptions,
         estimate: &EstimateOptions,
         max_radius: f32,
-        max_depth: u32,
+        depth_and_fade: (u32, f32),
         seed: u32,
         timings: &mut Timings,
         on_batch: &mut dyn FnMut(u32, u32),
@@ -199,7 +202,9 @@ impl FinalGather {
             let rays = self.batch.min(options.rays - done);
             self.gpu.finish();
             let t0 = std::time::Instant::now();
-            timer.around(|| self.trace_batch(scene, first, done..done + rays, max_depth, seed))?;
+            timer.around(|| {
+                self.trace_batch(scene, first, done..done + rays, depth_and_fade, seed)
+            })?;
             self.gpu.finish();
             timings.add_since("gather rays", timer.seconds(), t0, 1);
             let run = self.estimate.run(

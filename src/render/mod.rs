@@ -4,6 +4,7 @@
 //! own iterations. This file only declares and re-exports.
 
 pub mod adaptive;
+pub mod bias_compensation;
 pub mod differentials;
 pub mod direct;
 pub mod explain;

@@ -388,7 +388,7 @@ impl GatherRun<'_> {
             self.options,
             self.estimate,
             self.scene.photon_map.max_radius,
-            self.scene.render.max_specular_depth,
+            (self.scene.render.max_specular_depth, 0.0),
             seed,
             timings,
             &mut |done, total| {

@@ -29,7 +29,10 @@ fn offset_origin(p: Vec3, n: Vec3, dir: Vec3, floor: f32) -> Vec3 {
 }
 
 /// Gather ray `ray` of pixel `px` from its first diffuse hit at `first` with
-/// viewer-facing normal `n1`.
+/// viewer-facing normal `n1`. With `fade` = IGI's bound m > 0, the bias
+/// compensation's ray: only a diffuse hit straight from `first`, weighted by
+/// 1 - f(d).
+#[allow(clippy::too_many_arguments)]
 pub fn gather_ray(
     scene: &Scene,
     first: Vec3,
@@ -38,6 +41,7 @@ pub fn gather_ray(
     px: [u32; 2],
     ray: u32,
     max_depth: u32,
+    fade: f32,
 ) -> Option<GatherHit> {
     let floor = 1e-6 * scene.size();
     let mut rng = rng_init(seed, px, crate::layout::GATHER_STREAM | ray);
@@ -50,6 +54,16 @@ pub fn gather_ray(
         let material = scene.shapes[shape].material;
         let entering = n.dot(d) < 0.0;
         let nf = if entering { n } else { -n };
+        if fade > 0.0 {
+            let Material::Diffuse { .. } = scene.materials[material] else {
+                return None;
+            };
+            let left_out = 1.0 - super::igi::bound((p - first).length(), fade);
+            if left_out <= 0.0 {
+                return None;
+            }
+            throughput = Vec3::splat(left_out);
+        }
         let ior = match scene.materials[material] {
             Material::Emitter { .. } => return None,
             Material::Diffuse { .. } => {

@@ -114,7 +114,8 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
     }
 }
 
-/// IGI as a user runs it: the JSON reports the VPLs and the gather; IGI's
+/// IGI as a user runs it: the JSON reports the VPLs, the gather and the
+/// bias compensation; IGI's
 /// switches without `--method igi`, the one-shot estimate's accelerations
 /// with it, and impossible values are refused with a reason, writing nothing.
 #[test]
@@ -148,8 +149,23 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
     );
     let per_point = json["igi_samples"][0]["vpls_per_point"].as_f64().unwrap();
     assert_eq!(per_point, vpls as f64 / 4.0);
-    let refused: [(&[&str], &str); 7] = [
+    assert_eq!(
+        json["igi"]["bias_compensation"], 16,
+        "compensated by default"
+    );
+    let compensation = &json["bias_compensation_samples"][0];
+    assert_eq!(compensation["rays_per_pixel"], 16);
+    assert!(
+        compensation["queries"].as_u64().unwrap() > 0,
+        "{compensation}"
+    );
+    let refused: [(&[&str], &str); 9] = [
         (&["--interleave", "3"], "--method igi"),
+        (&["--bias-compensation", "8"], "--method igi"),
+        (
+            &["--method", "igi", "--bias-compensation", "1025"],
+            "0..=1024",
+        ),
         (&["--method", "sppm", "--interleave", "3"], "IGI's switches"),
         (&["--method", "igi", "--direct-only"], "--direct-only"),
         (&["--method", "igi", "--adaptive"], "--adaptive"),

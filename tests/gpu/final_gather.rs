@@ -9,7 +9,8 @@ use photonmap::photon::PhotonConfig;
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::{
-    render, EstimateOptions, FinalGatherOptions, Method, PhotonMapOptions, RenderOptions,
+    render, DirectLight, EstimateOptions, FinalGather, FinalGatherOptions, Method,
+    PhotonMapOptions, RenderOptions,
 };
 use photonmap::scene::{Material, Scene};
 use photonmap::twins::final_gather::{gather_ray, gathered_radiance, GatherHit};
@@ -53,19 +54,72 @@ fn final_gather_equals_its_cpu_twin() {
     let fg = out.gather().unwrap();
     assert_eq!(fg.batch, rays, "one batch holds every ray");
     let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
-    let first = common::texels(&out.state.direct.diffuse_position);
-    let first_normal = common::texels(&out.state.direct.diffuse_normal);
-    let first_throughput = common::texels(&out.state.direct.diffuse_throughput);
+    let depth_and_fade = (scene.render.max_specular_depth, 0.0);
+    let c = compare_with_twin(
+        &scene,
+        &out.state.direct,
+        fg,
+        &map,
+        (seed, rays, k),
+        depth_and_fade,
+    );
+    let TwinCheck {
+        rays_checked,
+        rays_apart,
+        through_specular,
+        pixels,
+        pixels_apart,
+    } = c;
+    eprintln!(
+        "final gather twin: {rays_apart} of {rays_checked} rays apart ({through_specular} through mirror or glass), {pixels_apart} of {pixels} pixels apart"
+    );
+    assert!(through_specular > 50, "the scene exercises specular chains");
+    assert!(rays_apart * 200 <= rays_checked, "{rays_apart} rays apart");
+    assert!(pixels_apart * 100 <= pixels, "{pixels_apart} pixels apart");
+}
+
+/// What `compare_with_twin` counted.
+pub struct TwinCheck {
+    pub rays_checked: u32,
+    pub rays_apart: u32,
+    /// GPU rays whose hit came through a mirror or glass, or was weighted.
+    pub through_specular: u32,
+    pub pixels: u32,
+    pub pixels_apart: u32,
+}
+
+/// Each gather ray of `fg` (one batch holding every ray) against the CPU's
+/// ray from the same first hit and random numbers, and each pixel's indirect
+/// light against the CPU kNN-grid's estimates at the GPU's hits on `map`.
+pub fn compare_with_twin(
+    scene: &Scene,
+    direct: &DirectLight,
+    fg: &FinalGather,
+    map: &CpuPhotonMap,
+    (seed, rays, k): (u32, u32, u32),
+    (max_depth, fade): (u32, f32),
+) -> TwinCheck {
+    let (w, h) = (
+        direct.diffuse_position.width,
+        direct.diffuse_position.height,
+    );
+    let first = common::texels(&direct.diffuse_position);
+    let first_normal = common::texels(&direct.diffuse_normal);
+    let first_throughput = common::texels(&direct.diffuse_throughput);
     let (gp, gn, gt) = (
         common::texels(&fg.position),
         common::texels(&fg.normal),
         common::texels(&fg.throughput),
     );
     let indirect = common::texels(&fg.indirect);
-    let max_depth = scene.render.max_specular_depth;
     let max_radius = scene.photon_map.max_radius;
-    let (mut rays_checked, mut rays_apart, mut through_specular) = (0, 0, 0);
-    let (mut pixels, mut pixels_apart) = (0, 0);
+    let mut c = TwinCheck {
+        rays_checked: 0,
+        rays_apart: 0,
+        through_specular: 0,
+        pixels: 0,
+        pixels_apart: 0,
+    };
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
@@ -75,15 +129,15 @@ fn final_gather_equals_its_cpu_twin() {
             let mut sum = Vec3::ZERO;
             for j in 0..rays {
                 let g = i + (j * w * h) as usize;
-                let n1 = common::v3(first_normal[i]);
-                let cpu = gather_ray(&scene, common::v3(first[i]), n1, seed, [x, y], j, max_depth);
+                let (p1, n1) = (common::v3(first[i]), common::v3(first_normal[i]));
+                let cpu = gather_ray(scene, p1, n1, seed, [x, y], j, max_depth, fade);
                 let gpu_hit = (gp[g][3] > 0.0).then(|| GatherHit {
                     position: common::v3(gp[g]),
                     normal: common::v3(gn[g]),
                     material: gn[g][3] as usize - 1,
                     throughput: common::v3(gt[g]),
                 });
-                rays_checked += 1;
+                c.rays_checked += 1;
                 let same = match (&cpu, &gpu_hit) {
                     (None, None) => true,
                     (Some(a), Some(b)) => {
@@ -94,13 +148,13 @@ fn final_gather_equals_its_cpu_twin() {
                     _ => false,
                 };
                 if !same {
-                    rays_apart += 1;
+                    c.rays_apart += 1;
                 }
                 if let Some(hit) = gpu_hit {
                     if hit.throughput != Vec3::ONE {
-                        through_specular += 1;
+                        c.through_specular += 1;
                     }
-                    sum += gathered_radiance(&scene, &map, &hit, k, max_radius);
+                    sum += gathered_radiance(scene, map, &hit, k, max_radius);
                 }
             }
             let Material::Diffuse { albedo } = scene.materials[first_normal[i][3] as usize - 1]
@@ -109,18 +163,13 @@ fn final_gather_equals_its_cpu_twin() {
             };
             let expected = common::v3(first_throughput[i]) * albedo * sum / rays as f32;
             let got = common::v3(indirect[i]);
-            pixels += 1;
+            c.pixels += 1;
             if (got - expected).abs().max_element() > 1e-4 + 1e-3 * expected.max_element() {
-                pixels_apart += 1;
+                c.pixels_apart += 1;
             }
         }
     }
-    eprintln!(
-        "final gather twin: {rays_apart} of {rays_checked} rays apart ({through_specular} through mirror or glass), {pixels_apart} of {pixels} pixels apart"
-    );
-    assert!(through_specular > 50, "the scene exercises specular chains");
-    assert!(rays_apart * 200 <= rays_checked, "{rays_apart} rays apart");
-    assert!(pixels_apart * 100 <= pixels, "{pixels_apart} pixels apart");
+    c
 }
 
 /// The furnace: a closed diffuse sphere (albedo 1/2, radius 1) with a point

@@ -7,6 +7,7 @@
 mod common;
 
 mod adaptive;
+mod bias_compensation;
 mod bit_identical;
 mod bvh;
 mod differentials;

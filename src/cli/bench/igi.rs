@@ -26,7 +26,7 @@ use crate::cli::args::in_range;
 pub struct IgiBenchArgs {
     #[command(flatten)]
     pub scene: BenchScene,
-    /// Light paths for VPLs (1..=1048576).
+    /// Light paths for VPLs (1..=1048576; the paper's 64 by default, not the render default).
     #[arg(long, default_value_t = 64, value_parser = in_range(1, 1 << 20))]
     pub vpl_paths: u32,
     /// Folder for each row's PNG (default photonmap-out/igi/<scene>).
@@ -73,8 +73,10 @@ pub struct IgiBench {
 
 /// The rows: the paper's four cumulative versions, then its remedies.
 fn rows(paths: u32) -> Vec<(&'static str, IgiOptions)> {
+    // The paper's versions: without the bias compensation added to the default.
     let base = IgiOptions {
         vpl_paths: paths,
+        bias_compensation: 0,
         ..IgiOptions::default()
     };
     let imperfect = IgiOptions {

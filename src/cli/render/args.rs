@@ -380,7 +380,7 @@ impl RenderArgs {
             (
                 Method::Igi,
                 self.igi.any_given(),
-                "--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave and --downsample are IGI's: add --method igi",
+                "--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample and --bias-compensation are IGI's: add --method igi",
                 "--method igi has its own accelerations (--interleave, --downsample) and its image is no one-map estimate",
             ),
             (

@@ -70,6 +70,7 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "igi": igi,
                 "vpls": out.vpls(),
                 "igi_samples": out.igi(),
+                "bias_compensation_samples": out.igi_run().and_then(|r| r.compensation.as_ref()).map(|c| &c.stats),
                 "differentials": out.differentials(),
                 "footprint_samples": out.footprint_estimates(),
                 "radiosity": out.radiosity(),
@@ -127,6 +128,16 @@ pub(super) fn print_summary(
             } else {
                 "none (nothing specular in the scene)"
             }
+        );
+    }
+    if let Some(c) = out.igi_run().and_then(|r| r.compensation.as_ref()) {
+        let hits: u64 = c.stats.iter().map(|s| s.queries).sum();
+        eprintln!(
+            "IGI bias compensation: {} rays a pixel, {hits} met a diffuse surface nearer than 1.2 x {} (global map of {} photons, k = {})",
+            c.rays(),
+            c.fade(),
+            c.photons_stored,
+            c.k()
         );
     }
     if let Some(r) = out.radiosity() {

@@ -153,8 +153,9 @@ pub(super) fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
     out
 }
 
-/// Instant global illumination: the canonical version, more VPLs, its
-/// caustic map from lights only and at the scene's k, each of
+/// Instant global illumination: the default, the paper's 64 paths, each
+/// without its bias compensation, its caustic map from lights only and at
+/// the scene's k, each of
 /// Marques and Santos's accelerations alone, all three together, the remedy
 /// they suggest for the combination's artefacts (a 2 x 2 interleave), and 4
 /// spp (at 1 spp every method's error is mostly aliasing against the
@@ -174,7 +175,14 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     out.push(igi("IGI", &|_| {}));
     out.push(igi("IGI, all three accelerations", &all_three));
     if !quick {
-        out.push(igi("IGI 256 paths", &|o| o.vpl_paths = 256));
+        out.push(igi("IGI 64 paths", &|o| o.vpl_paths = 64));
+        out.push(igi("IGI, no bias compensation", &|o| {
+            o.bias_compensation = 0
+        }));
+        out.push(igi("IGI 64 paths, no bias compensation", &|o| {
+            o.vpl_paths = 64;
+            o.bias_compensation = 0;
+        }));
         out.push(igi("IGI, caustics from lights", &|o| {
             o.caustic_paths = CausticPaths::FromLights
         }));
@@ -191,9 +199,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
             all_three(o);
             o.interleave = 2;
         }));
-        out.push(igi("IGI 256 paths, all three", &|o| {
+        out.push(igi("IGI 1024 paths, all three", &|o| {
             all_three(o);
-            o.vpl_paths = 256;
+            o.vpl_paths = 1024;
         }));
         // At 1 spp every method's error is mostly aliasing against the
         // antialiased reference; 4 spp compares the estimators.
@@ -202,9 +210,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
                 "IGI, 4 spp",
                 &(|_: &mut IgiOptions| {}) as &dyn Fn(&mut IgiOptions),
             ),
-            ("IGI 256 paths, all three, 4 spp", &|o: &mut IgiOptions| {
+            ("IGI 1024 paths, all three, 4 spp", &|o: &mut IgiOptions| {
                 all_three(o);
-                o.vpl_paths = 256;
+                o.vpl_paths = 1024;
             }),
         ] {
             let mut c = igi(label, f);
