@@ -16,7 +16,7 @@
 use crate::gpu::Result;
 use crate::photon::{self, PhotonConfig, PhotonMap};
 
-use super::final_gather::{FinalGather, FinalGatherOptions, GatherStats};
+use super::final_gather::{self, FinalGather, FinalGatherOptions, GatherStats};
 use super::observer::{Progress, RenderObserver};
 use super::radiance_estimate::EstimateOptions;
 use super::sample::{Prepare, SampleFrame};
@@ -52,12 +52,8 @@ impl BiasCompensation {
             return Ok(None);
         }
         observer.progress(&Progress::stage("bias compensation photons", 0, 1));
-        let mut global = p.scene.clone();
-        global.photon_map.caustics_only = false;
-        global.photon_map.specular_last_only = false;
-        global.photon_map.store_direct = true;
-        // Its own seed: independent of the caustic map's photons and the VPLs.
-        let seed = crate::random::pcg_hash(p.seed ^ crate::layout::GATHER_STREAM);
+        let global = final_gather::global_scene(p.scene);
+        let seed = final_gather::global_seed(p.seed);
         let built = photon::build_map(p.gpu, &global, p.textures, photons, seed, timings)?;
         let options = FinalGatherOptions {
             rays,

@@ -258,8 +258,21 @@ pub fn map_scenes(scene: &Scene) -> Result<(Scene, Scene)> {
     let mut caustic = scene.clone();
     caustic.photon_map.caustics_only = true;
     caustic.photon_map.store_direct = false;
+    Ok((caustic, global_scene(scene)))
+}
+
+/// The scene whose photon map is a global map: every diffuse hit stored,
+/// the first included (final gather's, and IGI's bias compensation's).
+pub fn global_scene(scene: &Scene) -> Scene {
     let mut global = scene.clone();
     global.photon_map.caustics_only = false;
+    global.photon_map.specular_last_only = false;
     global.photon_map.store_direct = true;
-    Ok((caustic, global))
+    global
+}
+
+/// The global map's seed for a render seeded `seed`: independent of the
+/// caustic map's photons (which take `seed` itself) and of the VPLs.
+pub fn global_seed(seed: u32) -> u32 {
+    crate::random::pcg_hash(seed ^ crate::layout::GATHER_STREAM)
 }

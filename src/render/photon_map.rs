@@ -215,8 +215,7 @@ impl PhotonMapRun {
                 } else {
                     None
                 };
-                // Another seed: the two maps' photons are independent.
-                let global_seed = crate::random::pcg_hash(seed ^ crate::layout::GATHER_STREAM);
+                let global_seed = final_gather::global_seed(seed);
                 let global =
                     photon::build_map(gpu, &global, textures, &o.photons, global_seed, timings)?;
                 (caustic, Some((global, fg)))

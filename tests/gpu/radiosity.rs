@@ -545,14 +545,9 @@ pub(crate) fn box_sums(out: &RenderOutput) -> (f64, f64, f64) {
     sums
 }
 
-#[test]
-fn in_a_closed_box_the_power_shot_is_the_power_received() {
-    // A 0.4 x 0.4 light (radiance 1) just under the ceiling, facing down:
-    // its one shot (power pi L A) all lands on the box, which reflects rho
-    // of it into radiosity and absorbs the rest. The received power,
-    // direct x area / rho, is a midpoint rule over receivers: its error at
-    // 16 elements is about a third of the change from 8 (Richardson).
-    let light = r#"
+/// A 0.4 x 0.4 area light (radiance 1) just under the closed box's ceiling,
+/// facing down.
+pub const CEILING_LIGHT: &str = r#"
 [[light]]
 type = "area"
 corner = [-0.2, 0.98, -0.2]
@@ -561,7 +556,15 @@ edge2 = [0.0, 0.0, 0.4]
 normal = [0.0, -1.0, 0.0]
 radiance = [1.0, 1.0, 1.0]
 "#;
-    let s = closed_box(light);
+
+#[test]
+fn in_a_closed_box_the_power_shot_is_the_power_received() {
+    // A 0.4 x 0.4 light (radiance 1) just under the ceiling, facing down:
+    // its one shot (power pi L A) all lands on the box, which reflects rho
+    // of it into radiosity and absorbs the rest. The received power,
+    // direct x area / rho, is a midpoint rule over receivers: its error at
+    // 16 elements is about a third of the change from 8 (Richardson).
+    let s = closed_box(CEILING_LIGHT);
     let shot = std::f64::consts::PI * 0.16;
     let received = |res: u32| {
         let out = solve(

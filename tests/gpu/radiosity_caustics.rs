@@ -78,15 +78,7 @@ fn the_caustic_deposit_adds_the_reflected_power_of_every_caustic_photon() {
 /// 0.4 x 0.4 area light under its ceiling, with a mirror ball under the
 /// light; `photon_map` holds the lines of its photon-map section.
 fn mirror_ball_box(photon_map: &str) -> photonmap::scene::Scene {
-    let light = r#"
-[[light]]
-type = "area"
-corner = [-0.2, 0.98, -0.2]
-edge1 = [0.4, 0.0, 0.0]
-edge2 = [0.0, 0.0, 0.4]
-normal = [0.0, -1.0, 0.0]
-radiance = [1.0, 1.0, 1.0]
-
+    let ball = r#"
 [[shape]]
 type = "sphere"
 center = [0.0, -0.4, 0.0]
@@ -96,7 +88,7 @@ material = "mirror"
     let text = common::fixture_text("closed_box");
     let (walls, _point_light) = text.split_once("[[light]]").unwrap();
     let text = common::replace_once(
-        &format!("{walls}{light}"),
+        &format!("{walls}{}{ball}", crate::radiosity::CEILING_LIGHT),
         "wall = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }",
         "wall = { type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }\nmirror = { type = \"mirror\", reflectance = [1.0, 1.0, 1.0] }",
     );
