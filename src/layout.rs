@@ -99,6 +99,12 @@ pub const FOOTPRINT_THICKNESS: f32 = 0.1;
 /// Nodes of the footprint BVH one pass of the footprint estimate visits per
 /// pixel at most (bounds work per pass).
 pub const FOOTPRINT_BUDGET: u32 = 256;
+/// A coverage probe (photon/footprints.frag) lands on the photon's surface
+/// only where the surface it meets is within this cosine of the footprint's
+/// plane.
+pub const COVERAGE_NORMAL_COS: f32 = 0.5;
+/// Surfaces of other materials a coverage probe passes through at most.
+pub const COVERAGE_CROSSINGS: u32 = 4;
 
 /// Vertices of a radiosity shooter's outline at most (glsl/radiosity/
 /// form_factor.glsl): a curved block's four edges in CURVED_OUTLINE_SEGMENTS
@@ -160,6 +166,8 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("DISC_THICKNESS", format!("{DISC_THICKNESS:?}")),
         ("CULL_SLACK", format!("{CULL_SLACK:?}")),
         ("FOOTPRINT_THICKNESS", format!("{FOOTPRINT_THICKNESS:?}")),
+        ("COVERAGE_NORMAL_COS", format!("{COVERAGE_NORMAL_COS:?}")),
+        ("COVERAGE_CROSSINGS", u(COVERAGE_CROSSINGS)),
         ("TILE_ROW", u(TILE_ROW)),
         ("LOCAL_BLOCK", u(SORT_BLOCK)),
         ("SHOOTER_OUTLINE", u(SHOOTER_OUTLINE)),

@@ -6,7 +6,12 @@
 // range of radii), one that has been only specular (a caustic) s_c Delta dp;
 // each semi-axis is then clamped to the maximum radius. Degenerate footprints
 // (a zero or non-finite area) get area 0 and are skipped by every pass after.
+// With u_coverage_samples > 0 the area kept is the ellipse's share on the
+// photon's own surface (footprint_coverage), so that a footprint overhanging
+// an edge, a corner or an occluder still spreads all its power over the
+// surface instead of losing the part that hangs over.
 #include "common/footprint.glsl"
+#include "common/scene.glsl"
 
 uniform isampler2D u_sorted;      // (Morton code, record) in order
 uniform sampler2D u_position;     // photon records
@@ -21,6 +26,8 @@ uniform float u_smoothing;        // s
 uniform float u_caustic_smoothing;
 uniform float u_max_radius;
 uniform float u_power_scale;
+uniform int u_coverage_samples;   // 0: the whole ellipse counts
+uniform int u_epanechnikov;       // weigh the coverage by the kernel
 
 layout(location = 0) out vec4 o_footprint0;
 layout(location = 1) out vec4 o_footprint1;
@@ -33,6 +40,48 @@ vec3 semi_axis(vec3 dp, bool diffuse) {
                         : u_caustic_smoothing * u_delta * dp;
     float r = length(axis);
     return r > u_max_radius ? axis * (u_max_radius / r) : axis;
+}
+
+// The kernel-weighted share of the ellipse p + alpha a + beta b on the
+// surface of `material`: at u_coverage_samples points q of a Vogel spiral
+// (uniform in area), a probe from h above q's plane down its normal, 2 h
+// long, must meet that material facing along the normal. It passes through
+// whatever else it meets first (an occluder above the surface, such as a
+// ball resting on it, hides q from the probe, not from the eye), up to
+// COVERAGE_CROSSINGS surfaces. h = 0.5 rho (rho: q's distance from p) plus
+// the footprint's thickness, so a surface curved away by rho^2 / 2R is met
+// for radii of curvature R above rho. 1 when no probe lands (a footprint
+// on a surface the probes cannot find is kept whole).
+float footprint_coverage(vec3 p, vec3 a, vec3 b, float thickness, int material) {
+    if (u_coverage_samples <= 0) return 1.0;
+    vec3 n = normalize(cross(a, b));
+    float golden = PI * (3.0 - sqrt(5.0));
+    float covered = 0.0, total = 0.0;
+    for (int i = 0; i < u_coverage_samples; ++i) {
+        float u2 = (float(i) + 0.5) / float(u_coverage_samples);
+        float phi = float(i) * golden;
+        vec3 q = p + sqrt(u2) * (cos(phi) * a + sin(phi) * b);
+        float w = u_epanechnikov != 0 ? 1.0 - u2 : 1.0;
+        total += w;
+        float h = 0.5 * distance(q, p) + thickness + 2.0 * offset_scale(q);
+        vec3 o = q + n * h;
+        float left = 2.0 * h;
+        for (int crossing = 0; crossing < COVERAGE_CROSSINGS; ++crossing) {
+            vec4 hit;
+            int prim = closest_hit(o, -n, hit);
+            if (prim < 0 || hit.x > left) break;
+            vec3 normal;
+            vec3 x = surface_point(prim, o, -n, hit, normal);
+            if (primitive_material(prim) == material && abs(dot(normal, n)) >= COVERAGE_NORMAL_COS) {
+                covered += w;
+                break;
+            }
+            float step = dot(o - x, n) + 2.0 * offset_scale(x);
+            o -= n * step;
+            left -= step;
+        }
+    }
+    return covered > 0.0 ? covered / total : 1.0;
 }
 
 void main() {
@@ -54,7 +103,9 @@ void main() {
     float area = PI * length(cross(a, b));
     if (!(area > 0.0) || isinf(area)) area = 0.0;
     float thickness = FOOTPRINT_THICKNESS * max(length(a), length(b));
-    o_footprint0 = vec4(texelFetch(u_position, t, 0).xyz, area);
+    vec4 position = texelFetch(u_position, t, 0);
+    if (area > 0.0) area *= footprint_coverage(position.xyz, a, b, thickness, int(position.w));
+    o_footprint0 = vec4(position.xyz, area);
     o_footprint1 = vec4(a, diffuse ? 1.0 : 0.0);
     o_footprint2 = vec4(b, thickness);
     o_footprint3 = vec4(texelFetch(u_power, t, 0).rgb * u_power_scale, 0.0);

@@ -6,6 +6,7 @@ use photonmap::scene::import::ImportOptions;
 
 use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
+use photonmap::render::differentials::COVERAGE_SAMPLES;
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::radiosity::FormFactor;
 use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart};
@@ -373,6 +374,13 @@ pub struct DifferentialsArgs {
     /// Differentials: the kernel over a footprint.
     #[arg(long, value_enum, default_value_t = Kernel::Constant)]
     pub kernel: Kernel,
+    /// Differentials: probes of each footprint's share on its own surface
+    /// (0..=256; 0: none, the whole ellipse counts). A footprint that
+    /// overhangs an edge, a corner or an occluder then spreads all its power
+    /// over the surface it is on instead of losing the overhang.
+    #[arg(long, value_name = "N", default_value_t = COVERAGE_SAMPLES,
+          value_parser = in_range(0, 256))]
+    pub footprint_coverage: u32,
 }
 
 /// Progressive radiosity's switches (`--method radiosity`).
@@ -502,6 +510,7 @@ impl DifferentialsArgs {
             || self.footprint_max_radius.is_some()
             || self.leaf_size != AutoOr::Auto
             || self.kernel != Kernel::Constant
+            || self.footprint_coverage != COVERAGE_SAMPLES
     }
 }
 
@@ -513,6 +522,7 @@ impl From<&DifferentialsArgs> for DifferentialsOptions {
             max_radius: a.footprint_max_radius,
             leaf_size: a.leaf_size.value(),
             kernel: a.kernel,
+            coverage_samples: a.footprint_coverage,
         }
     }
 }

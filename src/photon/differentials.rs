@@ -150,6 +150,10 @@ pub struct FootprintOptions {
     pub max_radius: f32,
     /// T: footprints a leaf (None: the automatic threshold).
     pub leaf_size: Option<u32>,
+    /// Probes a footprint for its share on its own surface (0: none, the
+    /// whole ellipse counts); weighted by the Epanechnikov kernel if asked.
+    pub coverage_samples: u32,
+    pub coverage_epanechnikov: bool,
 }
 
 /// The footprints in Morton order and their BVH.
@@ -303,6 +307,7 @@ impl FootprintBuilder {
     pub fn build(
         &self,
         scene: &Scene,
+        textures: &SceneTextures,
         frames: &PhotonFrames,
         diffs: &DifferentialFrames,
         options: &FootprintOptions,
@@ -341,9 +346,9 @@ impl FootprintBuilder {
         let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
         let footprints = [t()?, t()?, t()?, t()?];
         let delta = 2.0 * (std::f32::consts::PI / frames.photons_used as f32).sqrt();
-        self.footprints
-            .bind()
-            .texture("u_sorted", &sorted)
+        let mut b = self.footprints.bind();
+        textures.bind(&mut b);
+        b.texture("u_sorted", &sorted)
             .texture("u_position", &frames.position)
             .texture("u_power", &frames.power)
             .texture("u_incoming", &frames.incoming)
@@ -356,10 +361,13 @@ impl FootprintBuilder {
             .float("u_caustic_smoothing", options.caustic_smoothing)
             .float("u_max_radius", options.max_radius)
             .float("u_power_scale", frames.power_scale)
+            .int("u_coverage_samples", options.coverage_samples as i32)
+            .int("u_epanechnikov", i32::from(options.coverage_epanechnikov))
             .draw_fullscreen(
                 &Target::new(gpu, &footprints.each_ref())?,
                 &DrawState::PLAIN,
             )?;
+        drop(b);
         clock.stop(timings, "footprints", 1);
         // The footprints' total area (the automatic leaf size), by read-back.
         let totals = FootprintTotals::read(&footprints, count);

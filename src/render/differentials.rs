@@ -63,7 +63,14 @@ pub struct DifferentialsOptions {
     /// T (None: the paper's automatic threshold).
     pub leaf_size: Option<u32>,
     pub kernel: Kernel,
+    /// Probes a footprint for its share on its own surface, so one that
+    /// overhangs an edge keeps its power (0: the whole ellipse counts).
+    pub coverage_samples: u32,
 }
+
+/// Coverage probes a footprint by default: enough that one probe is 1/16 of
+/// the ellipse.
+pub const COVERAGE_SAMPLES: u32 = 16;
 
 impl Default for DifferentialsOptions {
     fn default() -> Self {
@@ -73,6 +80,7 @@ impl Default for DifferentialsOptions {
             max_radius: None,
             leaf_size: None,
             kernel: Kernel::Constant,
+            coverage_samples: COVERAGE_SAMPLES,
         }
     }
 }
@@ -94,6 +102,13 @@ impl DifferentialsOptions {
         if let Some(r) = self.max_radius {
             Error::check_positive("differentials.max_radius", r, "give a radius above 0")?;
         }
+        if self.coverage_samples > 256 {
+            return Err(Error::out_of_range(
+                "differentials.coverage_samples",
+                self.coverage_samples,
+                "the allowed range is 0..=256 (0: no coverage probes)",
+            ));
+        }
         if let Some(t) = self.leaf_size {
             if !(1..=1024).contains(&t) {
                 return Err(Error::out_of_range(
@@ -112,6 +127,8 @@ impl DifferentialsOptions {
             caustic_smoothing: self.caustic_smoothing,
             max_radius: self.max_radius.unwrap_or(scene.photon_map.max_radius),
             leaf_size: self.leaf_size,
+            coverage_samples: self.coverage_samples,
+            coverage_epanechnikov: self.kernel == Kernel::Epanechnikov,
         }
     }
 }
@@ -338,6 +355,8 @@ pub struct DifferentialsReport {
     pub leaf_size: u32,
     pub auto_leaf_size: u32,
     pub leaves: u32,
+    /// Coverage probes a footprint (0: the whole ellipse counts).
+    pub coverage_samples: u32,
     pub total_footprint_area: f64,
     pub surface_area: f64,
     pub delta: f32,
@@ -396,6 +415,7 @@ impl DifferentialsRun {
                     let options = self.options.footprint_options(f.scene, 1.0);
                     let pilot = self.builder.build(
                         f.scene,
+                        f.textures,
                         &self.photons.frames,
                         &self.photons.differentials,
                         &options,
@@ -429,6 +449,7 @@ impl DifferentialsRun {
             let mut stages = Timings::default();
             let map = self.builder.build(
                 f.scene,
+                f.textures,
                 &self.photons.frames,
                 &self.photons.differentials,
                 &options,
@@ -458,6 +479,7 @@ impl DifferentialsRun {
             leaf_size: m.leaf_size,
             auto_leaf_size: m.auto_leaf_size,
             leaves: m.leaves,
+            coverage_samples: m.options.coverage_samples,
             total_footprint_area: m.total_area,
             surface_area: m.surface_area,
             delta: m.delta,

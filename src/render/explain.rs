@@ -257,7 +257,7 @@ impl RenderOutput {
                 d.frames_traced as usize,
                 true,
                 format!(
-                    "{} photons traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {} caustic: {}), semi-axes at most {}",
+                    "{} photons traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {} caustic: {}), semi-axes at most {}; {}",
                     d.trace.photons_used,
                     d.footprints,
                     d.diffuse_footprints,
@@ -268,7 +268,11 @@ impl RenderOutput {
                     },
                     d.footprints - d.diffuse_footprints,
                     d.caustic_smoothing,
-                    d.max_radius
+                    d.max_radius,
+                    match d.coverage_samples {
+                        0 => "each footprint's whole ellipse counts, so the part overhanging an edge, a corner or an occluder is lost".to_string(),
+                        n => format!("each footprint's area is its share on its own surface, found by {n} probes, so one overhanging an edge, a corner or an occluder keeps its power"),
+                    }
                 ),
             ));
             lines.push(line(

@@ -6,12 +6,13 @@
 
 use glam::Vec3;
 
-use crate::layout::FOOTPRINT_THICKNESS;
+use crate::layout::{COVERAGE_CROSSINGS, COVERAGE_NORMAL_COS, FOOTPRINT_THICKNESS};
 use crate::photon::differentials::FootprintOptions;
 use crate::scene::pack::PackedScene;
 use crate::scene::{Geometry, Light, Material, Scene};
 
 use super::photon::{basis_around, primitive_normal, PhotonRecord};
+use super::ray_trace::{closest_hit, offset_scale};
 use super::shading::{fresnel_dielectric, shading_normal, specular_shaded};
 
 /// Two positional and two directional differentials (units of Delta).
@@ -285,6 +286,58 @@ pub fn footprint(
         b,
         thickness: FOOTPRINT_THICKNESS * a.length().max(b.length()),
         power: record.power.truncate() * power_scale,
+    }
+}
+
+/// The kernel-weighted share of the ellipse p + alpha a + beta b on the
+/// surface of `material` (footprints.frag's footprint_coverage): probes at
+/// a Vogel spiral's points, each passing through up to COVERAGE_CROSSINGS
+/// surfaces of other materials; 1 when no probe lands.
+pub fn coverage(
+    scene: &Scene,
+    fp: &Footprint,
+    material: usize,
+    samples: u32,
+    epanechnikov: bool,
+) -> f32 {
+    if samples == 0 {
+        return 1.0;
+    }
+    let floor = PackedScene::new(scene).offset_floor;
+    let n = fp.a.cross(fp.b).normalize();
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    let (mut covered, mut total) = (0.0f32, 0.0f32);
+    for i in 0..samples {
+        let u2 = (i as f32 + 0.5) / samples as f32;
+        let phi = i as f32 * golden;
+        let q = fp.p + u2.sqrt() * (phi.cos() * fp.a + phi.sin() * fp.b);
+        let w = if epanechnikov { 1.0 - u2 } else { 1.0 };
+        total += w;
+        let h = 0.5 * q.distance(fp.p) + fp.thickness + 2.0 * offset_scale(q, floor);
+        let mut o = q + n * h;
+        let mut left = 2.0 * h;
+        for _ in 0..COVERAGE_CROSSINGS {
+            let Some((shape, t, x, normal)) = closest_hit(scene, o, -n) else {
+                break;
+            };
+            if t > left {
+                break;
+            }
+            if scene.shapes[shape].material == material
+                && normal.dot(n).abs() >= COVERAGE_NORMAL_COS
+            {
+                covered += w;
+                break;
+            }
+            let step = (o - x).dot(n) + 2.0 * offset_scale(x, floor);
+            o -= n * step;
+            left -= step;
+        }
+    }
+    if covered > 0.0 {
+        covered / total
+    } else {
+        1.0
     }
 }
 

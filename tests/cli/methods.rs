@@ -215,14 +215,20 @@ fn differentials_run_and_refuse_what_they_cannot_do() {
         "{map}"
     );
     assert_eq!(map["leaf_size"], map["auto_leaf_size"]);
+    assert_eq!(map["coverage_samples"], 16, "{map}");
     let sample = &json["footprint_samples"][0];
     assert!(
         sample["mean_footprints"].as_f64().unwrap() > 1.0,
         "{sample}"
     );
     assert!(sample["passes"].as_u64().unwrap() >= 1);
-    let refused: [(&[&str], &str); 10] = [
+    let refused: [(&[&str], &str); 12] = [
         (&["--leaf-size", "8"], "--method differentials"),
+        (&["--footprint-coverage", "4"], "--method differentials"),
+        (
+            &["--method", "differentials", "--footprint-coverage", "257"],
+            "0..=256",
+        ),
         (&["--method", "differentials", "--grid", "hash"], "--grid"),
         (&["--method", "differentials", "--tile", "8"], "--tile"),
         (

@@ -267,7 +267,9 @@ fn the_morton_order_and_the_bvh_equal_a_cpu_build_on_the_same_footprints() {
             diffuse_at_hit: a1[r][3] != 0.0,
             ..Default::default()
         };
-        let c = twin::footprint(&recs[r], &diff, &fo, map.delta, f.power_scale);
+        let mut c = twin::footprint(&recs[r], &diff, &fo, map.delta, f.power_scale);
+        let material = recs[r].position.w as usize;
+        c.area *= twin::coverage(&scene, &c, material, fo.coverage_samples, false);
         let same = close(fp.a, c.a, 1e-6)
             && close(fp.b, c.b, 1e-6)
             && (fp.area - c.area).abs() <= 1e-3 * c.area
@@ -385,4 +387,94 @@ fn a_plane_under_a_point_light_gets_its_analytic_irradiance() {
         "{pixels} pixels: mean estimate / analytic = {ratio:.4} (allowed 1 +- {tolerance:.4}: {near} photons reach the disc, footprint radius {r:.3})"
     );
     assert!((ratio - 1.0).abs() <= tolerance);
+}
+
+/// The 1 x 1 floor square under the point light: most footprints (r_max 0.5)
+/// overhang its edges.
+fn square_under_point_light() -> Scene {
+    let text = common::replace_once(
+        &common::fixture_text("floor_under_point_light"),
+        "corner = [-4.0, 0.0, -4.0]\nedge1 = [0.0, 0.0, 8.0]\nedge2 = [8.0, 0.0, 0.0]",
+        "corner = [-0.5, 0.0, -0.5]\nedge1 = [0.0, 0.0, 1.0]\nedge2 = [1.0, 0.0, 0.0]",
+    );
+    let path = common::fixture_file("floor_under_point_light");
+    photonmap::scene::load_scene_str(&text, &path).unwrap()
+}
+
+/// The share of a footprint's ellipse on the square |x|, |z| <= 0.5, by a
+/// 64 x 64 polar grid uniform in area (independent of the probes' spiral).
+fn share_on_square(f: &Footprint) -> f64 {
+    let n = 64;
+    let mut on = 0usize;
+    for i in 0..n {
+        for j in 0..n {
+            let r = ((i as f32 + 0.5) / n as f32).sqrt();
+            let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / n as f32;
+            let q = f.p + r * (phi.cos() * f.a + phi.sin() * f.b);
+            on += usize::from(q.x.abs() <= 0.5 && q.z.abs() <= 0.5);
+        }
+    }
+    on as f64 / (n * n) as f64
+}
+
+/// The estimate integrated over the surface keeps footprint i's power times
+/// its true share on the surface over the share its area was divided by.
+/// Without coverage probes the overhang is lost; with them each footprint's
+/// area is its share of the ellipse (equal to the CPU twin's probes), so the
+/// power kept is all of it, up to the probes' quadrature error.
+#[test]
+fn footprints_overhanging_an_edge_keep_their_power_with_coverage_probes() {
+    let scene = square_under_point_light();
+    let material = scene.shapes[0].material;
+    let mut kept = Vec::new();
+    for samples in [0, 16] {
+        let o = DifferentialsOptions {
+            coverage_samples: samples,
+            ..DifferentialsOptions::default()
+        };
+        let out = run(&scene, 8, 8, o);
+        let fps = footprints(state(&out));
+        let (mut power, mut power_kept, mut overhanging, mut apart) = (0.0, 0.0, 0, 0);
+        // The quadrature error of each share the probes found, against the grid's.
+        let mut errors = Vec::new();
+        for f in &fps {
+            let ellipse = std::f32::consts::PI * f.a.cross(f.b).length();
+            let share = f64::from(f.area / ellipse);
+            let twin_share = twin::coverage(&scene, f, material, samples, false);
+            apart += usize::from((f64::from(twin_share) - share).abs() > 1e-4);
+            let truth = share_on_square(f);
+            let p = f64::from(f.power.x);
+            power += p;
+            power_kept += p * truth / share;
+            overhanging += usize::from(truth < 1.0);
+            if samples > 0 && truth < 1.0 {
+                errors.push(share - truth);
+            }
+        }
+        let fraction = power_kept / power;
+        let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
+        println!(
+            "{samples} probes: {} footprints, {overhanging} overhang; power kept {fraction:.4}; mean probe share - true share {mean_error:+.4}; {apart} apart from the twin",
+            fps.len()
+        );
+        assert_eq!(apart, 0, "the probes' shares equal the twin's");
+        kept.push((fraction, errors));
+    }
+    let (without, _) = &kept[0];
+    let (with, errors) = &kept[1];
+    // The spread of the probes' quadrature error over the footprints that
+    // overhang bounds how far their mean, and so the power kept, may stray.
+    let n = errors.len() as f64;
+    let mean = errors.iter().sum::<f64>() / n;
+    let sd = (errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let bound = 3.0 * sd / n.sqrt();
+    println!("allowed: 1 +- {bound:.4} (quadrature error sd {sd:.4} over {n} footprints)");
+    assert!(
+        1.0 - without > bound,
+        "without probes the overhang is lost: {without}"
+    );
+    assert!(
+        (with - 1.0).abs() <= bound,
+        "power kept with probes: {with}"
+    );
 }

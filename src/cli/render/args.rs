@@ -362,7 +362,7 @@ impl RenderArgs {
             || self.caustic_paths.is_some()
             || self.caustic_k.is_some()
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
         }
         Ok(())
     }
@@ -386,7 +386,7 @@ impl RenderArgs {
             (
                 Method::Differentials,
                 self.differentials.any_given(),
-                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size and --kernel are photon differentials': add --method differentials",
+                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel and --footprint-coverage are photon differentials': add --method differentials",
                 "--method differentials replaces the kNN estimate with footprints",
             ),
             (

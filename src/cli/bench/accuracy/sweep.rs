@@ -223,8 +223,8 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     out
 }
 
-/// Photon differentials: automatic smoothing (k_PD = the scene's k), four
-/// times the photons, the Epanechnikov kernel, and 4 spp.
+/// Photon differentials: automatic smoothing (k_PD = the scene's k), no
+/// coverage probes, four times the photons, the Epanechnikov kernel, and 4 spp.
 fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     let pd = |label: &str, kernel: Kernel, spp: u32| {
         let o = DifferentialsOptions {
@@ -239,6 +239,11 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
         let mut more = pd("differentials, photons x4", Kernel::Constant, 1);
         more.run.photons_stored *= 4;
         out.push(more);
+        let mut whole = pd("differentials, no coverage probes", Kernel::Constant, 1);
+        if let RunMethod::Differentials(o) = &mut whole.run.method {
+            o.coverage_samples = 0;
+        }
+        out.push(whole);
         out.push(pd("differentials, Epanechnikov", Kernel::Epanechnikov, 1));
         out.push(pd("differentials, 4 spp", Kernel::Constant, 4));
     }
