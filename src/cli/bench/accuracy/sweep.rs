@@ -154,8 +154,8 @@ pub(super) fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
 }
 
 /// Instant global illumination: the default, the paper's 64 paths, each
-/// without its bias compensation, its caustic map from lights only and at
-/// the scene's k, each of
+/// without its bias compensation, its caustic map from lights only, at
+/// the scene's k and at k = 32, each of
 /// Marques and Santos's accelerations alone, all three together, the remedy
 /// they suggest for the combination's artefacts (a 2 x 2 interleave), and 4
 /// spp (at 1 spp every method's error is mostly aliasing against the
@@ -189,6 +189,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
         let scene_k = base.run.k;
         out.push(igi("IGI, caustic map at the scene's k", &|o| {
             o.caustic_k = Some(scene_k)
+        }));
+        out.push(igi("IGI, caustic map at k = 32", &|o| {
+            o.caustic_k = Some(32)
         }));
         out.push(igi("IGI, imperfect visibility", &|o| {
             o.imperfect_visibility = true
@@ -251,7 +254,7 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 }
 
 /// Progressive radiosity: its defaults, its caustic map from lights only,
-/// not shot on and at the scene's k, the chapter's ~10,000 elements of
+/// not shot on, at the scene's k and at k = 32, the chapter's ~10,000 elements of
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, resolution: u32, spp: u32| {
@@ -278,6 +281,11 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
             o.caustic_k = Some(base.run.k);
         }
         out.push(scene_k);
+        let mut k32 = rad("radiosity, caustic map at k = 32", 16, 1);
+        if let RunMethod::Radiosity(o) = &mut k32.run.method {
+            o.caustic_k = Some(32);
+        }
+        out.push(k32);
         out.push(rad("radiosity, 32 elements", 32, 1));
         out.push(rad("radiosity, 4 spp", 16, 4));
     }
