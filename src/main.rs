@@ -1,7 +1,6 @@
 //! The `photonmap` command: parse, then hand each subcommand to its module in cli/.
 
 mod cli;
-
 use clap::{Parser, Subcommand};
 use photonmap::gpu::Platform;
 
@@ -28,6 +27,7 @@ enum Command {
     Render(Box<cli::render::RenderArgs>),
     Photons(cli::photons::PhotonsArgs),
     Compare(cli::compare::CompareArgs),
+    Merge(cli::merge::MergeArgs),
     Convert(cli::convert::ConvertArgs),
     ConvertScene(cli::convert_scene::ConvertSceneArgs),
     Reference(cli::reference::ReferenceArgs),
@@ -46,6 +46,7 @@ fn main() -> std::process::ExitCode {
         Command::Render(a) => cli::render::run(&a, cli.platform),
         Command::Photons(a) => cli::photons::run(&a, cli.platform),
         Command::Compare(a) => cli::compare::run(&a),
+        Command::Merge(a) => cli::merge::run(&a),
         Command::Convert(a) => cli::convert::run(&a),
         Command::ConvertScene(a) => cli::convert_scene::run(&a),
         Command::Reference(a) => cli::reference::run(&a, cli.platform),

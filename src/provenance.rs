@@ -18,6 +18,9 @@ pub struct Provenance {
     pub method: String,
     pub seed: u32,
     pub spp: u32,
+    /// SPPM's iterations run (set once the render is done).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iterations: Option<u32>,
     pub width: u32,
     pub height: u32,
     pub platform: String,

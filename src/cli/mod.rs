@@ -10,6 +10,7 @@ pub mod compare;
 pub mod convert;
 pub mod convert_scene;
 pub mod info;
+pub mod merge;
 pub mod photons;
 pub mod progress;
 pub mod regress;

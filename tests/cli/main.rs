@@ -10,6 +10,8 @@ mod bench;
 mod compare;
 mod faults;
 mod import;
+mod live;
+mod merge;
 mod methods;
 mod outputs;
 mod photons;

@@ -60,6 +60,12 @@ impl Run {
         self.arg(flag).arg(path.as_ref())
     }
 
+    /// `path`, a positional argument the command writes.
+    pub fn writing_arg(mut self, path: impl AsRef<Path>) -> Self {
+        self.outputs.push(path.as_ref().to_path_buf());
+        self.arg(path.as_ref())
+    }
+
     /// `-o path`, an output image.
     pub fn output_to(self, path: impl AsRef<Path>) -> Self {
         self.writing("-o", path)

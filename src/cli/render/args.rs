@@ -99,9 +99,8 @@ pub struct RenderArgs {
     #[arg(long, value_enum, value_name = "PATHS")]
     pub caustic_paths: Option<CausticPaths>,
     /// IGI and radiosity: k of their caustic map's estimate (1..=4096).
-    /// Default: the scene's photon_map.k, at most 32 (the paper's k for its
-    /// caustic scene): a caustic is sharp, and the scene's k may be a global
-    /// map's.
+    /// Default: the scene's photon_map.k, at most 16: a caustic is sharp,
+    /// and the scene's k may be a global map's.
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub caustic_k: Option<u32>,
     #[command(flatten)]
@@ -115,6 +114,19 @@ pub struct RenderArgs {
     /// Write the running estimate as numbered PNGs (and snapshots.json) into DIR.
     #[arg(long, value_name = "DIR")]
     pub snapshots: Option<PathBuf>,
+    /// Send the image in progress to the tev HDR viewer listening at
+    /// HOST:PORT (tev's TCP protocol; tev listens on 127.0.0.1:14158, which an
+    /// ssh port forward can bring from another machine): the running estimate
+    /// at most every 0.25 s, SPPM's iterations likewise, and every finished
+    /// image, named "scene (pid)". A viewer that is not there, or goes away,
+    /// never slows or stops the render.
+    #[arg(long, value_name = "HOST:PORT", value_parser = super::display::parse_address)]
+    pub display_server: Option<String>,
+    /// Rewrite this EXR, atomically, with the image in progress (at most every
+    /// 0.25 s) and last with the finished image; until then its header says
+    /// `partial = true`.
+    #[arg(long, value_name = "EXR", conflicts_with = "camera_path")]
+    pub write_partial: Option<PathBuf>,
     /// Snapshot interval: seconds ("0.5s") or passes ("10").
     #[arg(long, default_value = "0.5s", value_parser = parse_every)]
     pub every: SnapshotEvery,
@@ -245,6 +257,21 @@ impl RenderArgs {
     pub(super) fn outputs(&self) -> Result<Outputs> {
         if let Some(p) = &self.reference_software {
             crate::cli::check_output(p, "png", "--reference-software")?;
+            check_writable(p)?;
+        }
+        if let Some(p) = &self.write_partial {
+            if !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+                bail!(
+                    "--write-partial {}: the file name must end in .exr",
+                    p.display()
+                );
+            }
+            if self.output.iter().chain(&self.exr).any(|o| o == p) {
+                bail!(
+                    "--write-partial {}: also an output; give the partial image a file of its own",
+                    p.display()
+                );
+            }
             check_writable(p)?;
         }
         if let Some(dir) = &self.snapshots {

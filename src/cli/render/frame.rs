@@ -39,7 +39,7 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         views: cameras.len(),
         direct_only: args.direct_only,
     };
-    let mut observer = CliObserver::new(args, scene, &outputs, work);
+    let mut observer = CliObserver::new(args, scene, &outputs, work, &provenance);
     let out = render::render_views(&gpu, scene, &options, &cameras, &mut observer)?;
     observer.finish()?;
     let written = write_images(&out.image, outputs.images(), &provenance)?;

@@ -3,6 +3,7 @@
 //! of one of the other methods.
 
 mod args;
+mod display;
 mod frame;
 mod observer;
 mod output;

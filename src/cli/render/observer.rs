@@ -1,16 +1,23 @@
 //! The observers `render` supplies: the progress bar, snapshots of the
-//! running estimate, and fly-through frames.
+//! running estimate, fly-through frames, and the live image (the tev
+//! display server, `--write-partial`).
 
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 
 use photonmap::image::write_atomically;
+use photonmap::provenance::Provenance;
 use photonmap::render::{EstimatePass, Image, Progress, RenderObserver, StopReason};
 use photonmap::scene::Scene;
 
 use super::args::{Outputs, RenderArgs, SnapshotEvery};
+use super::display::{image_name, DisplayServer};
 use crate::cli::progress::{ProgressReport, Work};
+
+/// The shortest time between two live images of a render in progress.
+const LIVE_INTERVAL: Duration = Duration::from_millis(250);
 
 /// A snapshot written during the estimate.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -78,19 +85,73 @@ impl RenderObserver for SnapshotWriter {
     }
 }
 
+/// The image in progress, to a tev viewer and to a partial EXR: at most
+/// every `LIVE_INTERVAL` while the render runs, and each finished image.
+struct Live {
+    display: Option<DisplayServer>,
+    partial: Option<(PathBuf, Vec<(String, String)>)>,
+    last: Option<Instant>,
+}
+
+impl Live {
+    fn new(args: &RenderArgs, scene: &Scene, provenance: &Provenance) -> Option<Self> {
+        let display = args
+            .display_server
+            .as_deref()
+            .map(|a| DisplayServer::start(a, image_name(&scene.name)));
+        let partial = args.write_partial.clone().map(|p| (p, provenance.pairs()));
+        (display.is_some() || partial.is_some()).then_some(Self {
+            display,
+            partial,
+            last: None,
+        })
+    }
+
+    fn due(&self) -> bool {
+        self.last.is_none_or(|t| t.elapsed() >= LIVE_INTERVAL)
+    }
+
+    /// Shows `image`; `finished`: a finished image, not a partial one.
+    fn show(&mut self, image: &Image, finished: bool) -> photonmap::Result<()> {
+        self.last = Some(Instant::now());
+        if let Some(d) = &self.display {
+            d.show(image);
+        }
+        if let Some((path, pairs)) = &self.partial {
+            if image.has_non_finite() {
+                return Ok(());
+            }
+            let mut pairs = pairs.clone();
+            if !finished {
+                pairs.push(("partial".into(), "true".into()));
+            }
+            write_atomically(path, &image.exr_bytes_with(&pairs)?)?;
+        }
+        Ok(())
+    }
+}
+
 /// The CLI's observer: the progress report, snapshots of the first estimate,
-/// and the frames of a fly-through.
+/// the frames of a fly-through, and the live image.
 pub(super) struct CliObserver {
     progress: ProgressReport,
     snapshots: Option<SnapshotWriter>,
     frames: Option<PathBuf>,
     frame_times: Vec<f64>,
     clock: std::time::Instant,
+    live: Option<Live>,
 }
 
 impl CliObserver {
-    pub(super) fn new(args: &RenderArgs, scene: &Scene, outputs: &Outputs, work: Work) -> Self {
+    pub(super) fn new(
+        args: &RenderArgs,
+        scene: &Scene,
+        outputs: &Outputs,
+        work: Work,
+        provenance: &Provenance,
+    ) -> Self {
         Self {
+            live: Live::new(args, scene, provenance),
             progress: ProgressReport::new(args.quiet, &scene.name, work),
             snapshots: args
                 .snapshots
@@ -108,6 +169,9 @@ impl CliObserver {
     /// Writes the index of a fly-through's frames.
     pub(super) fn finish(&mut self) -> Result<()> {
         self.progress.finish();
+        if let Some(d) = self.live.as_mut().and_then(|l| l.display.as_mut()) {
+            d.finish();
+        }
         if let Some(dir) = &self.frames {
             let index = serde_json::json!({ "frames": self.frame_times.len(), "seconds_since_start": self.frame_times });
             write_atomically(&dir.join("frames.json"), index.to_string().as_bytes())?;
@@ -122,6 +186,11 @@ impl RenderObserver for CliObserver {
     }
 
     fn estimate_pass(&mut self, pass: &EstimatePass<'_>) -> photonmap::Result<()> {
+        if let Some(live) = &mut self.live {
+            if pass.at.view == 0 && live.due() {
+                live.show(&pass.image()?, false)?;
+            }
+        }
         match &mut self.snapshots {
             Some(s) => s.estimate_pass(pass),
             None => Ok(()),
@@ -129,6 +198,9 @@ impl RenderObserver for CliObserver {
     }
 
     fn frame(&mut self, view: usize, image: &Image) -> photonmap::Result<()> {
+        if let Some(live) = &mut self.live {
+            live.show(image, true)?;
+        }
         if let Some(dir) = &self.frames {
             write_atomically(
                 &dir.join(format!("frame_{view:04}.png")),

@@ -19,7 +19,7 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     } = args.start()?;
     let scene = &loaded.scene;
     let gpu = crate::cli::gpu(platform)?;
-    let provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
+    let mut provenance = provenance(loaded.provenance, &gpu, "sppm", &options);
     if args.adaptive
         && args.sppm.iterations.is_none()
         && args.sppm.time.is_some()
@@ -31,12 +31,13 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         iterations: args.sppm.iteration_limit(),
         seconds: args.sppm.time,
     };
-    let mut observer = CliObserver::new(args, scene, &outputs, work);
+    let mut observer = CliObserver::new(args, scene, &outputs, work, &provenance);
     let render::Method::Sppm(WithPhotons { method: sppm, .. }) = &options.method else {
         unreachable!("--method sppm gives Method::Sppm");
     };
     let out = render::sppm::render_sppm(&gpu, scene, &options, sppm, &mut observer)?;
     observer.finish()?;
+    provenance.iterations = Some(out.iterations);
     let written = write_images(&out.image, outputs.images(), &provenance)?;
     if args.json {
         crate::cli::print_json(&Report {

@@ -1,0 +1,280 @@
+//! `--display-server HOST:PORT`: the running image sent to the tev HDR
+//! viewer over its TCP protocol (tev's `include/tev/Ipc.h`), as pbrt-v4's
+//! `--display-server` does. Each packet is a little-endian u32 length (the
+//! whole packet's, itself included), a one-byte type, then its fields;
+//! strings end in a zero byte. photonmap sends:
+//! - CreateImage (4): grab focus, name, width, height, channel count, the
+//!   channel names R, G, B;
+//! - UpdateImage v3 (6): grab focus, name, channel count, the channel names,
+//!   x, y, width, height of a tile, an i64 offset and an i64 stride per
+//!   channel into the tile's f32 data (here interleaved RGB: offsets 0, 1, 2,
+//!   strides 3), then the data, row 0 at the top.
+//!
+//! The render never waits for the viewer: images go to a slot that holds
+//! only the latest one, and a thread of its own sends it. A viewer that is
+//! not there is tried again at most once a second; one that goes away is
+//! dropped quietly and tried again on a later image; connecting and writing
+//! time out. When the render ends the last image is sent before the thread
+//! stops (bounded by the same time-outs).
+
+use std::io::Write;
+use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use photonmap::image::Image;
+
+/// tev's packet types (tev's `IpcPacket::EType`).
+const CREATE_IMAGE: u8 = 4;
+const UPDATE_IMAGE_V3: u8 = 6;
+/// Tiles of an update, at most this many pixels a side (tev's own Python
+/// client's size, which keeps each packet small).
+const TILE: u32 = 128;
+const CONNECT_TIMEOUT: Duration = Duration::from_secs(1);
+const WRITE_TIMEOUT: Duration = Duration::from_secs(2);
+/// The shortest wait between two tries to reach a viewer that was not there.
+const RETRY: Duration = Duration::from_secs(1);
+
+/// A `--display-server` address, checked when the command line is read.
+pub fn parse_address(s: &str) -> Result<String, String> {
+    let (host, port) = s
+        .rsplit_once(':')
+        .ok_or_else(|| format!("{s}: give HOST:PORT, for example localhost:14158"))?;
+    if host.is_empty() {
+        return Err(format!("{s}: the host is empty; give HOST:PORT"));
+    }
+    port.parse::<u16>()
+        .map_err(|_| format!("{s}: the port must be a whole number in 0..=65535"))?;
+    Ok(s.to_string())
+}
+
+/// The viewer's name of a render's image: "scene (pid)".
+pub fn image_name(scene: &str) -> String {
+    format!("{scene} ({})", std::process::id())
+}
+
+#[derive(Default)]
+struct Slot {
+    latest: Option<Image>,
+    closing: bool,
+}
+
+struct Shared {
+    slot: Mutex<Slot>,
+    wake: Condvar,
+}
+
+/// A tev viewer the render's images are sent to, from a thread of its own.
+pub struct DisplayServer {
+    shared: Arc<Shared>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl DisplayServer {
+    pub fn start(address: &str, name: String) -> Self {
+        let shared = Arc::new(Shared {
+            slot: Mutex::new(Slot::default()),
+            wake: Condvar::new(),
+        });
+        let (s, address) = (shared.clone(), address.to_string());
+        let thread = std::thread::Builder::new()
+            .name("display-server".into())
+            .spawn(move || Sender::new(address, name).run(&s))
+            .ok();
+        Self { shared, thread }
+    }
+
+    /// Queues `image`, replacing one not yet sent; never waits for the viewer.
+    pub fn show(&self, image: &Image) {
+        if let Ok(mut slot) = self.shared.slot.lock() {
+            slot.latest = Some(image.clone());
+            self.shared.wake.notify_one();
+        }
+    }
+
+    /// Sends what is queued, then stops the thread.
+    pub fn finish(&mut self) {
+        if let Ok(mut slot) = self.shared.slot.lock() {
+            slot.closing = true;
+            self.shared.wake.notify_one();
+        }
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Drop for DisplayServer {
+    fn drop(&mut self) {
+        self.finish();
+    }
+}
+
+/// The thread's side: the connection and what the viewer has been told.
+struct Sender {
+    address: String,
+    name: String,
+    stream: Option<TcpStream>,
+    /// The size of the image created on the viewer over this connection.
+    created: Option<(u32, u32)>,
+    last_try: Option<Instant>,
+}
+
+impl Sender {
+    fn new(address: String, name: String) -> Self {
+        Self {
+            address,
+            name,
+            stream: None,
+            created: None,
+            last_try: None,
+        }
+    }
+
+    fn run(mut self, shared: &Shared) {
+        loop {
+            let (image, closing) = {
+                let Ok(mut slot) = shared.slot.lock() else {
+                    return;
+                };
+                while slot.latest.is_none() && !slot.closing {
+                    slot = match shared.wake.wait(slot) {
+                        Ok(s) => s,
+                        Err(_) => return,
+                    };
+                }
+                (slot.latest.take(), slot.closing)
+            };
+            if let Some(image) = image {
+                self.send(&image, closing);
+            }
+            if closing {
+                return;
+            }
+        }
+    }
+
+    fn send(&mut self, image: &Image, last: bool) {
+        if self.stream.is_none() {
+            let due = self.last_try.is_none_or(|t| t.elapsed() >= RETRY);
+            if !(due || last) {
+                return;
+            }
+            self.last_try = Some(Instant::now());
+            self.stream = connect(&self.address);
+            self.created = None;
+        }
+        let Some(stream) = &mut self.stream else {
+            return;
+        };
+        let size = (image.width, image.height);
+        let mut sent = Ok(());
+        if self.created != Some(size) {
+            sent = stream.write_all(&create_image(&self.name, size.0, size.1));
+            self.created = Some(size);
+        }
+        for packet in update_image(&self.name, image) {
+            if sent.is_err() {
+                break;
+            }
+            sent = stream.write_all(&packet);
+        }
+        if sent.and_then(|_| stream.flush()).is_err() {
+            self.stream = None;
+        }
+    }
+}
+
+fn connect(address: &str) -> Option<TcpStream> {
+    let addrs: Vec<SocketAddr> = address.to_socket_addrs().ok()?.collect();
+    let stream = addrs
+        .iter()
+        .find_map(|a| TcpStream::connect_timeout(a, CONNECT_TIMEOUT).ok())?;
+    stream.set_write_timeout(Some(WRITE_TIMEOUT)).ok()?;
+    let _ = stream.set_nodelay(true);
+    Some(stream)
+}
+
+/// A packet under construction: its length is patched in at the end.
+struct Packet(Vec<u8>);
+
+impl Packet {
+    fn new(kind: u8) -> Self {
+        let mut bytes = vec![0; 4];
+        bytes.push(kind);
+        Self(bytes)
+    }
+    fn byte(&mut self, b: u8) -> &mut Self {
+        self.0.push(b);
+        self
+    }
+    fn string(&mut self, s: &str) -> &mut Self {
+        // A zero byte would end the string early: tev's names have none.
+        self.0.extend(s.bytes().filter(|&b| b != 0));
+        self.0.push(0);
+        self
+    }
+    fn i32(&mut self, v: i32) -> &mut Self {
+        self.0.extend(v.to_le_bytes());
+        self
+    }
+    fn i64(&mut self, v: i64) -> &mut Self {
+        self.0.extend(v.to_le_bytes());
+        self
+    }
+    fn f32(&mut self, v: f32) -> &mut Self {
+        self.0.extend(v.to_le_bytes());
+        self
+    }
+    fn done(mut self) -> Vec<u8> {
+        let n = self.0.len() as u32;
+        self.0[..4].copy_from_slice(&n.to_le_bytes());
+        self.0
+    }
+}
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+fn create_image(name: &str, width: u32, height: u32) -> Vec<u8> {
+    let mut p = Packet::new(CREATE_IMAGE);
+    p.byte(0).string(name);
+    p.i32(width as i32)
+        .i32(height as i32)
+        .i32(CHANNELS.len() as i32);
+    for c in CHANNELS {
+        p.string(c);
+    }
+    p.done()
+}
+
+/// The image as UpdateImage v3 packets, a tile each.
+fn update_image(name: &str, image: &Image) -> Vec<Vec<u8>> {
+    let mut packets = Vec::new();
+    for y0 in (0..image.height).step_by(TILE as usize) {
+        for x0 in (0..image.width).step_by(TILE as usize) {
+            let (w, h) = (TILE.min(image.width - x0), TILE.min(image.height - y0));
+            let mut p = Packet::new(UPDATE_IMAGE_V3);
+            p.byte(0).string(name).i32(CHANNELS.len() as i32);
+            for c in CHANNELS {
+                p.string(c);
+            }
+            p.i32(x0 as i32).i32(y0 as i32).i32(w as i32).i32(h as i32);
+            for offset in 0..CHANNELS.len() {
+                p.i64(offset as i64);
+            }
+            for _ in CHANNELS {
+                p.i64(CHANNELS.len() as i64);
+            }
+            for y in y0..y0 + h {
+                for x in x0..x0 + w {
+                    for v in image.get(x, y) {
+                        p.f32(v);
+                    }
+                }
+            }
+            packets.push(p.done());
+        }
+    }
+    packets
+}

@@ -1,0 +1,281 @@
+//! The image in progress: `--display-server` speaks tev's protocol to a
+//! listener on 127.0.0.1 that decodes every packet, and the last image it
+//! builds equals the EXR written; `--write-partial` ends as the finished
+//! image. A viewer that is not there, or that hangs up, changes nothing.
+
+use std::io::Read;
+use std::net::{TcpListener, TcpStream};
+use std::time::{Duration, Instant};
+
+use crate::common::{Run, TempDir};
+
+use photonmap::render::Image;
+
+/// What a tev viewer was sent, decoded.
+#[derive(Debug, Default)]
+struct Received {
+    /// CreateImage: name, width, height, channel names.
+    created: Vec<(String, i32, i32, Vec<String>)>,
+    /// The image as the updates left it, and the updates' tiles.
+    image: Vec<[f32; 3]>,
+    tiles: usize,
+    /// Updates that covered the whole image, one per image sent.
+    images: usize,
+}
+
+fn take<const N: usize>(b: &mut &[u8]) -> [u8; N] {
+    let (head, rest) = b.split_at(N);
+    *b = rest;
+    head.try_into().unwrap()
+}
+
+fn string(b: &mut &[u8]) -> String {
+    let end = b
+        .iter()
+        .position(|&c| c == 0)
+        .expect("a string ends in a zero byte");
+    let s = String::from_utf8(b[..end].to_vec()).unwrap();
+    *b = &b[end + 1..];
+    s
+}
+
+fn i32_of(b: &mut &[u8]) -> i32 {
+    i32::from_le_bytes(take(b))
+}
+
+/// Decodes the byte stream packet by packet (tev's `include/tev/Ipc.h`).
+fn decode(mut stream: &[u8]) -> Received {
+    let mut r = Received::default();
+    let mut covered = 0usize;
+    while !stream.is_empty() {
+        let length = u32::from_le_bytes(take(&mut stream)) as usize;
+        let (packet, rest) = stream.split_at(length - 4);
+        stream = rest;
+        let mut p = packet;
+        let [kind] = take(&mut p);
+        let [_grab_focus] = take(&mut p);
+        let name = string(&mut p);
+        match kind {
+            4 => {
+                let (w, h, n) = (i32_of(&mut p), i32_of(&mut p), i32_of(&mut p));
+                let channels = (0..n).map(|_| string(&mut p)).collect();
+                r.created.push((name, w, h, channels));
+                r.image = vec![[f32::NAN; 3]; (w * h) as usize];
+            }
+            6 => {
+                let n = i32_of(&mut p) as usize;
+                let channels: Vec<String> = (0..n).map(|_| string(&mut p)).collect();
+                assert_eq!(channels, ["R", "G", "B"]);
+                let (x0, y0, w, h) = (
+                    i32_of(&mut p),
+                    i32_of(&mut p),
+                    i32_of(&mut p),
+                    i32_of(&mut p),
+                );
+                let offsets: Vec<i64> = (0..n).map(|_| i64::from_le_bytes(take(&mut p))).collect();
+                let strides: Vec<i64> = (0..n).map(|_| i64::from_le_bytes(take(&mut p))).collect();
+                let data: Vec<f32> = p
+                    .chunks_exact(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                    .collect();
+                assert_eq!(data.len(), (w * h) as usize * n, "the tile's data");
+                let width = r.created.last().expect("CreateImage comes first").1;
+                for y in 0..h {
+                    for x in 0..w {
+                        let t = (y * w + x) as i64;
+                        let px = &mut r.image[((y0 + y) * width + x0 + x) as usize];
+                        for c in 0..n {
+                            px[c] = data[(offsets[c] + t * strides[c]) as usize];
+                        }
+                    }
+                }
+                r.tiles += 1;
+                covered += (w * h) as usize;
+                if covered >= r.image.len() {
+                    r.images += 1;
+                    covered = 0;
+                }
+                p = &[];
+            }
+            other => panic!("packet type {other}: not one photonmap sends"),
+        }
+        assert!(p.is_empty(), "packet {kind}: {} bytes left over", p.len());
+    }
+    r
+}
+
+/// A listener on 127.0.0.1 that takes one connection and reads it to its
+/// end (`hang_up`: reads the first bytes, then closes it and stops listening).
+fn listen(hang_up: bool) -> (u16, std::thread::JoinHandle<Vec<u8>>) {
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    listener.set_nonblocking(true).unwrap();
+    let thread = std::thread::spawn(move || {
+        let deadline = Instant::now() + Duration::from_secs(300);
+        let mut stream: TcpStream = loop {
+            match listener.accept() {
+                Ok((s, _)) => break s,
+                Err(_) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(10))
+                }
+                Err(e) => panic!("no connection came: {e}"),
+            }
+        };
+        stream.set_nonblocking(false).unwrap();
+        let mut bytes = Vec::new();
+        if hang_up {
+            let mut first = [0u8; 16];
+            stream.read_exact(&mut first).unwrap();
+            bytes.extend(first);
+        } else {
+            stream.read_to_end(&mut bytes).unwrap();
+        }
+        bytes
+    });
+    (port, thread)
+}
+
+/// The one-shot estimate and SPPM, each streamed to a listener: the viewer
+/// is told the image's name ("scene (pid)") and size once, gets at least the
+/// first running image and the finished one, and what it last holds is the
+/// EXR written, bit for bit; so is `--write-partial`'s file, whose header no
+/// longer says partial.
+#[test]
+fn a_render_streams_to_a_tev_listener_and_ends_on_the_written_image() {
+    let d = TempDir::new("live");
+    for method in ["paper", "sppm"] {
+        let (port, listener) = listen(false);
+        let (exr, partial) = (
+            d.join(format!("{method}.exr")),
+            d.join(format!("{method}.partial.exr")),
+        );
+        let mut child = Run::new([
+            "render", "ring", "--quiet", "--width", "32", "--height", "24",
+        ])
+        .args(["--method", method, "--display-server"])
+        .arg(format!("127.0.0.1:{port}"))
+        .writing("--write-partial", &partial)
+        .output_to(&exr)
+        .args(if method == "sppm" {
+            &["--iterations", "8"][..]
+        } else {
+            &[][..]
+        })
+        .spawn();
+        let pid = child.id();
+        let status = child.wait().unwrap();
+        assert!(status.success(), "{method}: {status}");
+        let got = decode(&listener.join().unwrap());
+        assert_eq!(
+            got.created,
+            [(
+                format!("RING ({pid})"),
+                32,
+                24,
+                vec!["R".into(), "G".into(), "B".into()]
+            )],
+            "{method}"
+        );
+        assert!(got.images >= 2, "{method}: {} images sent", got.images);
+        let written = Image::read_exr(&exr).unwrap();
+        assert_eq!(
+            got.image, written.pixels,
+            "{method}: the viewer's last image"
+        );
+        assert_eq!(Image::read_exr(&partial).unwrap(), written, "{method}");
+        let header = Image::exr_attributes(&partial).unwrap();
+        assert!(header.iter().all(|(k, _)| k != "partial"), "{header:?}");
+        println!("{method}: {} images in {} tiles", got.images, got.tiles);
+    }
+}
+
+/// No viewer at the address, and one that hangs up after its first bytes:
+/// the render finishes and writes the same image as without the switch.
+#[test]
+fn a_viewer_that_is_absent_or_hangs_up_changes_nothing() {
+    let d = TempDir::new("live-absent");
+    let render = |name: &str, extra: &[String]| {
+        let out = d.join(name);
+        Run::new([
+            "render", "ring", "--quiet", "--width", "32", "--height", "24",
+        ])
+        .args(extra)
+        .output_to(&out)
+        .succeeds();
+        Image::read_exr(&out).unwrap()
+    };
+    let plain = render("plain.exr", &[]);
+    let free = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let absent = render(
+        "absent.exr",
+        &["--display-server".into(), format!("127.0.0.1:{free}")],
+    );
+    assert_eq!(absent, plain);
+    let (port, listener) = listen(true);
+    let hung_up = render(
+        "hung-up.exr",
+        &["--display-server".into(), format!("127.0.0.1:{port}")],
+    );
+    assert_eq!(listener.join().unwrap().len(), 16);
+    assert_eq!(hung_up, plain);
+}
+
+/// Bad addresses and partial files are refused before any work, writing nothing.
+#[test]
+fn bad_live_outputs_are_refused() {
+    let d = TempDir::new("live-bad");
+    let refused = |args: &[&str], says: &str| {
+        Run::new(["render", "ring", "--quiet", "--width", "8", "--height", "8"])
+            .args(args)
+            .output_to(d.join("bad.png"))
+            .refused_with(says);
+    };
+    refused(&["--display-server", "localhost"], "HOST:PORT");
+    refused(&["--display-server", "localhost:99999"], "0..=65535");
+    let png = d.join("partial.png");
+    refused(
+        &["--write-partial", png.to_str().unwrap()],
+        "must end in .exr",
+    );
+    assert!(!png.exists());
+}
+
+/// SIGTERM (as Slurm sends before a time limit) stops a long SPPM render:
+/// the outputs are not written, and the partial EXR holds the last image in
+/// progress, marked partial in its header.
+#[test]
+fn a_stopped_render_leaves_its_partial_image_marked_partial() {
+    let d = TempDir::new("live-term");
+    let (exr, partial) = (d.join("out.exr"), d.join("partial.exr"));
+    let mut child = Run::new([
+        "render", "ring", "--quiet", "--width", "32", "--height", "24",
+    ])
+    .args(["--method", "sppm", "--iterations", "1000000"])
+    .writing("--write-partial", &partial)
+    .output_to(&exr)
+    .spawn();
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while !partial.exists() {
+        assert!(Instant::now() < deadline, "no partial image came");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(143));
+    assert!(!exr.exists());
+    let image = Image::read_exr(&partial).unwrap();
+    assert_eq!((image.width, image.height), (32, 24));
+    let header = Image::exr_attributes(&partial).unwrap();
+    assert!(
+        header.contains(&("partial".into(), "true".into())),
+        "{header:?}"
+    );
+}
