@@ -16,6 +16,9 @@ pub struct Provenance {
     /// `--set` overrides, as given.
     pub overrides: Vec<String>,
     pub method: String,
+    /// FNV-1a (64-bit, hex) of the method's options as the run used them:
+    /// two runs of one frame that differ in any option differ here.
+    pub method_options: String,
     pub seed: u32,
     pub spp: u32,
     /// SPPM's iterations run (set once the render is done).

@@ -8,4 +8,5 @@ shift
 for kv in "$@"; do export "${kv?}"; done
 here=$(dirname "$0")
 array=$(sbatch --parsable --export=ALL --array=1-"$n" "$here/seeds.sbatch")
-sbatch --export=ALL --dependency=afterok:"$array" "$here/merge.sbatch"
+# --parsable prints "id" or, on a multi-cluster setup, "id;cluster".
+sbatch --export=ALL --dependency=afterok:"${array%%;*}" "$here/merge.sbatch"

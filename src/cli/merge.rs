@@ -3,8 +3,8 @@
 //! by its eye samples a pixel, with the variance of the mean beside it.
 //!
 //! The inputs must be photonmap's own EXRs of the same scene text, overrides,
-//! method, size and (SPPM) iterations, each with a seed of its own, and none
-//! a partial image. Averaging K independent runs leaves their bias as it is,
+//! method and method options, size and (SPPM) iterations, each with a seed
+//! of its own, and none a partial image or a merge itself. Averaging K independent runs leaves their bias as it is,
 //! SPPM's included (each run has the same expectation), and divides their
 //! variance by K, so their noise by sqrt(K).
 
@@ -31,6 +31,7 @@ pub struct MergeArgs {
     /// Two or more renders' EXRs.
     #[arg(required = true, num_args = 2..)]
     pub inputs: Vec<PathBuf>,
+    /// Print the merge's figures (inputs, seeds, weights, noise) as JSON.
     #[arg(long)]
     pub json: bool,
 }
@@ -44,10 +45,11 @@ struct Pass {
 }
 
 /// The provenance fields that must agree between passes of one frame.
-const SAME: [&str; 6] = [
+const SAME: [&str; 7] = [
     "scene_hash",
     "overrides",
     "method",
+    "method_options",
     "width",
     "height",
     "iterations",
@@ -65,6 +67,12 @@ fn read_pass(path: &Path) -> Result<Pass> {
                 path.display()
             )
         })?;
+    if attributes.iter().any(|(k, _)| k == "photonmap.merge") {
+        bail!(
+            "{}: already a merge of passes: merge its passes together instead",
+            path.display()
+        );
+    }
     if attributes
         .iter()
         .any(|(k, v)| k == "partial" && v == "true")
@@ -73,6 +81,9 @@ fn read_pass(path: &Path) -> Result<Pass> {
     }
     let provenance: serde_json::Value = serde_json::from_str(text)
         .with_context(|| format!("{}: its photonmap.provenance is not JSON", path.display()))?;
+    if provenance["method"] == "sppm" && provenance["iterations"].is_null() {
+        bail!("{}: an SPPM render whose header does not record its iterations (a --write-partial file?): passes of different lengths cannot be told apart", path.display());
+    }
     let weight = provenance["spp"]
         .as_f64()
         .filter(|s| *s >= 1.0)
@@ -209,7 +220,11 @@ fn relative_noise(variance: &[[f32; 3]], image: &Image) -> f64 {
         .sum::<f64>()
         / n;
     let mean: f64 = image.mean().iter().sum::<f64>() / 3.0;
-    v.sqrt() / mean
+    if mean > 0.0 {
+        v.sqrt() / mean
+    } else {
+        0.0
+    }
 }
 
 pub fn run(a: &MergeArgs) -> Result<()> {
@@ -245,7 +260,9 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         passes[0].provenance.to_string(),
     )];
     attributes.push(("photonmap.merge".to_string(), merged.to_string()));
-    write_atomically(&a.output, &merged_exr(&mean, &variance, &attributes)?)?;
+    let bytes = merged_exr(&mean, &variance, &attributes)
+        .with_context(|| format!("merge {}", a.output.display()))?;
+    write_atomically(&a.output, &bytes)?;
     if a.json {
         crate::cli::print_json(&merged)?;
     } else {

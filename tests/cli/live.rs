@@ -235,7 +235,8 @@ fn bad_live_outputs_are_refused() {
             .refused_with(says);
     };
     refused(&["--display-server", "localhost"], "HOST:PORT");
-    refused(&["--display-server", "localhost:99999"], "0..=65535");
+    refused(&["--display-server", "localhost:99999"], "1..=65535");
+    refused(&["--display-server", "localhost:0"], "1..=65535");
     let png = d.join("partial.png");
     refused(
         &["--write-partial", png.to_str().unwrap()],
@@ -244,7 +245,7 @@ fn bad_live_outputs_are_refused() {
     assert!(!png.exists());
 }
 
-/// SIGTERM (as Slurm sends before a time limit) stops a long SPPM render:
+/// SIGTERM (as Slurm sends at a time limit) stops a long SPPM render:
 /// the outputs are not written, and the partial EXR holds the last image in
 /// progress, marked partial in its header.
 #[test]

@@ -119,6 +119,14 @@ fn passes_of_different_frames_are_refused() {
     refused(&[&ring1, &glass], "scene_hash differs");
     refused(&[&ring1, &k8], "overrides differs");
     refused(&[&ring1, &ring1], "same seed");
+    let disc = render(&d, "ring", 4, &["--leak-test", "disc"]);
+    refused(&[&ring1, &disc], "method_options differs");
+    let once = d.join("once.exr");
+    Run::new(["merge", "--passes"])
+        .arg(&once)
+        .args([&ring1, &ring2])
+        .succeeds();
+    refused(&[&once, &glass], "already a merge");
     refused(&[&ring1, &ring2, &out], "also an input");
     let png = d.join("x.png");
     std::fs::write(&png, b"not an exr").unwrap();

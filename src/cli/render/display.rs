@@ -12,10 +12,11 @@
 //!
 //! The render never waits for the viewer: images go to a slot that holds
 //! only the latest one, and a thread of its own sends it. A viewer that is
-//! not there is tried again at most once a second; one that goes away is
-//! dropped quietly and tried again on a later image; connecting and writing
-//! time out. When the render ends the last image is sent before the thread
-//! stops (bounded by the same time-outs).
+//! not there is tried again at most once a second (an image it missed is
+//! kept for the next try); one that goes away is dropped quietly and tried
+//! again on a later image; connecting and writing time out. When the render
+//! ends the last image is sent, and the render waits for that at most
+//! `FINISH_TIMEOUT` before it leaves the thread behind.
 
 use std::io::Write;
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
@@ -35,6 +36,8 @@ const CONNECT_TIMEOUT: Duration = Duration::from_secs(1);
 const WRITE_TIMEOUT: Duration = Duration::from_secs(2);
 /// The shortest wait between two tries to reach a viewer that was not there.
 const RETRY: Duration = Duration::from_secs(1);
+/// The longest a finished render waits for its last image to go out.
+const FINISH_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// A `--display-server` address, checked when the command line is read.
 pub fn parse_address(s: &str) -> Result<String, String> {
@@ -44,8 +47,10 @@ pub fn parse_address(s: &str) -> Result<String, String> {
     if host.is_empty() {
         return Err(format!("{s}: the host is empty; give HOST:PORT"));
     }
-    port.parse::<u16>()
-        .map_err(|_| format!("{s}: the port must be a whole number in 0..=65535"))?;
+    match port.parse::<u16>() {
+        Ok(p) if p > 0 => {}
+        _ => return Err(format!("{s}: the port must be a whole number in 1..=65535")),
+    }
     Ok(s.to_string())
 }
 
@@ -69,6 +74,8 @@ struct Shared {
 pub struct DisplayServer {
     shared: Arc<Shared>,
     thread: Option<JoinHandle<()>>,
+    /// Says when the thread has ended.
+    ended: Option<std::sync::mpsc::Receiver<()>>,
 }
 
 impl DisplayServer {
@@ -78,11 +85,19 @@ impl DisplayServer {
             wake: Condvar::new(),
         });
         let (s, address) = (shared.clone(), address.to_string());
+        let (tell, ended) = std::sync::mpsc::channel();
         let thread = std::thread::Builder::new()
             .name("display-server".into())
-            .spawn(move || Sender::new(address, name).run(&s))
+            .spawn(move || {
+                Sender::new(address, name).run(&s);
+                let _ = tell.send(());
+            })
             .ok();
-        Self { shared, thread }
+        Self {
+            shared,
+            thread,
+            ended: Some(ended),
+        }
     }
 
     /// Queues `image`, replacing one not yet sent; never waits for the viewer.
@@ -93,14 +108,18 @@ impl DisplayServer {
         }
     }
 
-    /// Sends what is queued, then stops the thread.
+    /// Sends what is queued, then stops the thread; waits for it at most
+    /// `FINISH_TIMEOUT` (a viewer that reads too slowly is left behind).
     pub fn finish(&mut self) {
         if let Ok(mut slot) = self.shared.slot.lock() {
             slot.closing = true;
             self.shared.wake.notify_one();
         }
+        let ended = self.ended.take();
         if let Some(t) = self.thread.take() {
-            let _ = t.join();
+            if ended.is_some_and(|e| e.recv_timeout(FINISH_TIMEOUT).is_ok()) {
+                let _ = t.join();
+            }
         }
     }
 }
@@ -119,6 +138,8 @@ struct Sender {
     /// The size of the image created on the viewer over this connection.
     created: Option<(u32, u32)>,
     last_try: Option<Instant>,
+    /// An image the viewer missed while it was not there.
+    missed: Option<Image>,
 }
 
 impl Sender {
@@ -129,6 +150,7 @@ impl Sender {
             stream: None,
             created: None,
             last_try: None,
+            missed: None,
         }
     }
 
@@ -146,8 +168,8 @@ impl Sender {
                 }
                 (slot.latest.take(), slot.closing)
             };
-            if let Some(image) = image {
-                self.send(&image, closing);
+            if let Some(image) = image.or_else(|| self.missed.take().filter(|_| closing)) {
+                self.send(image, closing);
             }
             if closing {
                 return;
@@ -155,10 +177,11 @@ impl Sender {
         }
     }
 
-    fn send(&mut self, image: &Image, last: bool) {
+    fn send(&mut self, image: Image, last: bool) {
         if self.stream.is_none() {
             let due = self.last_try.is_none_or(|t| t.elapsed() >= RETRY);
             if !(due || last) {
+                self.missed = Some(image);
                 return;
             }
             self.last_try = Some(Instant::now());
@@ -166,6 +189,7 @@ impl Sender {
             self.created = None;
         }
         let Some(stream) = &mut self.stream else {
+            self.missed = Some(image);
             return;
         };
         let size = (image.width, image.height);
@@ -174,7 +198,7 @@ impl Sender {
             sent = stream.write_all(&create_image(&self.name, size.0, size.1));
             self.created = Some(size);
         }
-        for packet in update_image(&self.name, image) {
+        for packet in update_image(&self.name, &image) {
             if sent.is_err() {
                 break;
             }
@@ -182,6 +206,7 @@ impl Sender {
         }
         if sent.and_then(|_| stream.flush()).is_err() {
             self.stream = None;
+            self.missed = Some(image);
         }
     }
 }

@@ -117,15 +117,25 @@ impl Live {
         if let Some(d) = &self.display {
             d.show(image);
         }
-        if let Some((path, pairs)) = &self.partial {
-            if image.has_non_finite() {
-                return Ok(());
+        let failed = match &self.partial {
+            Some((path, pairs)) if !image.has_non_finite() => {
+                let mut pairs = pairs.clone();
+                if !finished {
+                    pairs.push(("partial".into(), "true".into()));
+                }
+                let written = image
+                    .exr_bytes_with(&pairs)
+                    .and_then(|bytes| write_atomically(path, &bytes));
+                written
+                    .err()
+                    .map(|e| format!("--write-partial {}: {e}", path.display()))
             }
-            let mut pairs = pairs.clone();
-            if !finished {
-                pairs.push(("partial".into(), "true".into()));
-            }
-            write_atomically(path, &image.exr_bytes_with(&pairs)?)?;
+            _ => None,
+        };
+        // A preview that cannot be written must not cost the render.
+        if let Some(why) = failed {
+            eprintln!("warning: {why}; no more partial images are written");
+            self.partial = None;
         }
         Ok(())
     }
@@ -187,7 +197,9 @@ impl RenderObserver for CliObserver {
 
     fn estimate_pass(&mut self, pass: &EstimatePass<'_>) -> photonmap::Result<()> {
         if let Some(live) = &mut self.live {
-            if pass.at.view == 0 && live.due() {
+            // The first eye sample's estimate, as snapshots show it: a later
+            // sample's alone would look like a step back.
+            if pass.at.view == 0 && pass.at.sample == 0 && live.due() {
                 live.show(&pass.image()?, false)?;
             }
         }

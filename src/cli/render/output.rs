@@ -29,6 +29,11 @@ pub(super) fn provenance(
 ) -> Provenance {
     let mut p = crate::cli::with_driver(p, gpu);
     p.method = method.into();
+    let options = format!("{:?}", o.method);
+    p.method_options = format!(
+        "{:016x}",
+        photonmap::provenance::fnv1a64(options.as_bytes())
+    );
     (p.seed, p.spp, p.width, p.height) = (o.seed, o.spp, o.width, o.height);
     p
 }
