@@ -24,6 +24,11 @@ pub struct Provenance {
     /// SPPM's iterations run (set once the render is done).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iterations: Option<u32>,
+    /// Photons emitted: SPPM's over all iterations, or the photons behind
+    /// the photon map (or the footprints) of a frame render; set once the
+    /// render is done, absent where no photons were traced.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub photons_emitted: Option<u64>,
     pub width: u32,
     pub height: u32,
     pub platform: String,

@@ -185,6 +185,13 @@ fn a_render_streams_to_a_tev_listener_and_ends_on_the_written_image() {
         assert_eq!(Image::read_exr(&partial).unwrap(), written, "{method}");
         let header = Image::exr_attributes(&partial).unwrap();
         assert!(header.iter().all(|(k, _)| k != "partial"), "{header:?}");
+        if method == "sppm" {
+            // The output's header records the iterations and photons emitted.
+            let out = Image::exr_attributes(&exr).unwrap();
+            let p: serde_json::Value = serde_json::from_str(&out[0].1).unwrap();
+            assert_eq!(p["iterations"], 8, "{p}");
+            assert!(p["photons_emitted"].as_u64().unwrap() > 0, "{p}");
+        }
         println!("{method}: {} images in {} tiles", got.images, got.tiles);
     }
 }

@@ -31,6 +31,8 @@ fn outputs_by_extension_all_at_once_with_provenance() {
     let h: serde_json::Value = serde_json::from_str(&header[0].1).unwrap();
     assert_eq!(h["scene"], "ring");
     assert_eq!(h["overrides"][0], "photon_map.k=8");
+    // The photons behind the map (RING traces to its stored count).
+    assert!(h["photons_emitted"].as_u64().unwrap() > 0, "{h}");
     assert!(h["renderer"].as_str().unwrap().contains("llvmpipe"));
     let v = out.json();
     assert_eq!(v["provenance"]["overrides"][0], "photon_map.k=8");

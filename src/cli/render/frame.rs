@@ -32,7 +32,7 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         (_, true) => "final-gather",
         _ => "paper",
     };
-    let provenance = provenance(loaded.provenance, &gpu, method, &options);
+    let mut provenance = provenance(loaded.provenance, &gpu, method, &options);
     let work = Work::Paper {
         passes: PassPlan::new(scene, &options).passes_per_sample(),
         samples: options.spp,
@@ -42,6 +42,11 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let mut observer = CliObserver::new(args, scene, &outputs, work, &provenance);
     let out = render::render_views(&gpu, scene, &options, &cameras, &mut observer)?;
     observer.finish()?;
+    provenance.photons_emitted = out
+        .photons()
+        .map(|p| p.trace.photons_used)
+        .or(out.differentials().map(|d| d.trace.photons_used))
+        .map(u64::from);
     let written = write_images(&out.image, outputs.images(), &provenance)?;
     if let Some(path) = &args.reference_software {
         let leak = options.method.estimate().map(|e| e.leak);

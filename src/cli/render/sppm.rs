@@ -38,6 +38,7 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let out = render::sppm::render_sppm(&gpu, scene, &options, sppm, &mut observer)?;
     observer.finish()?;
     provenance.iterations = Some(out.iterations);
+    provenance.photons_emitted = Some(out.photons_emitted);
     let written = write_images(&out.image, outputs.images(), &provenance)?;
     if args.json {
         crate::cli::print_json(&Report {
