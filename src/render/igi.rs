@@ -65,6 +65,9 @@ pub struct IgiOptions {
     /// k of the caustic map's estimate; None: the scene's, at most
     /// `CAUSTIC_K`.
     pub caustic_k: Option<u32>,
+    /// The caustic map on the scene's grid, not the refined one
+    /// (`CausticMap::grid_resolution`).
+    pub caustic_scene_grid: bool,
     /// Gather rays a pixel of the bias compensation, which adds the light
     /// the bound leaves out (`bias_compensation`); 0: off.
     pub bias_compensation: u32,
@@ -89,6 +92,7 @@ impl Default for IgiOptions {
             downsample: 1,
             caustic_paths: CausticPaths::All,
             caustic_k: None,
+            caustic_scene_grid: false,
             bias_compensation: 16,
         }
     }
@@ -100,6 +104,7 @@ impl IgiOptions {
         CausticMap {
             paths: self.caustic_paths,
             k: self.caustic_k,
+            scene_grid: self.caustic_scene_grid,
         }
     }
 

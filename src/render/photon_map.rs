@@ -110,6 +110,8 @@ impl MapEstimate {
         observer: &mut dyn RenderObserver,
     ) -> Result<Option<(Self, PhotonFrames)>> {
         let (paths, k) = (caustic.paths, caustic.k_for(p.scene.photon_map.k));
+        let resolution =
+            caustic.grid_resolution(p.scene.photon_map.grid_resolution, p.scene.photon_map.k);
         observer.progress(&Progress::stage("photons", 0, 1));
         if !p.scene.has_specular() {
             return Ok(None);
@@ -118,6 +120,7 @@ impl MapEstimate {
         caustic.photon_map.caustics_only = paths == CausticPaths::FromLights;
         caustic.photon_map.specular_last_only = paths == CausticPaths::All;
         caustic.photon_map.store_direct = false;
+        caustic.photon_map.grid_resolution = resolution;
         let built = photon::build_map(p.gpu, &caustic, p.textures, &o.photons, p.seed, timings)?;
         let size = (p.width, p.height);
         let (mut map, frames) = Self::with_frames(p.gpu, size, built, &o.photons, &o.estimate)?;

@@ -61,12 +61,41 @@ pub struct CausticMap {
     pub paths: CausticPaths,
     /// None: the scene's k, at most `CAUSTIC_K`.
     pub k: Option<u32>,
+    /// Build on the scene's grid as it is, not the refined one.
+    pub scene_grid: bool,
 }
+
+/// Cells of a refined caustic-map grid at most.
+pub const CAUSTIC_GRID_CELLS: u64 = 1 << 22;
 
 impl CausticMap {
     /// The k in use under a scene whose own is `scene_k`.
     pub fn k_for(&self, scene_k: u32) -> u32 {
         self.k.unwrap_or(scene_k.min(CAUSTIC_K))
+    }
+
+    /// The caustic map's grid. The kNN-grid resolves nothing finer than its
+    /// cells, and a scene's grid is sized for its own k: a caustic map read
+    /// at a smaller k_c gets cells (k / k_c)^(1/3) times finer on each axis
+    /// (rounded), so that a cell holds about as many of its k_c photons as a
+    /// scene cell held of k, at most `CAUSTIC_GRID_CELLS` cells.
+    pub fn grid_resolution(&self, resolution: [u32; 3], scene_k: u32) -> [u32; 3] {
+        let k = self.k_for(scene_k);
+        if self.scene_grid || k >= scene_k {
+            return resolution;
+        }
+        let mut factor = (f64::from(scene_k) / f64::from(k)).cbrt().round().max(1.0) as u32;
+        let cells = |f: u32| {
+            resolution
+                .iter()
+                .map(|&r| u64::from(r * f))
+                .product::<u64>()
+        };
+        while factor > 1 && cells(factor) > CAUSTIC_GRID_CELLS {
+            factor -= 1;
+        }
+        let side = crate::scene::defaults::MAX_GRID_SIDE as u32;
+        resolution.map(|r| (r * factor).min(side))
     }
 }
 
@@ -109,5 +138,57 @@ impl<T> WithCausticMap<T> {
     /// The estimate's options as the photon config constrains them.
     pub fn estimate_options(&self) -> EstimateOptions {
         self.estimate.under(&self.photons)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn map(k: Option<u32>, scene_grid: bool) -> CausticMap {
+        CausticMap {
+            paths: CausticPaths::All,
+            k,
+            scene_grid,
+        }
+    }
+
+    #[test]
+    fn the_caustic_grid_is_finer_by_the_cube_root_of_the_k_ratio() {
+        // CORNELL BOX: k 500, caustic k 16: (500 / 16)^(1/3) = 3.15, so 3.
+        assert_eq!(
+            map(None, false).grid_resolution([25, 25, 50], 500),
+            [75, 75, 150]
+        );
+        // GLASS BALL: k 32 -> 16: 1.26 rounds to 1, the scene's grid.
+        assert_eq!(
+            map(None, false).grid_resolution([250, 1, 250], 32),
+            [250, 1, 250]
+        );
+        // RING: k 64 -> 16: 1.59 rounds to 2.
+        assert_eq!(
+            map(None, false).grid_resolution([250, 1, 250], 64),
+            [500, 2, 500]
+        );
+        // A caustic k at or above the scene's, and the scene's grid asked for.
+        assert_eq!(
+            map(Some(64), false).grid_resolution([25, 25, 50], 64),
+            [25, 25, 50]
+        );
+        assert_eq!(
+            map(None, true).grid_resolution([25, 25, 50], 500),
+            [25, 25, 50]
+        );
+    }
+
+    #[test]
+    fn the_refined_caustic_grid_stays_under_its_cell_budget() {
+        // (4096 / 16)^(1/3) = 6.3 -> 6 would give 300^3 cells; the factor
+        // drops to 3, the largest whose grid holds at most
+        // CAUSTIC_GRID_CELLS (150^3 = 3.4M of 4.2M).
+        let r = map(None, false).grid_resolution([50, 50, 50], 4096);
+        assert_eq!(r, [150, 150, 150]);
+        let cells: u64 = r.iter().map(|&s| u64::from(s)).product();
+        assert!(cells <= CAUSTIC_GRID_CELLS);
     }
 }

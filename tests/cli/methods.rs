@@ -297,8 +297,16 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
         "{unshot:?}"
     );
     assert!(r["tiles"].as_u64().unwrap() >= r["patches"].as_u64().unwrap());
-    let refused: [(&[&str], &str); 12] = [
+    let refused: [(&[&str], &str); 14] = [
         (&["--elements", "8"], "--method radiosity"),
+        (
+            &["--caustic-scene-grid"],
+            "add --method igi or --method radiosity",
+        ),
+        (
+            &["--method", "sppm", "--caustic-scene-grid"],
+            "--caustic-scene-grid",
+        ),
         (&["--subdivide", "2"], "--method radiosity"),
         (&["--method", "radiosity", "--subdivide", "7"], "0..=6"),
         (&["--method", "radiosity", "--gradient", "0"], "positive"),

@@ -103,6 +103,12 @@ pub struct RenderArgs {
     /// and the scene's k may be a global map's.
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub caustic_k: Option<u32>,
+    /// IGI and radiosity: build their caustic map on the scene's grid. By
+    /// default its cells are (k / K)^(1/3) times finer on each axis (k the
+    /// scene's, K the caustic map's), since the kNN-grid resolves nothing
+    /// finer than a cell.
+    #[arg(long)]
+    pub caustic_scene_grid: bool,
     #[command(flatten)]
     pub differentials: DifferentialsArgs,
     #[command(flatten)]
@@ -348,6 +354,7 @@ impl RenderArgs {
                 method: IgiOptions {
                     caustic_paths: self.caustic_paths.unwrap_or_default(),
                     caustic_k: self.caustic_k,
+                    caustic_scene_grid: self.caustic_scene_grid,
                     ..(&self.igi).into()
                 },
             }),
@@ -361,6 +368,7 @@ impl RenderArgs {
                 method: RadiosityOptions {
                     caustic_paths: self.caustic_paths.unwrap_or_default(),
                     caustic_k: self.caustic_k,
+                    caustic_scene_grid: self.caustic_scene_grid,
                     ..(&self.radiosity).into()
                 },
             }),
@@ -388,8 +396,9 @@ impl RenderArgs {
             || self.radiosity.any_given()
             || self.caustic_paths.is_some()
             || self.caustic_k.is_some()
+            || self.caustic_scene_grid
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
         }
         Ok(())
     }
@@ -423,10 +432,10 @@ impl RenderArgs {
                 "--method radiosity computes the diffuse interreflection itself",
             ),
         ];
-        if (self.caustic_paths.is_some() || self.caustic_k.is_some())
+        if (self.caustic_paths.is_some() || self.caustic_k.is_some() || self.caustic_scene_grid)
             && !matches!(self.method, Method::Igi | Method::Radiosity)
         {
-            bail!("--caustic-paths and --caustic-k choose the caustic map of IGI and radiosity: add --method igi or --method radiosity");
+            bail!("--caustic-paths, --caustic-k and --caustic-scene-grid choose the caustic map of IGI and radiosity: add --method igi or --method radiosity");
         }
         for (method, given, theirs, cannot) in methods {
             if self.method != method && given {

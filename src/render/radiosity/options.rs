@@ -29,6 +29,9 @@ pub struct RadiosityOptions {
     /// k of the caustic map's estimate; None: the scene's, at most
     /// `CAUSTIC_K`.
     pub caustic_k: Option<u32>,
+    /// The caustic map on the scene's grid, not the refined one
+    /// (`CausticMap::grid_resolution`).
+    pub caustic_scene_grid: bool,
     /// Whether the caustic map's records are deposited into the elements
     /// before the first shot, so that light from a mirror or glass bounces
     /// on from the diffuse surface it reached (L S+ D D+).
@@ -68,6 +71,7 @@ impl Default for RadiosityOptions {
             form_factor: FormFactor::Polygon,
             caustic_paths: CausticPaths::All,
             caustic_k: None,
+            caustic_scene_grid: false,
             shoot_caustics: true,
         }
     }
@@ -79,6 +83,7 @@ impl RadiosityOptions {
         CausticMap {
             paths: self.caustic_paths,
             k: self.caustic_k,
+            scene_grid: self.caustic_scene_grid,
         }
     }
 

@@ -155,7 +155,7 @@ pub(super) fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
 
 /// Instant global illumination: the default, the paper's 64 paths, each
 /// without its bias compensation, its caustic map from lights only, at
-/// the scene's k and at k = 32, each of
+/// the scene's k, at k = 32 and on the scene's grid, each of
 /// Marques and Santos's accelerations alone, all three together, the remedy
 /// they suggest for the combination's artefacts (a 2 x 2 interleave), and 4
 /// spp (at 1 spp every method's error is mostly aliasing against the
@@ -192,6 +192,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
         }));
         out.push(igi("IGI, caustic map at k = 32", &|o| {
             o.caustic_k = Some(32)
+        }));
+        out.push(igi("IGI, caustic map on the scene's grid", &|o| {
+            o.caustic_scene_grid = true
         }));
         out.push(igi("IGI, imperfect visibility", &|o| {
             o.imperfect_visibility = true
@@ -254,7 +257,7 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 }
 
 /// Progressive radiosity: its defaults, its caustic map from lights only,
-/// not shot on, at the scene's k and at k = 32, the chapter's ~10,000 elements of
+/// not shot on, at the scene's k, at k = 32 and on the scene's grid, the chapter's ~10,000 elements of
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, resolution: u32, spp: u32| {
@@ -286,6 +289,11 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
             o.caustic_k = Some(32);
         }
         out.push(k32);
+        let mut scene_grid = rad("radiosity, caustic map on the scene's grid", 16, 1);
+        if let RunMethod::Radiosity(o) = &mut scene_grid.run.method {
+            o.caustic_scene_grid = true;
+        }
+        out.push(scene_grid);
         out.push(rad("radiosity, 32 elements", 32, 1));
         out.push(rad("radiosity, 4 spp", 16, 4));
     }
