@@ -42,6 +42,10 @@ pub enum Error {
     /// SIGINT or SIGTERM came (src/interrupt.rs): the work stopped and nothing was written.
     #[error("interrupted by {}: stopped, and no output was written", signal_name(*.signal))]
     Interrupted { signal: i32 },
+    /// A signal stopped the work after what was done had been written
+    /// (`render --on-signal write-partial`).
+    #[error("interrupted by {}: stopped; {wrote}", signal_name(*.signal))]
+    InterruptedAfterWriting { signal: i32, wrote: String },
     /// The headless platform (EGL or OSMesa) could not give a GL 4.5 context.
     #[error("{0}")]
     Platform(String),

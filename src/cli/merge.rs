@@ -4,7 +4,8 @@
 //!
 //! The inputs must be photonmap's own EXRs of the same scene text, overrides,
 //! method and method options, size and (SPPM) iterations, each with a seed
-//! of its own, and none a partial image or a merge itself. Averaging K independent runs leaves their bias as it is,
+//! of its own, and none a merge itself or a partial image of unknown samples
+//! (what `--on-signal write-partial` writes counts its samples, and is used). Averaging K independent runs leaves their bias as it is,
 //! SPPM's included (each run has the same expectation), and divides their
 //! variance by K, so their noise by sqrt(K).
 
@@ -19,8 +20,8 @@ use photonmap::render::Image;
 /// Average independent renders of one frame into OUT.exr (weighted by their
 /// eye samples), with the variance of the mean as a second layer, and print
 /// the noise before and after. Inputs of another scene, overrides, method,
-/// size or SPPM iteration count, repeated seeds and partial images are
-/// refused, and nothing is written.
+/// size or SPPM iteration count, repeated seeds and partial images of
+/// unknown samples are refused, and nothing is written.
 #[derive(Args)]
 pub struct MergeArgs {
     /// Independent runs of the same frame (the only mode: tiles are not merged).
@@ -73,11 +74,19 @@ fn read_pass(path: &Path) -> Result<Pass> {
             path.display()
         );
     }
-    if attributes
+    // `--on-signal write-partial` records the samples it holds (and sets
+    // spp or iterations to them); `--write-partial`'s file does not.
+    let partial = attributes
         .iter()
-        .any(|(k, v)| k == "partial" && v == "true")
-    {
-        bail!("{}: a partial image (a stopped render or --write-partial's file): its samples are not known", path.display());
+        .any(|(k, v)| k == "partial" && v == "true");
+    let counted = attributes
+        .iter()
+        .any(|(k, _)| k == "photonmap.samples_done");
+    if partial && !counted {
+        bail!(
+            "{}: a partial image (--write-partial's file): its samples are not known",
+            path.display()
+        );
     }
     let provenance: serde_json::Value = serde_json::from_str(text)
         .with_context(|| format!("{}: its photonmap.provenance is not JSON", path.display()))?;

@@ -115,7 +115,10 @@ pub fn fail(e: anyhow::Error) -> std::process::ExitCode {
         .collect();
     eprintln!("error: {}", causes.join(": "));
     let signal = e.chain().find_map(|c| match c.downcast_ref() {
-        Some(photonmap::error::Error::Interrupted { signal }) => Some(*signal),
+        Some(
+            photonmap::error::Error::Interrupted { signal }
+            | photonmap::error::Error::InterruptedAfterWriting { signal, .. },
+        ) => Some(*signal),
         _ => None,
     });
     match signal {

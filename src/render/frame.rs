@@ -99,8 +99,9 @@ pub fn render_views(
                 at,
             };
             sum.add(&method.sample(&frame, &mut timings, observer)?);
+            observer.samples_done(view, sum.count, &|| sum.mean_so_far());
         }
-        let view_image = sum.mean();
+        let view_image = sum.mean_so_far();
         observer.frame(view, &view_image)?;
         image = Some(view_image);
     }
@@ -147,8 +148,9 @@ impl ImageSum {
         }
     }
 
-    fn mean(self) -> Image {
-        let mut image = self.sum.expect("at least one sample");
+    /// The mean of the samples so far.
+    fn mean_so_far(&self) -> Image {
+        let mut image = self.sum.clone().expect("at least one sample");
         if self.count > 1 {
             image.divide(self.count as f32);
         }

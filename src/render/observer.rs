@@ -88,6 +88,10 @@ pub trait RenderObserver {
         Ok(())
     }
 
+    /// After each eye sample of a view: `done` samples so far, and their
+    /// mean on demand (what a render stopped now would have made).
+    fn samples_done(&mut self, _view: usize, _done: u32, _mean: &dyn Fn() -> Image) {}
+
     /// A view's finished image (the mean of its eye samples).
     fn frame(&mut self, _view: usize, _image: &Image) -> Result<()> {
         Ok(())

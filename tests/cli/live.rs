@@ -5,6 +5,7 @@
 
 use std::io::Read;
 use std::net::{TcpListener, TcpStream};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::common::{Run, TempDir};
@@ -244,6 +245,7 @@ fn bad_live_outputs_are_refused() {
     refused(&["--display-server", "localhost"], "HOST:PORT");
     refused(&["--display-server", "localhost:99999"], "1..=65535");
     refused(&["--display-server", "localhost:0"], "1..=65535");
+    refused(&["--on-signal", "write-partial"], "give an .exr output");
     let png = d.join("partial.png");
     refused(
         &["--write-partial", png.to_str().unwrap()],
@@ -259,25 +261,14 @@ fn bad_live_outputs_are_refused() {
 fn a_stopped_render_leaves_its_partial_image_marked_partial() {
     let d = TempDir::new("live-term");
     let (exr, partial) = (d.join("out.exr"), d.join("partial.exr"));
-    let mut child = Run::new([
+    let child = Run::new([
         "render", "ring", "--quiet", "--width", "32", "--height", "24",
     ])
     .args(["--method", "sppm", "--iterations", "1000000"])
     .writing("--write-partial", &partial)
     .output_to(&exr)
     .spawn();
-    let deadline = Instant::now() + Duration::from_secs(300);
-    while !partial.exists() {
-        assert!(Instant::now() < deadline, "no partial image came");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let killed = std::process::Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(143));
+    assert_eq!(terminate_once_under_way(child, &partial), Some(143));
     assert!(!exr.exists());
     let image = Image::read_exr(&partial).unwrap();
     assert_eq!((image.width, image.height), (32, 24));
@@ -286,4 +277,86 @@ fn a_stopped_render_leaves_its_partial_image_marked_partial() {
         header.contains(&("partial".into(), "true".into())),
         "{header:?}"
     );
+}
+
+/// Waits for `partial` to appear (the render is under way), lets the render
+/// run a little longer, then stops it with SIGTERM; returns its exit code.
+fn terminate_once_under_way(mut child: std::process::Child, partial: &Path) -> Option<i32> {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while !partial.exists() {
+        assert!(Instant::now() < deadline, "no partial image came");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the render ended early"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(1500));
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    child.wait().unwrap().code()
+}
+
+/// `--on-signal write-partial`: SIGTERM writes the eye samples (SPPM: the
+/// iterations) done to the EXR output, marked partial with their count,
+/// which `merge --passes` then weighs by that count.
+#[test]
+fn a_signal_writes_the_work_done_when_asked() {
+    let d = TempDir::new("live-on-signal");
+    for (method, limit, count_field) in [
+        ("paper", ["--spp", "1024"], "spp"),
+        ("sppm", ["--iterations", "1000000"], "iterations"),
+    ] {
+        let (exr, partial) = (
+            d.join(format!("{method}.exr")),
+            d.join(format!("{method}.partial.exr")),
+        );
+        let child = Run::new([
+            "render", "ring", "--quiet", "--width", "32", "--height", "24",
+        ])
+        .args(["--method", method, "--on-signal", "write-partial"])
+        .args(limit)
+        .writing("--write-partial", &partial)
+        .output_to(&exr)
+        .spawn();
+        assert_eq!(terminate_once_under_way(child, &partial), Some(143));
+        let header = Image::exr_attributes(&exr).unwrap();
+        assert!(
+            header.contains(&("partial".into(), "true".into())),
+            "{header:?}"
+        );
+        let done: u32 = header
+            .iter()
+            .find(|(k, _)| k == "photonmap.samples_done")
+            .map(|(_, v)| v.parse().unwrap())
+            .unwrap_or_else(|| panic!("{method}: no count in {header:?}"));
+        assert!((1..1024).contains(&done), "{method}: {done}");
+        let provenance = header
+            .iter()
+            .find(|(k, _)| k == "photonmap.provenance")
+            .map(|(_, v)| serde_json::from_str::<serde_json::Value>(v).unwrap())
+            .unwrap();
+        assert_eq!(provenance[count_field], done, "{method}");
+        let image = Image::read_exr(&exr).unwrap();
+        assert!(image.pixels.iter().flatten().any(|c| *c > 0.0), "{method}");
+    }
+    // A one-shot pass stopped at k samples merges with a whole one, weighed k.
+    let whole = d.join("whole.exr");
+    Run::new([
+        "render", "ring", "--quiet", "--width", "32", "--height", "24", "--spp", "2",
+    ])
+    .args(["--seed", "2"])
+    .output_to(&whole)
+    .succeeds();
+    let merged = d.join("merged.exr");
+    let report = Run::new(["merge", "--passes", "--json"])
+        .writing_arg(&merged)
+        .args([d.join("paper.exr"), whole])
+        .json();
+    let weights = report["weights"].as_array().unwrap();
+    assert!(weights[0].as_f64().unwrap() >= 1.0, "{report}");
+    assert_eq!(weights[1], 2.0, "{report}");
 }

@@ -133,6 +133,13 @@ pub struct RenderArgs {
     /// `partial = true`.
     #[arg(long, value_name = "EXR", conflicts_with = "camera_path")]
     pub write_partial: Option<PathBuf>,
+    /// What SIGINT or SIGTERM (Slurm's warning before a time limit) does:
+    /// `stop` writes nothing; `write-partial` writes the eye samples (SPPM:
+    /// the iterations) done so far to the EXR outputs, marked `partial =
+    /// true` with their count in the header, so `merge --passes` can weigh
+    /// them. A second signal ends the program at once.
+    #[arg(long, value_enum, default_value_t = OnSignal::Stop, conflicts_with = "camera_path")]
+    pub on_signal: OnSignal,
     /// Snapshot interval: seconds ("0.5s") or passes ("10").
     #[arg(long, default_value = "0.5s", value_parser = parse_every)]
     pub every: SnapshotEvery,
@@ -147,6 +154,13 @@ pub struct RenderArgs {
     /// paths and photons, the estimate on the CPU by Jensen's kd-tree) to this PNG.
     #[arg(long, value_name = "PNG", conflicts_with = "direct_only")]
     pub reference_software: Option<PathBuf>,
+}
+
+/// What a render does when a signal stops it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OnSignal {
+    Stop,
+    WritePartial,
 }
 
 /// How often the running estimate is written.
@@ -279,6 +293,15 @@ impl RenderArgs {
                 );
             }
             check_writable(p)?;
+        }
+        if self.on_signal == OnSignal::WritePartial
+            && !self
+                .output
+                .iter()
+                .chain(&self.exr)
+                .any(|p| Format::of(p).ok() == Some(Format::Exr))
+        {
+            bail!("--on-signal write-partial: give an .exr output (-o X.exr): only an EXR's header can mark the image partial");
         }
         if let Some(dir) = &self.snapshots {
             if !dir.is_dir() {

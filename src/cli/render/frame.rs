@@ -9,7 +9,9 @@ use photonmap::render::{self, PassPlan, RenderOptions};
 
 use super::args::{Format, RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{print_explain, provenance, write_images, write_software_reference, Report};
+use super::output::{
+    print_explain, provenance, write_done_on_signal, write_images, write_software_reference, Report,
+};
 use crate::cli::args::Method;
 use crate::cli::progress::Work;
 
@@ -40,7 +42,20 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         direct_only: args.direct_only,
     };
     let mut observer = CliObserver::new(args, scene, &outputs, work, &provenance);
-    let out = render::render_views(&gpu, scene, &options, &cameras, &mut observer)?;
+    let out = match render::render_views(&gpu, scene, &options, &cameras, &mut observer) {
+        Ok(out) => out,
+        Err(e) => {
+            let done = observer.done.take();
+            observer.finish()?;
+            return Err(write_done_on_signal(
+                e,
+                done,
+                outputs.images(),
+                provenance,
+                false,
+            ));
+        }
+    };
     observer.finish()?;
     provenance.photons_emitted = out
         .photons()

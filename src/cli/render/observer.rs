@@ -12,7 +12,7 @@ use photonmap::provenance::Provenance;
 use photonmap::render::{EstimatePass, Image, Progress, RenderObserver, StopReason};
 use photonmap::scene::Scene;
 
-use super::args::{Outputs, RenderArgs, SnapshotEvery};
+use super::args::{OnSignal, Outputs, RenderArgs, SnapshotEvery};
 use super::display::{image_name, DisplayServer};
 use crate::cli::progress::{ProgressReport, Work};
 
@@ -141,9 +141,20 @@ impl Live {
     }
 }
 
+/// The work done so far, kept for `--on-signal write-partial`: the mean of
+/// the eye samples done, or the image after SPPM's iterations done.
+pub(super) struct Done {
+    pub(super) image: Image,
+    pub(super) count: u32,
+}
+
 /// The CLI's observer: the progress report, snapshots of the first estimate,
-/// the frames of a fly-through, and the live image.
+/// the frames of a fly-through, the live image, and the work done so far.
 pub(super) struct CliObserver {
+    /// Kept only with `--on-signal write-partial`.
+    pub(super) done: Option<Done>,
+    keep_done: bool,
+    sppm: bool,
     progress: ProgressReport,
     snapshots: Option<SnapshotWriter>,
     frames: Option<PathBuf>,
@@ -161,6 +172,9 @@ impl CliObserver {
         provenance: &Provenance,
     ) -> Self {
         Self {
+            done: None,
+            keep_done: args.on_signal == OnSignal::WritePartial,
+            sppm: matches!(work, Work::Iterations { .. }),
             live: Live::new(args, scene, provenance),
             progress: ProgressReport::new(args.quiet, &scene.name, work),
             snapshots: args
@@ -196,6 +210,13 @@ impl RenderObserver for CliObserver {
     }
 
     fn estimate_pass(&mut self, pass: &EstimatePass<'_>) -> photonmap::Result<()> {
+        // SPPM reports each iteration done as a pass (`pass` counts from 0).
+        if self.keep_done && self.sppm && !pass.finished {
+            self.done = Some(Done {
+                image: pass.image()?,
+                count: pass.pass + 1,
+            });
+        }
         if let Some(live) = &mut self.live {
             // The first eye sample's estimate, as snapshots show it: a later
             // sample's alone would look like a step back.
@@ -206,6 +227,15 @@ impl RenderObserver for CliObserver {
         match &mut self.snapshots {
             Some(s) => s.estimate_pass(pass),
             None => Ok(()),
+        }
+    }
+
+    fn samples_done(&mut self, view: usize, done: u32, mean: &dyn Fn() -> Image) {
+        if self.keep_done && view == 0 {
+            self.done = Some(Done {
+                image: mean(),
+                count: done,
+            });
         }
     }
 
