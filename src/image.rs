@@ -47,6 +47,20 @@ impl Image {
         }
     }
 
+    /// The `w` x `h` pixels from column `x`, row `y` (rows from the top).
+    pub fn crop(&self, x: u32, y: u32, w: u32, h: u32) -> Self {
+        let mut pixels = Vec::with_capacity((w * h) as usize);
+        for row in y..y + h {
+            let start = (row * self.width + x) as usize;
+            pixels.extend_from_slice(&self.pixels[start..start + w as usize]);
+        }
+        Self {
+            width: w,
+            height: h,
+            pixels,
+        }
+    }
+
     pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
         self.pixels[(y * self.width + x) as usize]
     }
@@ -119,6 +133,17 @@ impl Image {
 
     /// The EXR with text attributes (provenance) in its header.
     pub fn exr_bytes_with(&self, attributes: &[(String, String)]) -> Result<Vec<u8>> {
+        self.exr_bytes_placed(attributes, (0, 0), (self.width, self.height))
+    }
+
+    /// The EXR of a part of a frame: its data window starts at `origin`
+    /// (column, row from the top) of a display window of `frame` pixels.
+    pub fn exr_bytes_placed(
+        &self,
+        attributes: &[(String, String)],
+        origin: (u32, u32),
+        frame: (u32, u32),
+    ) -> Result<Vec<u8>> {
         use exr::prelude::*;
         let w = self.width as usize;
         let mut layer_attributes = LayerAttributes::named("rgb");
@@ -128,6 +153,7 @@ impl Image {
                 layer_attributes.other.insert(k, AttributeValue::Text(v));
             }
         }
+        layer_attributes.layer_position = Vec2(origin.0 as i32, origin.1 as i32);
         let layer = Layer::new(
             (w, self.height as usize),
             layer_attributes,
@@ -137,8 +163,11 @@ impl Image {
                 (p[0], p[1], p[2])
             }),
         );
+        let mut image = exr::image::Image::from_layer(layer);
+        image.attributes.display_window =
+            IntegerBounds::new((0, 0), (frame.0 as usize, frame.1 as usize));
         let mut out = std::io::Cursor::new(Vec::new());
-        exr::image::Image::from_layer(layer)
+        image
             .write()
             .to_buffered(&mut out)
             .map_err(|e| crate::error::Error::Image(format!("encoding an EXR: {e}")))?;
@@ -173,6 +202,51 @@ impl Image {
         }
         out.sort();
         Ok(out)
+    }
+
+    /// Where an EXR's pixels sit: its data window's origin (column, row from
+    /// the top) and its display window's size.
+    pub fn exr_placement(path: &Path) -> Result<((i64, i64), (u64, u64))> {
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| {
+            crate::error::Error::Image(format!("cannot read EXR {}: {e}", path.display()))
+        })?;
+        let h = meta.headers.first().ok_or_else(|| {
+            crate::error::Error::Image(format!("EXR {} has no header", path.display()))
+        })?;
+        let display = h.shared_attributes.display_window;
+        let origin = h.own_attributes.layer_position;
+        Ok((
+            (
+                origin.x() as i64 - display.position.x() as i64,
+                origin.y() as i64 - display.position.y() as i64,
+            ),
+            (display.size.x() as u64, display.size.y() as u64),
+        ))
+    }
+
+    /// An EXR's header text attributes and the provenance among them (as JSON:
+    /// a file of an older version may lack fields).
+    pub fn exr_provenance(
+        path: &Path,
+    ) -> crate::error::Result<(Vec<(String, String)>, serde_json::Value)> {
+        let attributes = Self::exr_attributes(path)?;
+        let text = attributes
+            .iter()
+            .find(|(k, _)| k == "photonmap.provenance")
+            .map(|(_, v)| v)
+            .ok_or_else(|| {
+                crate::error::Error::Image(format!(
+                    "{}: no photonmap.provenance in its header: not a photonmap render",
+                    path.display()
+                ))
+            })?;
+        let provenance = serde_json::from_str(text).map_err(|e| {
+            crate::error::Error::Image(format!(
+                "{}: its photonmap.provenance is not JSON: {e}",
+                path.display()
+            ))
+        })?;
+        Ok((attributes, provenance))
     }
 
     pub fn read_exr(path: &Path) -> Result<Self> {

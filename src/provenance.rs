@@ -29,8 +29,13 @@ pub struct Provenance {
     /// render is done, absent where no photons were traced.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub photons_emitted: Option<u64>,
+    /// The frame's size (a crop's image is a part of it).
     pub width: u32,
     pub height: u32,
+    /// A crop's pixels in the frame: x0, x1, y0, y1 (half-open, rows from
+    /// the top); absent for the whole frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pixel_bounds: Option<[u32; 4]>,
     pub platform: String,
     pub renderer: String,
     pub gl_version: String,
@@ -45,6 +50,11 @@ impl Provenance {
             commit: option_env!("PHOTONMAP_GIT_COMMIT").map(str::to_string),
             ..Self::default()
         }
+    }
+
+    /// Where the image sits in the frame: its first pixel (column, row).
+    pub fn origin(&self) -> (u32, u32) {
+        self.pixel_bounds.map_or((0, 0), |b| (b[0], b[2]))
     }
 
     /// The image-header attribute that carries it: one text attribute,

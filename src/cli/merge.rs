@@ -17,20 +17,27 @@ use clap::Args;
 use photonmap::image::write_atomically;
 use photonmap::render::Image;
 
-/// Average independent renders of one frame into OUT.exr (weighted by their
-/// eye samples), with the variance of the mean as a second layer, and print
-/// the noise before and after. Inputs of another scene, overrides, method,
-/// size or SPPM iteration count, repeated seeds and partial images of
-/// unknown samples are refused, and nothing is written.
+/// Merge renders of one frame into OUT.exr. `--passes`: independent runs
+/// (other seeds), averaged by their eye samples, with the variance of the
+/// mean as a second layer and the noise before and after; inputs of another
+/// scene, overrides, method, size or SPPM iteration count, repeated seeds and
+/// partial images of unknown samples are refused. `--tiles`: crops of one
+/// render (`render --crop-window` or `--pixel-bounds`), placed by their data
+/// windows into the frame; gaps, overlaps and tiles of different renders are
+/// refused. Nothing is written when an input is refused.
 #[derive(Args)]
+#[command(group(clap::ArgGroup::new("mode").required(true).args(["passes", "tiles"])))]
 pub struct MergeArgs {
-    /// Independent runs of the same frame (the only mode: tiles are not merged).
-    #[arg(long, required = true)]
+    /// Independent runs of the same frame, averaged.
+    #[arg(long)]
     pub passes: bool,
+    /// Tiles of one render, stitched into its frame.
+    #[arg(long)]
+    pub tiles: bool,
     /// The merged EXR.
     pub output: PathBuf,
-    /// Two or more renders' EXRs.
-    #[arg(required = true, num_args = 2..)]
+    /// The renders' EXRs (two or more passes; one or more tiles).
+    #[arg(required = true, num_args = 1..)]
     pub inputs: Vec<PathBuf>,
     /// Print the merge's figures (inputs, seeds, weights, noise) as JSON.
     #[arg(long)]
@@ -57,18 +64,17 @@ const SAME: [&str; 7] = [
 ];
 
 fn read_pass(path: &Path) -> Result<Pass> {
-    let attributes = Image::exr_attributes(path)?;
-    let text = attributes
+    let (attributes, provenance) = Image::exr_provenance(path)?;
+    if provenance["pixel_bounds"].is_array() {
+        bail!(
+            "{}: a tile (a crop of the frame): stitch the tiles with merge --tiles first",
+            path.display()
+        );
+    }
+    let merged_passes = attributes
         .iter()
-        .find(|(k, _)| k == "photonmap.provenance")
-        .map(|(_, v)| v)
-        .with_context(|| {
-            format!(
-                "{}: no photonmap.provenance in its header: not a photonmap render",
-                path.display()
-            )
-        })?;
-    if attributes.iter().any(|(k, _)| k == "photonmap.merge") {
+        .any(|(k, v)| k == "photonmap.merge" && v.contains("\"mode\":\"passes\""));
+    if merged_passes {
         bail!(
             "{}: already a merge of passes: merge its passes together instead",
             path.display()
@@ -88,8 +94,6 @@ fn read_pass(path: &Path) -> Result<Pass> {
             path.display()
         );
     }
-    let provenance: serde_json::Value = serde_json::from_str(text)
-        .with_context(|| format!("{}: its photonmap.provenance is not JSON", path.display()))?;
     if provenance["method"] == "sppm" && provenance["iterations"].is_null() {
         bail!("{}: an SPPM render whose header does not record its iterations (a --write-partial file?): passes of different lengths cannot be told apart", path.display());
     }
@@ -109,16 +113,12 @@ fn read_pass(path: &Path) -> Result<Pass> {
 fn check_passes(passes: &[Pass]) -> Result<()> {
     let first = &passes[0];
     for p in &passes[1..] {
-        for field in SAME {
-            let (a, b) = (&first.provenance[field], &p.provenance[field]);
-            if a != b {
-                bail!(
-                    "{} and {}: {field} differs ({a} and {b}): not passes of one frame",
-                    first.path.display(),
-                    p.path.display()
-                );
-            }
-        }
+        super::merge_tiles::require_same(
+            &SAME,
+            (&first.path, &first.provenance),
+            (&p.path, &p.provenance),
+            "passes of one frame",
+        )?;
         if (p.image.width, p.image.height) != (first.image.width, first.image.height) {
             bail!(
                 "{} and {}: the images' sizes differ",
@@ -243,6 +243,12 @@ pub fn run(a: &MergeArgs) -> Result<()> {
             "merge {}: also an input; write the merged image to a file of its own",
             a.output.display()
         );
+    }
+    if a.tiles {
+        return super::merge_tiles::run(&a.output, &a.inputs, a.json);
+    }
+    if a.inputs.len() < 2 {
+        bail!("merge --passes: give two or more passes");
     }
     let passes = a
         .inputs

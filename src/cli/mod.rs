@@ -11,6 +11,7 @@ pub mod convert;
 pub mod convert_scene;
 pub mod info;
 pub mod merge;
+pub mod merge_tiles;
 pub mod photons;
 pub mod progress;
 pub mod regress;

@@ -48,6 +48,20 @@ struct Shared {
     state: Cell<Option<DrawState>>,
     texture_barrier: Option<context::VoidFn>,
     max_texture_size: u32,
+    /// While set: draws and clears into targets of this size (the image's)
+    /// touch only this rectangle (GL scissor), so a crop costs its pixels.
+    pixel_window: Cell<Option<PixelWindow>>,
+    /// The scissor rectangle last sent (None: scissor test off).
+    scissor: Cell<Option<[i32; 4]>>,
+}
+
+/// Which targets are image-shaped, and the part of them to draw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelWindow {
+    /// The image's size: targets of exactly this size are clipped.
+    pub size: (u32, u32),
+    /// The rectangle drawn, in GL's coordinates (x, y from the bottom, w, h).
+    pub rect: [i32; 4],
 }
 
 fn gl_compare(c: Compare) -> u32 {
@@ -89,6 +103,8 @@ impl Gpu {
                 state: Cell::new(None),
                 texture_barrier,
                 max_texture_size,
+                pixel_window: Cell::new(None),
+                scissor: Cell::new(None),
             }),
         })
     }
@@ -99,6 +115,38 @@ impl Gpu {
 
     pub(crate) fn context(&self) -> &GlContext {
         &self.inner.ctx
+    }
+
+    /// Clips every later draw and clear into image-sized targets to the
+    /// window's rectangle, until set to None.
+    pub fn set_pixel_window(&self, window: Option<PixelWindow>) {
+        self.inner.pixel_window.set(window);
+    }
+
+    /// Turns the scissor test on over the pixel window for a target of
+    /// `size`, off for any other (called as a target is bound).
+    pub(crate) fn scissor_for(&self, size: (u32, u32)) {
+        let want = self
+            .inner
+            .pixel_window
+            .get()
+            .filter(|w| w.size == size)
+            .map(|w| w.rect);
+        if want == self.inner.scissor.get() {
+            return;
+        }
+        let gl = self.gl();
+        // SAFETY: module doc; state calls take no object.
+        unsafe {
+            match want {
+                Some([x, y, w, h]) => {
+                    gl.enable(glow::SCISSOR_TEST);
+                    gl.scissor(x, y, w, h);
+                }
+                None => gl.disable(glow::SCISSOR_TEST),
+            }
+        }
+        self.inner.scissor.set(want);
     }
 
     /// GL_MAX_TEXTURE_SIZE: the largest side of a texture or render target.

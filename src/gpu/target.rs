@@ -111,6 +111,7 @@ impl Target {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.raw));
             gl.viewport(x, y, w, h);
         }
+        self.gpu.scissor_for((self.width, self.height));
     }
 
     /// Clears every colour attachment to `value`.

@@ -50,6 +50,22 @@ impl RenderOutput {
     /// The passes this render ran and skipped, with why.
     pub fn explain(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
         let mut lines = self.ray_tracing_lines(scene);
+        if let Some(b) = options.pixel_bounds {
+            let how = if self.method.crops_eye_passes() {
+                "the eye passes draw only these (GL scissor); photons are the frame's"
+            } else {
+                "the eye passes draw the whole frame and the crop is cut from it (this method's pixels read one another's)"
+            };
+            lines.push(line(
+                "crop",
+                0,
+                true,
+                format!(
+                    "pixels {}..{} x {}..{} of the {} x {} frame: {how}",
+                    b.x0, b.x1, b.y0, b.y1, options.width, options.height
+                ),
+            ));
+        }
         // Final gather's maps are made from two views of the scene.
         let method = &options.method;
         let views = method

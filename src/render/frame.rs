@@ -4,7 +4,7 @@
 //! each first diffuse hit, and average the samples into the image.
 
 use crate::error::Error;
-use crate::gpu::{Gpu, Result};
+use crate::gpu::{Gpu, PixelWindow, Result};
 use crate::image::Image;
 use crate::scene::pack::SceneTextures;
 use crate::scene::{Camera, Scene};
@@ -13,7 +13,7 @@ use crate::timing::Timings;
 use super::direct::DirectLight;
 use super::eye_paths::{trace_eye_paths, EyeSample};
 use super::method::MethodRun;
-use super::observer::{At, RenderObserver};
+use super::observer::{At, EstimatePass, Progress, RenderObserver};
 use super::options::RenderOptions;
 use super::output::{FrameState, RenderOutput};
 use super::plan::PassPlan;
@@ -53,6 +53,10 @@ pub fn render_views(
     observer: &mut dyn RenderObserver,
 ) -> Result<RenderOutput> {
     check_request(gpu, options, cameras)?;
+    let observer = &mut Cropped {
+        inner: observer,
+        options,
+    };
     let plan = PassPlan::new(scene, options);
     let (w, h) = (options.width, options.height);
     let textures = SceneTextures::new(gpu, scene)?;
@@ -63,6 +67,19 @@ pub fn render_views(
     // The method first: one map (or final gather's two) serves every view
     // and every eye sample.
     let mut method = MethodRun::prepare(gpu, scene, &textures, options, &mut timings, observer)?;
+    // A crop: the eye passes draw only its pixels where the method's pixels
+    // do not read one another's (`MethodRun::crops_eye_passes`); the image is
+    // cut from the frame's either way.
+    let crop = options.pixel_bounds;
+    let _window = PixelWindowGuard::set(
+        gpu,
+        crop.filter(|_| method.crops_eye_passes())
+            .map(|b| PixelWindow {
+                size: (w, h),
+                rect: b.gl_rect(h),
+            }),
+    );
+    let cut = |image: Image| options.cut(image);
     let mut image = None;
     for (view, camera) in cameras.iter().enumerate() {
         let mut sum = ImageSum::default();
@@ -99,9 +116,9 @@ pub fn render_views(
                 at,
             };
             sum.add(&method.sample(&frame, &mut timings, observer)?);
-            observer.samples_done(view, sum.count, &|| sum.mean_so_far());
+            observer.samples_done(view, sum.count, &|| cut(sum.mean_so_far()));
         }
-        let view_image = sum.mean_so_far();
+        let view_image = cut(sum.mean_so_far());
         observer.frame(view, &view_image)?;
         image = Some(view_image);
     }
@@ -117,6 +134,53 @@ pub fn render_views(
     })
 }
 
+/// The observer as a crop's render shows it: estimate passes' images cut to
+/// the crop, like every other image it sees.
+struct Cropped<'a> {
+    inner: &'a mut dyn RenderObserver,
+    options: &'a RenderOptions,
+}
+
+impl RenderObserver for Cropped<'_> {
+    fn progress(&mut self, progress: &Progress<'_>) {
+        self.inner.progress(progress);
+    }
+
+    fn estimate_pass(&mut self, pass: &EstimatePass<'_>) -> Result<()> {
+        if self.options.pixel_bounds.is_none() {
+            return self.inner.estimate_pass(pass);
+        }
+        self.inner.estimate_pass(&EstimatePass {
+            image: &|| Ok(self.options.cut(pass.image()?)),
+            ..*pass
+        })
+    }
+
+    fn samples_done(&mut self, view: usize, done: u32, mean: &dyn Fn() -> Image) {
+        self.inner.samples_done(view, done, mean);
+    }
+
+    fn frame(&mut self, view: usize, image: &Image) -> Result<()> {
+        self.inner.frame(view, image)
+    }
+}
+
+/// The pixel window while it lives: a failed render leaves none behind.
+struct PixelWindowGuard<'a>(&'a Gpu);
+
+impl<'a> PixelWindowGuard<'a> {
+    fn set(gpu: &'a Gpu, window: Option<PixelWindow>) -> Self {
+        gpu.set_pixel_window(window);
+        Self(gpu)
+    }
+}
+
+impl Drop for PixelWindowGuard<'_> {
+    fn drop(&mut self) {
+        self.0.set_pixel_window(None);
+    }
+}
+
 /// Refuses what no render can do before any GPU work.
 fn check_request(gpu: &Gpu, options: &RenderOptions, cameras: &[Camera]) -> Result<()> {
     if cameras.is_empty() {
@@ -129,7 +193,7 @@ fn check_request(gpu: &Gpu, options: &RenderOptions, cameras: &[Camera]) -> Resu
             options.width, options.height
         )));
     }
-    Ok(())
+    options.check_pixel_bounds()
 }
 
 /// The running sum of eye samples (in order, then one division: the box filter).

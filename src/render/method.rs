@@ -73,6 +73,22 @@ impl MethodRun {
         }
     }
 
+    /// Whether a crop may draw only its own pixels in the eye passes: true
+    /// where no pixel's light reads another pixel's or a compacted list of
+    /// pixels (tested: a crop then equals the frame's pixels bit for bit).
+    /// Otherwise the eye passes run over the whole frame and the crop is cut
+    /// from it.
+    pub fn crops_eye_passes(&self) -> bool {
+        match self {
+            // Adaptive sampling plans from neighbouring pixels and compacts
+            // the pixels it computes; differentials' gather was measured to
+            // differ at a crop's pixels when the others are not drawn.
+            MethodRun::PhotonMap(m) => m.pyramid.is_none(),
+            MethodRun::Differentials(_) => false,
+            MethodRun::DirectOnly | MethodRun::Igi(_) | MethodRun::Radiosity(_) => true,
+        }
+    }
+
     /// One eye sample's image.
     pub fn sample(
         &mut self,

@@ -43,7 +43,7 @@ pub use frame::{render, render_views};
 pub use igi::{Igi, IgiOptions, IgiRun, IgiStats, VplReport, Vpls};
 pub use method::MethodRun;
 pub use observer::{At, EstimatePass, Progress, RenderObserver, StopReason};
-pub use options::{Method, RenderOptions};
+pub use options::{Method, PixelBounds, RenderOptions};
 pub use output::{FrameState, RenderOutput};
 pub use photon_map::{MapEstimate, PhotonMapRun, PhotonReport};
 pub use photon_options::{CausticPaths, PhotonMapOptions, WithCausticMap, WithPhotons};

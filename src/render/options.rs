@@ -27,6 +27,59 @@ pub struct RenderOptions {
     pub spp: u32,
     /// The light beyond direct light and specular paths, and how it is made.
     pub method: Method,
+    /// Render only these pixels of the frame (pbrt's crop window); the
+    /// image is the crop. Pixel and photon streams stay the frame's, so
+    /// tiles stitch into the full render bit for bit.
+    pub pixel_bounds: Option<PixelBounds>,
+}
+
+/// A rectangle of the frame's pixels, half-open: columns x0..x1, rows
+/// y0..y1 counted from the top (pbrt's `--pixelbounds`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct PixelBounds {
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
+}
+
+impl PixelBounds {
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+
+    /// Whether it is a non-empty part of a `width` x `height` frame.
+    pub fn fits(&self, width: u32, height: u32) -> bool {
+        self.x0 < self.x1 && self.y0 < self.y1 && self.x1 <= width && self.y1 <= height
+    }
+
+    /// pbrt's crop window: fractions [x0, x1) x [y0, y1) of the frame, from
+    /// the top left, rounded to pixels as pbrt-v4 rounds them (each edge at
+    /// the ceiling of its fraction of the side).
+    pub fn of_crop_window(crop: [f64; 4], width: u32, height: u32) -> Self {
+        let at = |f: f64, side: u32| ((f * side as f64).ceil() as u32).min(side);
+        Self {
+            x0: at(crop[0], width),
+            x1: at(crop[1], width),
+            y0: at(crop[2], height),
+            y1: at(crop[3], height),
+        }
+    }
+
+    /// The rectangle in GL's window coordinates (x, y from the bottom, w, h)
+    /// of a frame `height` pixels high.
+    pub fn gl_rect(&self, height: u32) -> [i32; 4] {
+        [
+            self.x0 as i32,
+            (height - self.y1) as i32,
+            self.width() as i32,
+            self.height() as i32,
+        ]
+    }
 }
 
 /// The global-illumination method of a render, with its options.
@@ -116,6 +169,7 @@ impl RenderOptions {
             shadow_batch: 0,
             spp: 1,
             method: Method::PhotonMap(PhotonMapOptions::default()),
+            pixel_bounds: None,
         }
     }
 
@@ -129,6 +183,30 @@ impl RenderOptions {
         match &mut self.method {
             Method::PhotonMap(o) => Some(o),
             _ => None,
+        }
+    }
+
+    /// The part of a frame-sized `image` the pixel bounds keep (all of it
+    /// without them).
+    pub fn cut(&self, image: crate::image::Image) -> crate::image::Image {
+        match self.pixel_bounds {
+            Some(b) => image.crop(b.x0, b.y0, b.width(), b.height()),
+            None => image,
+        }
+    }
+
+    /// Refuses pixel bounds that are empty or leave the frame.
+    pub fn check_pixel_bounds(&self) -> crate::error::Result<()> {
+        match self.pixel_bounds {
+            Some(b) if !b.fits(self.width, self.height) => Err(crate::error::Error::out_of_range(
+                "pixel_bounds",
+                format!("{} {} {} {}", b.x0, b.x1, b.y0, b.y1),
+                format!(
+                    "x0 < x1 <= {} and y0 < y1 <= {} (pixels of the {} x {} frame)",
+                    self.width, self.height, self.width, self.height
+                ),
+            )),
+            _ => Ok(()),
         }
     }
 

@@ -21,3 +21,4 @@ mod render;
 mod reports;
 mod scenes;
 mod tables;
+mod tiles;

@@ -138,25 +138,13 @@ fn passes_of_different_frames_are_refused() {
 #[test]
 fn the_slurm_job_scripts_render_passes_and_merge_them() {
     let d = TempDir::new("slurm");
-    let run = |script: &str, task: Option<u32>| {
-        let mut c = std::process::Command::new("bash");
-        c.arg(format!("contrib/slurm/{script}"))
-            .current_dir(crate::common::root())
-            .env("PHOTONMAP", env!("CARGO_BIN_EXE_photonmap"))
-            .env("SCENE", "scenes/ring.toml")
-            .env("OUT", d.as_ref() as &Path)
-            .env("RENDER_ARGS", "--width 32 --height 24")
-            .env_remove("SLURM_ARRAY_TASK_ID");
-        if let Some(t) = task {
-            c.env("SLURM_ARRAY_TASK_ID", t.to_string());
-        }
-        let out = c.output().unwrap();
-        assert!(
-            out.status.success(),
-            "{script}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    };
+    let out = d.as_ref() as &Path;
+    let env = [
+        ("SCENE", "scenes/ring.toml"),
+        ("OUT", out.to_str().unwrap()),
+        ("RENDER_ARGS", "--width 32 --height 24"),
+    ];
+    let run = |script: &str, task: Option<u32>| crate::tiles::slurm(script, task, &env);
     for task in 1..=4 {
         run("seeds.sbatch", Some(task));
     }

@@ -12,7 +12,7 @@ use photonmap::provenance::Provenance;
 use photonmap::render::sppm::SppmOptions;
 use photonmap::render::{
     self, AdaptiveOptions, CausticPaths, FinalGatherOptions, IgiOptions, Image, PhotonMapOptions,
-    RadiosityOptions, RenderOptions, WithCausticMap, WithPhotons,
+    PixelBounds, RadiosityOptions, RenderOptions, WithCausticMap, WithPhotons,
 };
 use photonmap::scene::Scene;
 
@@ -47,6 +47,18 @@ pub struct RenderArgs {
     /// Image height in pixels (default: the scene's; 1..=16384).
     #[arg(long, value_parser = in_range(1, 16384))]
     pub height: Option<u32>,
+    /// Render only this part of the frame, as fractions of its width and
+    /// height from the top left: X0 X1 Y0 Y1, each in 0..=1 (pbrt's
+    /// --cropwindow; each edge at the ceiling of its fraction, in pixels).
+    /// The image is the crop; its EXR keeps the crop as its data window and
+    /// the frame as its display window, and `merge --tiles` stitches tiles
+    /// into the frame, bit for bit as one render makes it.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], allow_negative_numbers = true, conflicts_with = "pixel_bounds")]
+    pub crop_window: Option<Vec<f64>>,
+    /// Render only pixels X0..X1 (columns) by Y0..Y1 (rows from the top),
+    /// half-open (pbrt's --pixelbounds); as --crop-window otherwise.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"])]
+    pub pixel_bounds: Option<Vec<u32>>,
     /// No progress and no timing table on stderr.
     #[arg(long)]
     pub quiet: bool,
@@ -227,7 +239,11 @@ impl Format {
     pub(super) fn encode(self, image: &Image, provenance: &Provenance) -> Result<Vec<u8>> {
         Ok(match self {
             Format::Png => image.png_bytes()?,
-            Format::Exr => image.exr_bytes_with(&provenance.pairs())?,
+            Format::Exr => image.exr_bytes_placed(
+                &provenance.pairs(),
+                provenance.origin(),
+                (provenance.width, provenance.height),
+            )?,
             Format::Pfm => image.pfm_bytes(),
         })
     }
@@ -264,12 +280,49 @@ impl RenderArgs {
         let outputs = self.outputs()?;
         let loaded = self.scene.load()?;
         warn_far_from_origin(&loaded.scene, self.quiet);
-        let options = self.options(&loaded.scene, method);
+        let mut options = self.options(&loaded.scene, method);
+        options.pixel_bounds = self.pixel_bounds_of(options.width, options.height)?;
         Ok(Start {
             outputs,
             loaded,
             options,
         })
+    }
+
+    /// `--crop-window` or `--pixel-bounds` in the frame's pixels, checked.
+    fn pixel_bounds_of(&self, width: u32, height: u32) -> Result<Option<PixelBounds>> {
+        let bounds = match (&self.crop_window, &self.pixel_bounds) {
+            (Some(c), _) => {
+                if let Some(f) = c.iter().find(|f| !(0.0..=1.0).contains(*f)) {
+                    bail!("--crop-window {f}: each fraction must be in 0..=1");
+                }
+                let b = PixelBounds::of_crop_window([c[0], c[1], c[2], c[3]], width, height);
+                if !b.fits(width, height) {
+                    bail!(
+                        "--crop-window {} {} {} {}: holds no pixel of the {width} x {height} frame (x0 < x1 and y0 < y1, after rounding up to pixels: {} {} {} {})",
+                        c[0], c[1], c[2], c[3], b.x0, b.x1, b.y0, b.y1
+                    );
+                }
+                b
+            }
+            (None, Some(p)) => {
+                let b = PixelBounds {
+                    x0: p[0],
+                    x1: p[1],
+                    y0: p[2],
+                    y1: p[3],
+                };
+                if !b.fits(width, height) {
+                    bail!(
+                        "--pixel-bounds {} {} {} {}: need x0 < x1 <= {width} and y0 < y1 <= {height} (the {width} x {height} frame)",
+                        b.x0, b.x1, b.y0, b.y1
+                    );
+                }
+                b
+            }
+            (None, None) => return Ok(None),
+        };
+        Ok(Some(bounds))
     }
 
     /// Every output, checked before any work: a known extension, a folder

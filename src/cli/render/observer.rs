@@ -90,6 +90,8 @@ impl RenderObserver for SnapshotWriter {
 struct Live {
     display: Option<DisplayServer>,
     partial: Option<(PathBuf, Vec<(String, String)>)>,
+    /// Where the image sits in the frame (a crop), and the frame's size.
+    placement: ((u32, u32), (u32, u32)),
     last: Option<Instant>,
 }
 
@@ -103,6 +105,7 @@ impl Live {
         (display.is_some() || partial.is_some()).then_some(Self {
             display,
             partial,
+            placement: (provenance.origin(), (provenance.width, provenance.height)),
             last: None,
         })
     }
@@ -123,8 +126,9 @@ impl Live {
                 if !finished {
                     pairs.push(("partial".into(), "true".into()));
                 }
+                let (origin, frame) = self.placement;
                 let written = image
-                    .exr_bytes_with(&pairs)
+                    .exr_bytes_placed(&pairs, origin, frame)
                     .and_then(|bytes| write_atomically(path, &bytes));
                 written
                     .err()

@@ -35,6 +35,7 @@ pub(super) fn provenance(
         photonmap::provenance::fnv1a64(options.as_bytes())
     );
     (p.seed, p.spp, p.width, p.height) = (o.seed, o.spp, o.width, o.height);
+    p.pixel_bounds = o.pixel_bounds.map(|b| [b.x0, b.x1, b.y0, b.y1]);
     p
 }
 
@@ -102,7 +103,11 @@ pub(super) fn write_done_on_signal(
         if done.image.has_non_finite() {
             bail!("the image done so far has NaN or infinite pixels");
         }
-        let bytes = done.image.exr_bytes_with(&pairs)?;
+        let bytes = done.image.exr_bytes_placed(
+            &pairs,
+            provenance.origin(),
+            (provenance.width, provenance.height),
+        )?;
         let files: Vec<(&Path, &[u8])> = exrs.iter().map(|p| (*p, bytes.as_slice())).collect();
         write_all_atomically(&files)?;
         Ok(())

@@ -40,6 +40,9 @@ pub fn render_sppm(
     sppm: &SppmOptions,
     observer: &mut dyn RenderObserver,
 ) -> Result<SppmOutput> {
+    // A crop renders the whole frame and keeps its pixels: each iteration's
+    // grid follows the largest radius over every pixel.
+    options.check_pixel_bounds()?;
     let mut run = Sppm::new(gpu, scene, options, sppm)?;
     let mut timings = Timings::default();
     let wall = std::time::Instant::now();
@@ -74,11 +77,11 @@ pub fn render_sppm(
             query_pixels: 0,
             seconds: wall.elapsed().as_secs_f64() - observed,
             finished: false,
-            image: &|| run.image(),
+            image: &|| Ok(options.cut(run.image()?)),
         })?;
         observed += t0.elapsed().as_secs_f64();
     }
-    let image = run.image()?;
+    let image = options.cut(run.image()?);
     timings.wall_seconds = wall.elapsed().as_secs_f64();
     observer.estimate_pass(&EstimatePass {
         at: At {
@@ -97,7 +100,21 @@ pub fn render_sppm(
     })?;
     observer.frame(0, &image)?;
     let final_largest_radius = run.largest_radius()?;
-    let explain = explain(&run, sppm);
+    let mut explain = explain(&run, sppm);
+    if let Some(b) = options.pixel_bounds {
+        explain.insert(
+            0,
+            ExplainLine {
+                stage: "crop".into(),
+                passes: 0,
+                ran: true,
+                why: format!(
+                    "pixels {}..{} x {}..{} of the {} x {} frame: every iteration runs over the whole frame (its grid follows the largest radius over every pixel) and the crop is cut from it",
+                    b.x0, b.x1, b.y0, b.y1, options.width, options.height
+                ),
+            },
+        );
+    }
     let adaptive = run
         .adaptive_stats()
         .map(|s| (run.adaptive.as_ref().expect("adaptive").pilot, s.clone()));
