@@ -20,8 +20,11 @@ struct Received {
     /// The image as the updates left it, and the updates' tiles.
     image: Vec<[f32; 3]>,
     tiles: usize,
-    /// Updates that covered the whole image, one per image sent.
+    /// Updates that covered the whole image (a crop's outline, if one was
+    /// drawn), one per image sent.
     images: usize,
+    /// VectorGraphics: the outline's corners, as drawn.
+    outline: Vec<(f32, f32)>,
 }
 
 fn take<const N: usize>(b: &mut &[u8]) -> [u8; N] {
@@ -92,11 +95,36 @@ fn decode(mut stream: &[u8]) -> Received {
                 }
                 r.tiles += 1;
                 covered += (w * h) as usize;
-                if covered >= r.image.len() {
+                let whole = match r.outline.as_slice() {
+                    [(x0, y0), _, (x1, y1), ..] => ((x1 - x0) * (y1 - y0)) as usize,
+                    _ => r.image.len(),
+                };
+                if covered >= whole {
                     r.images += 1;
                     covered = 0;
                 }
                 p = &[];
+            }
+            8 => {
+                let [append] = take(&mut p);
+                assert_eq!(append, 0, "the outline replaces what was drawn");
+                let n = i32_of(&mut p);
+                let f = |p: &mut &[u8]| f32::from_le_bytes(take(p));
+                let mut kinds = Vec::new();
+                for _ in 0..n {
+                    let [kind] = take(&mut p);
+                    kinds.push(kind);
+                    match kind {
+                        10 | 11 => r.outline.push((f(&mut p), f(&mut p))),
+                        4 => {
+                            let rgba = [f(&mut p), f(&mut p), f(&mut p), f(&mut p)];
+                            assert!(rgba.iter().all(|c| (0.0..=1.0).contains(c)));
+                        }
+                        5..=7 => {}
+                        other => panic!("vector graphics command {other}"),
+                    }
+                }
+                assert_eq!(kinds, [6, 10, 11, 11, 11, 7, 4, 5]);
             }
             other => panic!("packet type {other}: not one photonmap sends"),
         }
@@ -194,6 +222,42 @@ fn a_render_streams_to_a_tev_listener_and_ends_on_the_written_image() {
             assert!(p["photons_emitted"].as_u64().unwrap() > 0, "{p}");
         }
         println!("{method}: {} images in {} tiles", got.images, got.tiles);
+    }
+}
+
+/// A crop is shown in place: the viewer's image is the frame's size, the
+/// crop's pixels land where they belong (the written EXR, bit for bit) and
+/// an outline marks them; nothing else is sent.
+#[test]
+fn a_crop_streams_into_its_place_in_the_frame() {
+    let d = TempDir::new("live-crop");
+    let (port, listener) = listen(false);
+    let exr = d.join("crop.exr");
+    let status = Run::new([
+        "render", "ring", "--quiet", "--width", "32", "--height", "24",
+    ])
+    .args(["--pixel-bounds", "5", "21", "3", "15", "--display-server"])
+    .arg(format!("127.0.0.1:{port}"))
+    .output_to(&exr)
+    .spawn()
+    .wait()
+    .unwrap();
+    assert!(status.success(), "{status}");
+    let got = decode(&listener.join().unwrap());
+    assert_eq!((got.created[0].1, got.created[0].2), (32, 24));
+    assert_eq!(
+        got.outline,
+        [(5.0, 3.0), (21.0, 3.0), (21.0, 15.0), (5.0, 15.0)]
+    );
+    assert!(got.images >= 1, "{} images", got.images);
+    let written = Image::read_exr(&exr).unwrap();
+    for (i, px) in got.image.iter().enumerate() {
+        let (x, y) = (i as u32 % 32, i as u32 / 32);
+        if (5..21).contains(&x) && (3..15).contains(&y) {
+            assert_eq!(*px, written.get(x - 5, y - 3), "pixel {x}, {y}");
+        } else {
+            assert!(px.iter().all(|c| c.is_nan()), "pixel {x}, {y} was sent");
+        }
     }
 }
 

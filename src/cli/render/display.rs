@@ -8,7 +8,14 @@
 //! - UpdateImage v3 (6): grab focus, name, channel count, the channel names,
 //!   x, y, width, height of a tile, an i64 offset and an i64 stride per
 //!   channel into the tile's f32 data (here interleaved RGB: offsets 0, 1, 2,
-//!   strides 3), then the data, row 0 at the top.
+//!   strides 3), then the data, row 0 at the top;
+//! - VectorGraphics (8), for a crop only: grab focus, name, append (0), the
+//!   command count, then each command's one-byte type and its f32s: the
+//!   crop's outline as BeginPath (6), MoveTo (10) and three LineTo (11) to
+//!   its corners, ClosePath (7), StrokeColor (4, RGBA) and Stroke (5).
+//!
+//! A crop's image is created at the frame's size and its tiles are placed at
+//! the crop, so tiles of one frame sent to one viewer sit where they belong.
 //!
 //! The render never waits for the viewer: images go to a slot that holds
 //! only the latest one, and a thread of its own sends it. A viewer that is
@@ -29,6 +36,14 @@ use photonmap::image::Image;
 /// tev's packet types (tev's `IpcPacket::EType`).
 const CREATE_IMAGE: u8 = 4;
 const UPDATE_IMAGE_V3: u8 = 6;
+const VECTOR_GRAPHICS: u8 = 8;
+/// tev's vector graphics commands (tev's `VgCommand::EType`).
+const VG_STROKE_COLOR: u8 = 4;
+const VG_STROKE: u8 = 5;
+const VG_BEGIN_PATH: u8 = 6;
+const VG_CLOSE_PATH: u8 = 7;
+const VG_MOVE_TO: u8 = 10;
+const VG_LINE_TO: u8 = 11;
 /// Tiles of an update, at most this many pixels a side (tev's own Python
 /// client's size, which keeps each packet small).
 const TILE: u32 = 128;
@@ -59,6 +74,14 @@ pub fn image_name(scene: &str) -> String {
     format!("{scene} ({})", std::process::id())
 }
 
+/// Where the images sit in the viewer's image: a crop's first pixel
+/// (column, row from the top) and the frame's size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    pub origin: (u32, u32),
+    pub frame: (u32, u32),
+}
+
 #[derive(Default)]
 struct Slot {
     latest: Option<Image>,
@@ -79,7 +102,7 @@ pub struct DisplayServer {
 }
 
 impl DisplayServer {
-    pub fn start(address: &str, name: String) -> Self {
+    pub fn start(address: &str, name: String, placement: Option<Placement>) -> Self {
         let shared = Arc::new(Shared {
             slot: Mutex::new(Slot::default()),
             wake: Condvar::new(),
@@ -89,7 +112,7 @@ impl DisplayServer {
         let thread = std::thread::Builder::new()
             .name("display-server".into())
             .spawn(move || {
-                Sender::new(address, name).run(&s);
+                Sender::new(address, name, placement).run(&s);
                 let _ = tell.send(());
             })
             .ok();
@@ -134,6 +157,7 @@ impl Drop for DisplayServer {
 struct Sender {
     address: String,
     name: String,
+    placement: Option<Placement>,
     stream: Option<TcpStream>,
     /// The size of the image created on the viewer over this connection.
     created: Option<(u32, u32)>,
@@ -143,10 +167,11 @@ struct Sender {
 }
 
 impl Sender {
-    fn new(address: String, name: String) -> Self {
+    fn new(address: String, name: String, placement: Option<Placement>) -> Self {
         Self {
             address,
             name,
+            placement,
             stream: None,
             created: None,
             last_try: None,
@@ -192,13 +217,20 @@ impl Sender {
             self.missed = Some(image);
             return;
         };
-        let size = (image.width, image.height);
+        let (origin, size) = match self.placement {
+            Some(p) => (p.origin, p.frame),
+            None => ((0, 0), (image.width, image.height)),
+        };
         let mut sent = Ok(());
         if self.created != Some(size) {
             sent = stream.write_all(&create_image(&self.name, size.0, size.1));
+            if self.placement.is_some() {
+                let outline = outline(&self.name, origin, (image.width, image.height));
+                sent = sent.and_then(|_| stream.write_all(&outline));
+            }
             self.created = Some(size);
         }
-        for packet in update_image(&self.name, &image) {
+        for packet in update_image(&self.name, &image, origin) {
             if sent.is_err() {
                 break;
             }
@@ -273,8 +305,25 @@ fn create_image(name: &str, width: u32, height: u32) -> Vec<u8> {
     p.done()
 }
 
-/// The image as UpdateImage v3 packets, a tile each.
-fn update_image(name: &str, image: &Image) -> Vec<Vec<u8>> {
+/// The outline of the `size` pixels at `origin`, as VectorGraphics.
+fn outline(name: &str, origin: (u32, u32), size: (u32, u32)) -> Vec<u8> {
+    let (x0, y0) = (origin.0 as f32, origin.1 as f32);
+    let (x1, y1) = (x0 + size.0 as f32, y0 + size.1 as f32);
+    let mut p = Packet::new(VECTOR_GRAPHICS);
+    p.byte(0).string(name).byte(0).i32(8);
+    p.byte(VG_BEGIN_PATH);
+    p.byte(VG_MOVE_TO).f32(x0).f32(y0);
+    for (x, y) in [(x1, y0), (x1, y1), (x0, y1)] {
+        p.byte(VG_LINE_TO).f32(x).f32(y);
+    }
+    p.byte(VG_CLOSE_PATH);
+    p.byte(VG_STROKE_COLOR).f32(1.0).f32(0.6).f32(0.0).f32(1.0);
+    p.byte(VG_STROKE);
+    p.done()
+}
+
+/// The image as UpdateImage v3 packets, a tile each, placed at `origin`.
+fn update_image(name: &str, image: &Image, origin: (u32, u32)) -> Vec<Vec<u8>> {
     let mut packets = Vec::new();
     for y0 in (0..image.height).step_by(TILE as usize) {
         for x0 in (0..image.width).step_by(TILE as usize) {
@@ -284,7 +333,8 @@ fn update_image(name: &str, image: &Image) -> Vec<Vec<u8>> {
             for c in CHANNELS {
                 p.string(c);
             }
-            p.i32(x0 as i32).i32(y0 as i32).i32(w as i32).i32(h as i32);
+            let (x, y) = (origin.0 + x0, origin.1 + y0);
+            p.i32(x as i32).i32(y as i32).i32(w as i32).i32(h as i32);
             for offset in 0..CHANNELS.len() {
                 p.i64(offset as i64);
             }

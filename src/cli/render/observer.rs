@@ -13,7 +13,7 @@ use photonmap::render::{EstimatePass, Image, Progress, RenderObserver, StopReaso
 use photonmap::scene::Scene;
 
 use super::args::{OnSignal, Outputs, RenderArgs, SnapshotEvery};
-use super::display::{image_name, DisplayServer};
+use super::display::{image_name, DisplayServer, Placement};
 use crate::cli::progress::{ProgressReport, Work};
 
 /// The shortest time between two live images of a render in progress.
@@ -97,10 +97,13 @@ struct Live {
 
 impl Live {
     fn new(args: &RenderArgs, scene: &Scene, provenance: &Provenance) -> Option<Self> {
-        let display = args
-            .display_server
-            .as_deref()
-            .map(|a| DisplayServer::start(a, image_name(&scene.name)));
+        let display = args.display_server.as_deref().map(|a| {
+            let placement = provenance.pixel_bounds.map(|_| Placement {
+                origin: provenance.origin(),
+                frame: (provenance.width, provenance.height),
+            });
+            DisplayServer::start(a, image_name(&scene.name), placement)
+        });
         let partial = args.write_partial.clone().map(|p| (p, provenance.pairs()));
         (display.is_some() || partial.is_some()).then_some(Self {
             display,
