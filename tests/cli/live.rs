@@ -165,8 +165,8 @@ fn listen(hang_up: bool) -> (u16, std::thread::JoinHandle<Vec<u8>>) {
 }
 
 /// The one-shot estimate and SPPM, each streamed to a listener: the viewer
-/// is told the image's name ("scene (pid)") and size once, gets at least the
-/// first running image and the finished one, and what it last holds is the
+/// is told the image's name ("scene (pid)") and size once, gets the finished
+/// image (and running ones as the sender keeps up), and what it last holds is the
 /// EXR written, bit for bit; so is `--write-partial`'s file, whose header no
 /// longer says partial.
 #[test]
@@ -205,7 +205,9 @@ fn a_render_streams_to_a_tev_listener_and_ends_on_the_written_image() {
             )],
             "{method}"
         );
-        assert!(got.images >= 2, "{method}: {} images sent", got.images);
+        // Running images are sent as the sender keeps up (the slot holds the
+        // newest only), so under load the finished image may be the one.
+        assert!(got.images >= 1, "{method}: {} images sent", got.images);
         let written = Image::read_exr(&exr).unwrap();
         assert_eq!(
             got.image, written.pixels,
