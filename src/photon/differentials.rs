@@ -103,7 +103,7 @@ pub fn trace_differentials(
     for (l, m) in measures.iter().enumerate() {
         data[4 * l..4 * l + 2].copy_from_slice(m);
     }
-    let measure = Texture::from_f32(
+    let measure = Texture::from_texels(
         gpu,
         measures.len().max(1) as u32,
         1,

@@ -326,7 +326,7 @@ impl PhotonTracer {
                 }
             }
         }
-        Texture::from_f32(
+        Texture::from_texels(
             &self.gpu,
             width * 2,
             frame_height * frames,
@@ -590,7 +590,8 @@ impl PhotonTracer {
             return Err(Error::NoCausticPath);
         }
         let t = maps.texels(scene);
-        let texture = Texture::from_f32(&self.gpu, t.width, t.height, TexFormat::Rgba32F, &t.data)?;
+        let texture =
+            Texture::from_texels(&self.gpu, t.width, t.height, TexFormat::Rgba32F, &t.data)?;
         Ok(Some(Aim { maps, texture }))
     }
 
@@ -736,7 +737,7 @@ impl PhotonFrames {
         photons_used: u32,
     ) -> Result<Self> {
         let height = frame_height * frames;
-        let t = |d: &[f32]| Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, d);
+        let t = |d: &[f32]| Texture::from_texels(gpu, width, height, TexFormat::Rgba32F, d);
         let outgoing = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
         let mut f = Self::assemble(
             gpu,

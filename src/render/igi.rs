@@ -230,8 +230,7 @@ impl Vpls {
         let mut state = crate::random::rng_init(seed, [count, 0], crate::layout::VPL_STREAM);
         crate::random::shuffle(&mut order, &mut state);
         order.resize((pairs.width * pairs.height) as usize, -1);
-        let order =
-            Texture::from_i32_format(gpu, pairs.width, pairs.height, TexFormat::R32I, &order)?;
+        let order = Texture::from_texels(gpu, pairs.width, pairs.height, TexFormat::R32I, &order)?;
         let t = || Texture::new(gpu, pairs.width, pairs.height, TexFormat::Rgba32F);
         let (position, normal, intensity) = (t()?, t()?, t()?);
         let target = Target::new(gpu, &[&position, &normal, &intensity])?;
@@ -488,7 +487,7 @@ fn primitive_boxes(gpu: &Gpu, scene: &Scene) -> Result<Texture> {
         data[8 * i..8 * i + 3].copy_from_slice(&lo.to_array());
         data[8 * i + 4..8 * i + 7].copy_from_slice(&hi.to_array());
     }
-    Texture::from_f32(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
+    Texture::from_texels(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
 }
 
 /// IGI through a render: the caustic map, the VPLs, the gather's textures
