@@ -114,20 +114,8 @@ impl IgiOptions {
     }
 
     pub fn check(&self) -> Result<()> {
-        if !(1..=1 << 20).contains(&self.vpl_paths) {
-            return Err(Error::out_of_range(
-                "igi.vpl_paths",
-                self.vpl_paths,
-                "the allowed range is 1..=1048576",
-            ));
-        }
-        if !(1..=64).contains(&self.vpl_bounces) {
-            return Err(Error::out_of_range(
-                "igi.vpl_bounces",
-                self.vpl_bounces,
-                "the allowed range is 1..=64",
-            ));
-        }
+        Error::check_range("igi.vpl_paths", self.vpl_paths, 1..=1 << 20)?;
+        Error::check_range("igi.vpl_bounces", self.vpl_bounces, 1..=64)?;
         if !(1..=8).contains(&self.interleave) {
             return Err(Error::out_of_range(
                 "igi.interleave",
@@ -135,13 +123,7 @@ impl IgiOptions {
                 "the allowed range is 1..=8 (n x n subsets)",
             ));
         }
-        if !(1..=16).contains(&self.downsample) {
-            return Err(Error::out_of_range(
-                "igi.downsample",
-                self.downsample,
-                "the allowed range is 1..=16",
-            ));
-        }
+        Error::check_range("igi.downsample", self.downsample, 1..=16)?;
         if let Some(k) = self.caustic_k {
             Error::check_range("igi.caustic_k", k, 1..=MAX_K)?;
         }
