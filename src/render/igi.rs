@@ -221,12 +221,9 @@ impl Vpls {
         textures.bind(&mut b);
         b.texture("u_pairs", &pairs)
             .texture("u_order", &order)
-            .int("u_count", count as i32)
-            .texture("u_position", &frames.position)
-            .texture("u_power", &frames.power)
-            .texture("u_incoming", &frames.incoming)
-            .texture("u_outgoing", &frames.outgoing)
-            .int("u_record_width", frames.width as i32)
+            .int("u_count", count as i32);
+        frames.bind_record_textures(&mut b);
+        b.int("u_record_width", frames.width as i32)
             .draw_fullscreen(&target, &DrawState::PLAIN)?;
         drop(b);
         gpu.finish();

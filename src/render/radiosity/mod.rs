@@ -658,11 +658,8 @@ impl Radiosity {
         let mut b = self.programs.deposit.bind();
         textures.bind(&mut b);
         self.bind_atlas(&mut b);
-        b.texture("u_position", &records.position)
-            .texture("u_power", &records.power)
-            .texture("u_incoming", &records.incoming)
-            .texture("u_outgoing", &records.outgoing)
-            .int("u_record_width", records.width as i32)
+        records.bind_record_textures(&mut b);
+        b.int("u_record_width", records.width as i32)
             .int("u_frame_height", records.frame_height as i32)
             .int("u_photons_used", records.photons_used as i32)
             .float("u_power_scale", records.power_scale)
