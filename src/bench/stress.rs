@@ -398,7 +398,7 @@ fn sort_errors(gpu: &Gpu, n: usize) -> Result<usize> {
         .map(|i| (crate::random::pcg_hash(99u32.wrapping_add(i + 1)) % 100_000) as i32)
         .collect();
     let data = crate::photon::bitonic::key_records(&keys);
-    let tex = Texture::from_i32_format(gpu, w, h, TexFormat::Rg32I, &data)?;
+    let tex = Texture::from_texels(gpu, w, h, TexFormat::Rg32I, &data)?;
     let (sorted, _) = BitonicBuild::new(gpu)?.sort(tex)?;
     let got = sorted.read_i32();
     Ok(crate::photon::bitonic::sorted_pairs(&keys)

@@ -160,13 +160,14 @@ impl Texture {
         })
     }
 
-    /// A float texture filled from `data` (row 0 first, `channels` floats a texel).
-    pub fn from_f32(
+    /// A texture filled from `data` (row 0 first, `channels` values a texel;
+    /// floats or ints as `format` holds).
+    pub fn from_texels<T: Texel>(
         gpu: &Gpu,
         width: u32,
         height: u32,
         format: TexFormat,
-        data: &[f32],
+        data: &[T],
     ) -> Result<Self> {
         let t = Self::new(gpu, width, height, format)?;
         t.upload(data)?;
@@ -175,19 +176,7 @@ impl Texture {
 
     /// An RGBA32I texture filled from `data` (4 ints a texel).
     pub fn from_i32(gpu: &Gpu, width: u32, height: u32, data: &[i32]) -> Result<Self> {
-        Self::from_i32_format(gpu, width, height, TexFormat::Rgba32I, data)
-    }
-
-    pub fn from_i32_format(
-        gpu: &Gpu,
-        width: u32,
-        height: u32,
-        format: TexFormat,
-        data: &[i32],
-    ) -> Result<Self> {
-        let t = Self::new(gpu, width, height, format)?;
-        t.upload(data)?;
-        Ok(t)
+        Self::from_texels(gpu, width, height, TexFormat::Rgba32I, data)
     }
 
     /// Replaces level 0 with `data` (row 0 first, `channels` values a texel).

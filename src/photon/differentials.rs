@@ -103,7 +103,7 @@ pub fn trace_differentials(
     for (l, m) in measures.iter().enumerate() {
         data[4 * l..4 * l + 2].copy_from_slice(m);
     }
-    let measure = Texture::from_f32(
+    let measure = Texture::from_texels(
         gpu,
         measures.len().max(1) as u32,
         1,
@@ -117,11 +117,8 @@ pub fn trace_differentials(
         gpu.texture_barrier();
         let mut b = program.bind();
         textures.bind(&mut b);
-        b.texture("u_position", &frames.position)
-            .texture("u_power", &frames.power)
-            .texture("u_incoming", &frames.incoming)
-            .texture("u_outgoing", &frames.outgoing)
-            .texture("u_axis1", &out.axis1)
+        frames.bind_record_textures(&mut b);
+        b.texture("u_axis1", &out.axis1)
             .texture("u_axis2", &out.axis2)
             .texture("u_state0", &out.state[0])
             .texture("u_state1", &out.state[1])

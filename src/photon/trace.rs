@@ -107,6 +107,15 @@ impl PhotonFrames {
             .iter()
             .sum()
     }
+
+    /// The four record textures, under the names every program reading
+    /// whole photon records gives them.
+    pub fn bind_record_textures(&self, b: &mut crate::gpu::Bindings<'_>) {
+        b.texture("u_position", &self.position)
+            .texture("u_power", &self.power)
+            .texture("u_incoming", &self.incoming)
+            .texture("u_outgoing", &self.outgoing);
+    }
 }
 
 /// What both bounce programs (per bounce and fused) read: the scene, the
@@ -123,11 +132,8 @@ fn bind_bounce_inputs(
     if let Some((_, r)) = &batch.random {
         b.texture("u_random_numbers", r);
     }
-    b.texture("u_position", &f.position)
-        .texture("u_power", &f.power)
-        .texture("u_incoming", &f.incoming)
-        .texture("u_outgoing", &f.outgoing)
-        .uint("u_seed", seed)
+    f.bind_record_textures(b);
+    b.uint("u_seed", seed)
         .int("u_frame_height", f.frame_height as i32)
         .int("u_store_direct", scene.photon_map.store_direct as i32)
         .int("u_caustics_only", scene.photon_map.caustics_only as i32)
@@ -326,7 +332,7 @@ impl PhotonTracer {
                 }
             }
         }
-        Texture::from_f32(
+        Texture::from_texels(
             &self.gpu,
             width * 2,
             frame_height * frames,
@@ -590,7 +596,8 @@ impl PhotonTracer {
             return Err(Error::NoCausticPath);
         }
         let t = maps.texels(scene);
-        let texture = Texture::from_f32(&self.gpu, t.width, t.height, TexFormat::Rgba32F, &t.data)?;
+        let texture =
+            Texture::from_texels(&self.gpu, t.width, t.height, TexFormat::Rgba32F, &t.data)?;
         Ok(Some(Aim { maps, texture }))
     }
 
@@ -736,7 +743,7 @@ impl PhotonFrames {
         photons_used: u32,
     ) -> Result<Self> {
         let height = frame_height * frames;
-        let t = |d: &[f32]| Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, d);
+        let t = |d: &[f32]| Texture::from_texels(gpu, width, height, TexFormat::Rgba32F, d);
         let outgoing = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
         let mut f = Self::assemble(
             gpu,

@@ -114,20 +114,8 @@ impl IgiOptions {
     }
 
     pub fn check(&self) -> Result<()> {
-        if !(1..=1 << 20).contains(&self.vpl_paths) {
-            return Err(Error::out_of_range(
-                "igi.vpl_paths",
-                self.vpl_paths,
-                "the allowed range is 1..=1048576",
-            ));
-        }
-        if !(1..=64).contains(&self.vpl_bounces) {
-            return Err(Error::out_of_range(
-                "igi.vpl_bounces",
-                self.vpl_bounces,
-                "the allowed range is 1..=64",
-            ));
-        }
+        Error::check_range("igi.vpl_paths", self.vpl_paths, 1..=1 << 20)?;
+        Error::check_range("igi.vpl_bounces", self.vpl_bounces, 1..=64)?;
         if !(1..=8).contains(&self.interleave) {
             return Err(Error::out_of_range(
                 "igi.interleave",
@@ -135,13 +123,7 @@ impl IgiOptions {
                 "the allowed range is 1..=8 (n x n subsets)",
             ));
         }
-        if !(1..=16).contains(&self.downsample) {
-            return Err(Error::out_of_range(
-                "igi.downsample",
-                self.downsample,
-                "the allowed range is 1..=16",
-            ));
-        }
+        Error::check_range("igi.downsample", self.downsample, 1..=16)?;
         if let Some(k) = self.caustic_k {
             Error::check_range("igi.caustic_k", k, 1..=MAX_K)?;
         }
@@ -230,8 +212,7 @@ impl Vpls {
         let mut state = crate::random::rng_init(seed, [count, 0], crate::layout::VPL_STREAM);
         crate::random::shuffle(&mut order, &mut state);
         order.resize((pairs.width * pairs.height) as usize, -1);
-        let order =
-            Texture::from_i32_format(gpu, pairs.width, pairs.height, TexFormat::R32I, &order)?;
+        let order = Texture::from_texels(gpu, pairs.width, pairs.height, TexFormat::R32I, &order)?;
         let t = || Texture::new(gpu, pairs.width, pairs.height, TexFormat::Rgba32F);
         let (position, normal, intensity) = (t()?, t()?, t()?);
         let target = Target::new(gpu, &[&position, &normal, &intensity])?;
@@ -240,12 +221,9 @@ impl Vpls {
         textures.bind(&mut b);
         b.texture("u_pairs", &pairs)
             .texture("u_order", &order)
-            .int("u_count", count as i32)
-            .texture("u_position", &frames.position)
-            .texture("u_power", &frames.power)
-            .texture("u_incoming", &frames.incoming)
-            .texture("u_outgoing", &frames.outgoing)
-            .int("u_record_width", frames.width as i32)
+            .int("u_count", count as i32);
+        frames.bind_record_textures(&mut b);
+        b.int("u_record_width", frames.width as i32)
             .draw_fullscreen(&target, &DrawState::PLAIN)?;
         drop(b);
         gpu.finish();
@@ -488,7 +466,7 @@ fn primitive_boxes(gpu: &Gpu, scene: &Scene) -> Result<Texture> {
         data[8 * i..8 * i + 3].copy_from_slice(&lo.to_array());
         data[8 * i + 4..8 * i + 7].copy_from_slice(&hi.to_array());
     }
-    Texture::from_f32(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
+    Texture::from_texels(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
 }
 
 /// IGI through a render: the caustic map, the VPLs, the gather's textures

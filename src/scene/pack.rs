@@ -255,7 +255,7 @@ fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture> {
     let height = (rows.len().div_ceil(width as usize) as u32).max(1);
     let mut data: Vec<f32> = rows.iter().flatten().copied().collect();
     data.resize(width as usize * height as usize * 4, 0.0);
-    Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, &data)
+    Texture::from_texels(gpu, width, height, TexFormat::Rgba32F, &data)
 }
 
 /// `values` (channels of `format` a texel) in rows of BVH_ROW_TEXELS texels.
@@ -263,7 +263,7 @@ fn upload_ints(gpu: &Gpu, mut values: Vec<i32>, format: TexFormat) -> Result<Tex
     let row = BVH_ROW_TEXELS as usize * format.channels();
     let height = values.len().div_ceil(row).max(1);
     values.resize(row * height, 0);
-    Texture::from_i32_format(gpu, BVH_ROW_TEXELS, height as u32, format, &values)
+    Texture::from_texels(gpu, BVH_ROW_TEXELS, height as u32, format, &values)
 }
 
 /// Refuses a scene whose primitive texture this driver cannot hold.

@@ -204,7 +204,7 @@ pub fn intersect_twin(
     let upload = |texels: &[[f32; 4]]| {
         let mut d: Vec<f32> = texels.iter().flatten().copied().collect();
         d.resize((width * height * 4) as usize, 0.0);
-        Texture::from_f32(gpu, width, height, TexFormat::Rgba32F, &d).unwrap()
+        Texture::from_texels(gpu, width, height, TexFormat::Rgba32F, &d).unwrap()
     };
     let (to, td, tn) = (upload(origins), upload(directions), upload(normals));
     let out = Texture::new(gpu, width, height, TexFormat::Rgba32F).unwrap();

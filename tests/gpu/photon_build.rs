@@ -29,7 +29,7 @@ fn sort_on_gpu(
         .enumerate()
         .flat_map(|(i, &k)| [k, i as i32, 0, 0].into_iter().take(channels))
         .collect();
-    let tex = Texture::from_i32_format(gpu, w, h, format, &data).unwrap();
+    let tex = Texture::from_texels(gpu, w, h, format, &data).unwrap();
     let (sorted, passes) = build.sort(tex).unwrap();
     (
         sorted
@@ -433,7 +433,7 @@ fn float_addressing_refuses_sorts_past_2_pow_24() {
     let (w, h) = sort_texture_size(keys.len() as u64);
     let data = key_records(&keys);
     let (sorted, _) = build
-        .sort(Texture::from_i32_format(&gpu, w, h, TexFormat::Rg32I, &data).unwrap())
+        .sort(Texture::from_texels(&gpu, w, h, TexFormat::Rg32I, &data).unwrap())
         .unwrap();
     let got: Vec<(i32, i32)> = sorted.read_i32().chunks(2).map(|c| (c[0], c[1])).collect();
     let cpu = sorted_pairs(&keys);

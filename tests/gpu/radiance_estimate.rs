@@ -9,7 +9,7 @@ use photonmap::render::{
     render, EstimateMode, Method, PhotonMapOptions, RenderOptions, RenderOutput,
 };
 use photonmap::scene::Scene;
-use photonmap::twins::knn::{knn_grid, CpuPhotonMap};
+use photonmap::twins::knn::{knn_grid, CpuPhotonMap, KnnResult};
 
 fn render_gi(
     scene: &Scene,
@@ -72,31 +72,39 @@ fn gpu_results(out: &RenderOutput) -> Vec<(usize, Vec3, Vec3, f32, u32)> {
     v
 }
 
-/// How many of the GPU's queries `results` end otherwise than `twin(pixel,
-/// position)`'s (accepted, r^2, flux): another accepted count, or radius or
-/// flux beyond float precision. The first few are printed, named `what`.
-fn disagreeing(
+/// At most one in `per` of the GPU's queries `results` end otherwise than
+/// `twin(pixel, position)`'s: another accepted count, or radius or flux beyond
+/// float precision. The first few, and the count, are printed, named `what`.
+fn assert_agrees_with_twin(
     what: &str,
     results: &[(usize, Vec3, Vec3, f32, u32)],
-    twin: impl Fn(usize, Vec3) -> (u32, f32, Vec3),
-) -> usize {
+    per: usize,
+    twin: impl Fn(usize, Vec3) -> KnnResult,
+) {
     let mut mismatched = 0;
     for &(i, x, flux, r2, accepted) in results {
         let cpu = twin(i, x);
-        let same = cpu.0 == accepted
-            && (cpu.1 - r2).abs() <= 1e-5 * r2.max(1e-12)
-            && (cpu.2 - flux).abs().max_element() <= 1e-4 * cpu.2.max_element().max(1e-20);
+        let same = cpu.accepted == accepted
+            && (cpu.radius2 - r2).abs() <= 1e-5 * r2.max(1e-12)
+            && (cpu.flux - flux).abs().max_element() <= 1e-4 * cpu.flux.max_element().max(1e-20);
         if !same {
             mismatched += 1;
             if mismatched < 4 {
                 eprintln!(
                     "{what} pixel {i}: GPU {accepted} {r2} {flux}, CPU {} {} {}",
-                    cpu.0, cpu.1, cpu.2
+                    cpu.accepted, cpu.radius2, cpu.flux
                 );
             }
         }
     }
-    mismatched
+    eprintln!(
+        "{what}: {} query pixels, {mismatched} differ from the CPU twin",
+        results.len()
+    );
+    assert!(
+        mismatched * per <= results.len(),
+        "{what}: {mismatched} pixels differ"
+    );
 }
 
 #[test]
@@ -117,19 +125,10 @@ fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
                 "{name}: only {} query pixels",
                 results.len()
             );
-            let mismatched = disagreeing(&format!("{name} {build:?}"), &results, |_, x| {
-                let cpu = knn_grid(&cpu_map, x, k, max_r);
-                (cpu.accepted, cpu.radius2, cpu.flux)
-            });
-            eprintln!(
-                "{name} {build:?}: {} query pixels, {mismatched} differ from the CPU kNN-grid",
-                results.len()
-            );
             // A photon exactly at the radius can fall either side of f32 rounding.
-            assert!(
-                mismatched * 1000 <= results.len(),
-                "{name} {build:?}: {mismatched} pixels differ"
-            );
+            assert_agrees_with_twin(&format!("{name} {build:?}"), &results, 1000, |_, x| {
+                knn_grid(&cpu_map, x, k, max_r)
+            });
         }
     }
 }
@@ -401,7 +400,7 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
             let (k, max_r) = (scene.photon_map.k, scene.photon_map.max_radius);
             let thickness = photonmap::layout::DISC_THICKNESS * max_r;
             let results = gpu_results(&out);
-            let mismatched = disagreeing(&format!("{name} {leak:?}"), &results, |i, x| {
+            assert_agrees_with_twin(&format!("{name} {leak:?}"), &results, 100, |i, x| {
                 let nf = Vec3::from_slice(&normal[4 * i..]);
                 let accept = |p: Vec3| {
                     let disc = !matches!(leak, LeakTest::Disc | LeakTest::DiscAndVisibility)
@@ -410,17 +409,8 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
                         || photon_visible(&scene, x, nf, p);
                     disc && seen
                 };
-                let cpu = knn_grid_filtered(&cpu_map, x, k, max_r, &accept);
-                (cpu.accepted, cpu.radius2, cpu.flux)
+                knn_grid_filtered(&cpu_map, x, k, max_r, &accept)
             });
-            eprintln!(
-                "{name} {leak:?}: {} query pixels, {mismatched} differ from the CPU twin",
-                results.len()
-            );
-            assert!(
-                mismatched * 100 <= results.len(),
-                "{name} {leak:?}: {mismatched} differ"
-            );
         }
     }
 }

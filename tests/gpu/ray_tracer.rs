@@ -74,16 +74,41 @@ fn failing(gpu_mean: &Image, n: usize, cpu: &(Image, Image, Vec<bool>)) -> f64 {
     bad as f64 / tested as f64
 }
 
-/// The mean of `images` (one a seed) against `scene`'s split tree and against
-/// `wrong`'s: (well-conditioned pixels, pixels, the fraction of channels
-/// failing against each).
-fn against_split_trees(images: &[Image], scene: &Scene, wrong: &Scene) -> (usize, usize, f64, f64) {
+/// The mean of `images` (one a seed) matches `scene`'s split tree (`right`
+/// names it) in every channel of its well-conditioned pixels, more than
+/// `min_stable` of all, and is told apart from `wrong`'s (named `wrong_name`).
+fn assert_converges_to_split_tree(
+    images: &[Image],
+    (scene, right_name): (&Scene, &str),
+    (wrong, wrong_name): (&Scene, &str),
+    min_stable: f64,
+) {
     let mean = Image::average(images);
     let cpu = cpu_expectation(scene);
-    let stable = cpu.2.iter().filter(|&&s| s).count();
+    let (stable, pixels) = (cpu.2.iter().filter(|&&s| s).count(), cpu.2.len());
     let right = failing(&mean, images.len(), &cpu);
     let wrong = failing(&mean, images.len(), &cpu_expectation(wrong));
-    (stable, cpu.2.len(), right, wrong)
+    eprintln!(
+        "{stable} of {pixels} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against {right_name}, {:.3}% against {wrong_name}",
+        100.0 * right,
+        100.0 * wrong
+    );
+    assert!(
+        stable as f64 > min_stable * pixels as f64,
+        "too few pixels compared"
+    );
+    // At 4.5 sigma a correct estimator fails ~1e-5 of channels.
+    assert!(
+        right == 0.0,
+        "GPU mean departs from {right_name} in {:.3}% of channels",
+        100.0 * right
+    );
+    // A wrong expectation must show in a good part of the shape.
+    assert!(
+        wrong > 0.01,
+        "{wrong_name} was not told apart ({:.3}%)",
+        100.0 * wrong
+    );
 }
 
 #[test]
@@ -97,27 +122,12 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
         "no pixel varies: nothing stochastic was tested"
     );
     // A different ior changes the expectation: the test must notice.
-    let (stable, pixels, right, wrong) = against_split_trees(&images, &scene, &glass_scene(1.6));
-    eprintln!(
-        "{stable} of {pixels} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against the split tree, {:.3}% against ior 1.6",
-        100.0 * right,
-        100.0 * wrong
-    );
-    assert!(
-        stable as f64 > 0.9 * pixels as f64,
-        "too few pixels compared"
-    );
-    // At 4.5 sigma a correct estimator fails ~1e-5 of channels.
-    assert!(
-        right == 0.0,
-        "GPU mean departs from the split tree in {:.3}% of channels",
-        100.0 * right
-    );
-    // The ball fills about a tenth of the frame; a wrong ior must show in a good part of it.
-    assert!(
-        wrong > 0.01,
-        "a 1.6 ior expectation was not told apart ({:.3}%)",
-        100.0 * wrong
+    // The ball fills about a tenth of the frame.
+    assert_converges_to_split_tree(
+        &images,
+        (&scene, "the split tree"),
+        (&glass_scene(1.6), "ior 1.6"),
+        0.9,
     );
 }
 
@@ -213,25 +223,11 @@ fn a_glass_mesh_with_vertex_normals_converges_to_its_split_tree() {
     // The same sphere without its normals (flat facets) is another image.
     let mut flat = scene.clone();
     flat.shapes.iter_mut().for_each(|s| s.normals = None);
-    let (stable, pixels, right, wrong) = against_split_trees(&images, &scene, &flat);
-    eprintln!(
-        "{stable} of {pixels} pixels well-conditioned; channels beyond 4.5 standard errors: {:.3}% against the shaded split tree, {:.3}% against flat facets",
-        100.0 * right,
-        100.0 * wrong
-    );
-    assert!(
-        stable as f64 > 0.8 * pixels as f64,
-        "too few pixels compared"
-    );
-    assert!(
-        right == 0.0,
-        "GPU mean departs from the twin in {:.3}% of channels",
-        100.0 * right
-    );
-    assert!(
-        wrong > 0.01,
-        "flat facets were not told apart ({:.3}%)",
-        100.0 * wrong
+    assert_converges_to_split_tree(
+        &images,
+        (&scene, "the shaded split tree"),
+        (&flat, "flat facets"),
+        0.8,
     );
 }
 

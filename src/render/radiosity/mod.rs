@@ -193,7 +193,7 @@ impl Radiosity {
         }
         let (w, h) = (elements.width, elements.height);
         let flat = |v: &[[f32; 4]]| v.iter().flatten().copied().collect::<Vec<f32>>();
-        let upload = |v: &[[f32; 4]]| Texture::from_f32(gpu, w, h, TexFormat::Rgba32F, &flat(v));
+        let upload = |v: &[[f32; 4]]| Texture::from_texels(gpu, w, h, TexFormat::Rgba32F, &flat(v));
         let position = upload(&elements.position)?;
         let normal = upload(&elements.normal)?;
         let albedo = upload(&elements.albedo)?;
@@ -213,7 +213,7 @@ impl Radiosity {
             .max(1);
         let mut ids = elements.patch_of.clone();
         ids.resize((patch_of_width * rows) as usize, -1);
-        let patch_of = Texture::from_i32_format(gpu, patch_of_width, rows, TexFormat::R32I, &ids)?;
+        let patch_of = Texture::from_texels(gpu, patch_of_width, rows, TexFormat::R32I, &ids)?;
         let power = record_texture(gpu, elements.capacity as usize, TexFormat::Rgba32F)?;
         let power_target = Target::new(gpu, &[&power])?;
         let pick = Texture::new(gpu, 1, 1, TexFormat::Rgba32F)?;
@@ -658,11 +658,8 @@ impl Radiosity {
         let mut b = self.programs.deposit.bind();
         textures.bind(&mut b);
         self.bind_atlas(&mut b);
-        b.texture("u_position", &records.position)
-            .texture("u_power", &records.power)
-            .texture("u_incoming", &records.incoming)
-            .texture("u_outgoing", &records.outgoing)
-            .int("u_record_width", records.width as i32)
+        records.bind_record_textures(&mut b);
+        b.int("u_record_width", records.width as i32)
             .int("u_frame_height", records.frame_height as i32)
             .int("u_photons_used", records.photons_used as i32)
             .float("u_power_scale", records.power_scale)

@@ -109,6 +109,28 @@ impl<'a> Cx<'a> {
         }
     }
 
+    /// An emitting mesh's `unpaired` triangles, which make no parallelogram
+    /// light: as `unsupported`, kept without emission (nothing when none).
+    pub fn unpaired_triangles(
+        &mut self,
+        file: &Path,
+        line: usize,
+        what: &str,
+        unpaired: usize,
+    ) -> Result<(), SceneError> {
+        if unpaired == 0 {
+            return Ok(());
+        }
+        let what =
+            format!("{what} emitting, but {unpaired} of its triangles make no parallelogram");
+        self.unsupported(
+            file,
+            line,
+            &what,
+            "those triangles are kept without emission",
+        )
+    }
+
     /// A file the scene names, relative to `dir`.
     pub fn read(&self, dir: &Path, name: &str) -> Result<(PathBuf, Vec<u8>), String> {
         let path = dir.join(name);

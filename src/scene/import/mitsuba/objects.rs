@@ -238,27 +238,25 @@ fn conductor(r: &mut Reader, at: &At, p: &Props) -> Result<[f64; 3], SceneError>
             match METALS.iter().find(|(m, _)| *m == name) {
                 Some((_, c)) => *c,
                 None => {
-                    r.cx.unsupported(
-                        at.file,
-                        p.line_of(at, "material"),
-                        &format!("{} material `{name}`", p.what),
-                        "a grey mirror of 0.9",
-                    )?;
-                    [0.9; 3]
+                    let what = format!("{} material `{name}`", p.what);
+                    grey_mirror(r, at, p.line_of(at, "material"), &what)?
                 }
             }
         }
-        _ => {
-            r.cx.unsupported(
-                at.file,
-                p.line_of(at, "eta"),
-                &format!("{} eta and k", p.what),
-                "a grey mirror of 0.9",
-            )?;
-            [0.9; 3]
-        }
+        _ => grey_mirror(
+            r,
+            at,
+            p.line_of(at, "eta"),
+            &format!("{} eta and k", p.what),
+        )?,
     };
     Ok(unit(std::array::from_fn(|i| base[i] * scale[i])))
+}
+
+/// What a conductor it cannot colour becomes (`what`, at `line`, unsupported).
+fn grey_mirror(r: &mut Reader, at: &At, line: usize, what: &str) -> Result<[f64; 3], SceneError> {
+    r.cx.unsupported(at.file, line, what, "a grey mirror of 0.9")?;
+    Ok([0.9; 3])
 }
 
 /// A `<bsdf>` (or `<ref>` to one) as a material.
@@ -444,19 +442,7 @@ pub fn shape(r: &mut Reader, at: &At, n: Node) -> Result<(), SceneError> {
         ..emission
     });
     let unpaired = geometry::place_mesh(&mut r.model, &mesh, &xf, material, emission);
-    if unpaired > 0 {
-        let what = format!(
-            "{} emitting, but {unpaired} of its triangles make no parallelogram",
-            p.what
-        );
-        r.cx.unsupported(
-            at.file,
-            at.line(n),
-            &what,
-            "those triangles are kept without emission",
-        )?;
-    }
-    Ok(())
+    r.cx.unpaired_triangles(at.file, at.line(n), &p.what, unpaired)
 }
 
 fn sphere(

@@ -495,19 +495,7 @@ pub fn shape(r: &mut Reader, s: &PendingShape, p: &Params, extra: &Xf) -> Result
         }
     };
     let unpaired = geometry::place_mesh(&mut r.model, &mesh, &xf, material, emission);
-    if unpaired > 0 {
-        let what = format!(
-            "{} emitting, but {unpaired} of its triangles make no parallelogram",
-            p.what
-        );
-        r.cx.unsupported(
-            p.file,
-            p.line,
-            &what,
-            "those triangles are kept without emission",
-        )?;
-    }
-    Ok(())
+    r.cx.unpaired_triangles(p.file, p.line, &p.what, unpaired)
 }
 
 fn ply_mesh(r: &mut Reader, p: &Params) -> Result<Mesh, SceneError> {

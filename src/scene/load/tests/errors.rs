@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::good;
+use super::{dir_with, good};
 use crate::scene::{load_scene, load_scene_str, Scene, SceneError};
 
 pub(super) fn load(text: &str) -> Result<Scene, SceneError> {
@@ -221,26 +221,19 @@ fn missing_obj_names_the_path() {
 
 #[test]
 fn obj_with_nan_vertex_is_refused() {
-    let temp = tempfile::tempdir().unwrap();
+    let temp = dir_with("bad.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
     let dir = temp.path();
-    std::fs::write(
-        dir.join("bad.obj"),
-        "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n",
-    )
-    .unwrap();
     let e = load_scene(&with_mesh(dir, "bad.obj")).unwrap_err();
     assert!(e.message.contains("finite"), "{e}");
 }
 
 #[test]
 fn good_obj_loads_as_triangles() {
-    let temp = tempfile::tempdir().unwrap();
-    let dir = temp.path();
-    std::fs::write(
-        dir.join("quad.obj"),
+    let temp = dir_with(
+        "quad.obj",
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
-    )
-    .unwrap();
+    );
+    let dir = temp.path();
     let s = load_scene(&with_mesh(dir, "quad.obj")).unwrap();
     assert_eq!(s.shapes.len(), 2);
 }

@@ -33,6 +33,14 @@ fn fixture(name: &str) -> &'static str {
         .unwrap_or_else(|| panic!("scenes/tests/{name}.toml is not embedded"))
 }
 
+/// A temporary folder holding one file, `name`, of `text` (a mesh the test's
+/// scene names).
+fn dir_with(name: &str, text: &str) -> tempfile::TempDir {
+    let temp = tempfile::tempdir().unwrap();
+    std::fs::write(temp.path().join(name), text).unwrap();
+    temp
+}
+
 /// The good scene every malformed one in these tests is made from: one
 /// sphere and one point light.
 fn good() -> &'static str {

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use glam::{DVec3, Vec3};
 
-use super::fixture;
+use super::{dir_with, fixture};
 use crate::scene::camera_path::load_camera_path;
 use crate::scene::{
     embedded, load_scene_str, load_scene_str_translated, Geometry, Light, Rebase, Scene,
@@ -152,13 +152,11 @@ fn a_camera_path_follows_its_scene() {
 
 #[test]
 fn a_mesh_is_placed_in_f64() {
-    let temp = tempfile::tempdir().unwrap();
-    let d = temp.path();
-    std::fs::write(
-        d.join("tri.obj"),
+    let temp = dir_with(
+        "tri.obj",
         "v 0.1 0.2 0.3\nv 1.7 0.2 0.3\nv 0.1 1.3 0.9\nf 1 2 3\n",
-    )
-    .unwrap();
+    );
+    let d = temp.path();
     let text = fixture("placed_mesh");
     let file = d.join("mesh.toml");
     let near = load_scene_str(text, &file).unwrap();
