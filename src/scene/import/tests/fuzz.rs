@@ -2,10 +2,16 @@
 //! tests/fuzz_corpus/import/ (pbrt, xml, ply), and cheap mutations of each
 //! (truncations, byte flips, spliced bytes), through the three parsers'
 //! byte entry points must never panic. PHOTONMAP_FUZZ_ITERATIONS sets the
-//! mutations per seed (default 300).
+//! mutations per seed (default 300). The cargo-fuzz targets' minimised
+//! corpora (tests/fuzz/corpus/{pbrt_scene,mitsuba_scene,ply_mesh}/) are
+//! replayed through the targets' own code, tests/fuzz/import_harness.rs.
 
 use super::*;
 use crate::scene::import::{ply::parse_ply, NoFiles};
+
+/// The cargo-fuzz targets' code, as their fuzz_targets/ include it.
+#[path = "../../../../tests/fuzz/import_harness.rs"]
+mod import_harness;
 
 /// xorshift64: the mutations, reproducible.
 struct Rng(u64);
@@ -107,4 +113,32 @@ fn ply_never_panics() {
     run("ply", &|_, b| {
         let _ = parse_ply(b);
     });
+}
+
+/// The cargo-fuzz corpora of the importers' targets, each file through its
+/// target, without libFuzzer: no panic, and each corpus has accepted inputs.
+#[test]
+fn the_cargo_fuzz_corpora_of_the_importers_replay_without_panics() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus");
+    for (name, target) in import_harness::TARGETS {
+        let dir = root.join(name);
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        assert!(!files.is_empty(), "no corpus for {name}");
+        let mut accepted = 0;
+        for file in &files {
+            let bytes = std::fs::read(file).unwrap();
+            let outcome = std::panic::catch_unwind(|| target(&bytes))
+                .unwrap_or_else(|_| panic!("{name} panicked on {}", file.display()));
+            accepted += usize::from(outcome == Some(true));
+        }
+        assert!(
+            accepted > 0,
+            "{name}: none of {} files accepted",
+            files.len()
+        );
+    }
 }

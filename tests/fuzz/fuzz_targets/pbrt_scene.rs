@@ -1,0 +1,9 @@
+#![no_main]
+//! cargo +nightly fuzz run --fuzz-dir tests/fuzz pbrt_scene (see the book: Stress and fuzzing).
+
+#[path = "../import_harness.rs"]
+mod import_harness;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    import_harness::pbrt_scene(data);
+});
