@@ -9,9 +9,7 @@ use photonmap::render::{self, PassPlan, RenderOptions};
 
 use super::args::{Format, RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{
-    print_explain, provenance, write_done_on_signal, write_images, write_software_reference, Report,
-};
+use super::output::{print_explain, provenance, write_images, write_software_reference, Report};
 use crate::cli::args::Method;
 use crate::cli::progress::Work;
 
@@ -42,21 +40,8 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
         direct_only: args.direct_only,
     };
     let mut observer = CliObserver::new(args, scene, &outputs, work, &provenance);
-    let out = match render::render_views(&gpu, scene, &options, &cameras, &mut observer) {
-        Ok(out) => out,
-        Err(e) => {
-            let done = observer.done.take();
-            observer.finish()?;
-            return Err(write_done_on_signal(
-                e,
-                done,
-                outputs.images(),
-                provenance,
-                false,
-            ));
-        }
-    };
-    observer.finish()?;
+    let result = render::render_views(&gpu, scene, &options, &cameras, &mut observer);
+    let out = observer.finish_with(result, outputs.images(), &provenance)?;
     provenance.photons_emitted = out
         .photons()
         .map(|p| p.trace.photons_used)

@@ -7,12 +7,15 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 
-use photonmap::image::write_atomically;
+use std::path::Path;
+
+use anyhow::bail;
+use photonmap::image::{write_all_atomically, write_atomically};
 use photonmap::provenance::Provenance;
 use photonmap::render::{EstimatePass, Image, Progress, RenderObserver, StopReason};
 use photonmap::scene::Scene;
 
-use super::args::{OnSignal, Outputs, RenderArgs, SnapshotEvery};
+use super::args::{Format, OnSignal, Outputs, RenderArgs, SnapshotEvery};
 use super::display::{image_name, DisplayServer, Placement};
 use crate::cli::progress::{ProgressReport, Work};
 
@@ -197,8 +200,22 @@ impl CliObserver {
         }
     }
 
+    /// Finishes the observing of a render that returned `result`; a render
+    /// stopped by a signal with `--on-signal write-partial` first has the
+    /// work done written to the EXR outputs.
+    pub(super) fn finish_with<T>(
+        &mut self,
+        result: photonmap::Result<T>,
+        outputs: &[(PathBuf, Format)],
+        provenance: &Provenance,
+    ) -> Result<T> {
+        let done = self.done.take();
+        self.finish()?;
+        result.map_err(|e| write_done_on_signal(e, done, outputs, provenance.clone(), self.sppm))
+    }
+
     /// Writes the index of a fly-through's frames.
-    pub(super) fn finish(&mut self) -> Result<()> {
+    fn finish(&mut self) -> Result<()> {
         self.progress.finish();
         if let Some(d) = self.live.as_mut().and_then(|l| l.display.as_mut()) {
             d.finish();
@@ -258,5 +275,65 @@ impl RenderObserver for CliObserver {
             self.frame_times.push(self.clock.elapsed().as_secs_f64());
         }
         Ok(())
+    }
+}
+
+/// After a render stopped by a signal with `--on-signal write-partial`:
+/// writes the work done to the EXR outputs, marked partial with its count of
+/// eye samples (SPPM: iterations), and returns the error it stopped with.
+fn write_done_on_signal(
+    error: photonmap::error::Error,
+    done: Option<Done>,
+    outputs: &[(PathBuf, Format)],
+    mut provenance: Provenance,
+    sppm: bool,
+) -> anyhow::Error {
+    let (photonmap::error::Error::Interrupted { signal }, Some(done)) = (&error, done) else {
+        return error.into();
+    };
+    let what = if sppm {
+        provenance.iterations = Some(done.count);
+        "SPPM iterations"
+    } else {
+        provenance.spp = done.count;
+        "eye samples"
+    };
+    let mut pairs = provenance.pairs();
+    pairs.push(("partial".into(), "true".into()));
+    pairs.push(("photonmap.samples_done".into(), done.count.to_string()));
+    let exrs: Vec<&Path> = outputs
+        .iter()
+        .filter(|(_, f)| *f == Format::Exr)
+        .map(|(p, _)| p.as_path())
+        .collect();
+    let written = (|| -> Result<()> {
+        if done.image.has_non_finite() {
+            bail!("the image done so far has NaN or infinite pixels");
+        }
+        let bytes = done.image.exr_bytes_placed(
+            &pairs,
+            provenance.origin(),
+            (provenance.width, provenance.height),
+        )?;
+        let files: Vec<(&Path, &[u8])> = exrs.iter().map(|p| (*p, bytes.as_slice())).collect();
+        write_all_atomically(&files)?;
+        Ok(())
+    })();
+    match written {
+        Ok(()) => photonmap::error::Error::InterruptedAfterWriting {
+            signal: *signal,
+            wrote: format!(
+                "the {} {what} done were written, marked partial, to {}",
+                done.count,
+                exrs.iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
+        .into(),
+        Err(e) => anyhow::Error::new(error).context(format!(
+            "--on-signal write-partial: the work done could not be written: {e:#}"
+        )),
     }
 }

@@ -71,66 +71,6 @@ pub(super) fn write_images(
         .collect())
 }
 
-/// After a render stopped by a signal with `--on-signal write-partial`:
-/// writes the work done to the EXR outputs, marked partial with its count of
-/// eye samples (SPPM: iterations), and returns the error it stopped with.
-pub(super) fn write_done_on_signal(
-    error: photonmap::error::Error,
-    done: Option<super::observer::Done>,
-    outputs: &[(PathBuf, Format)],
-    mut provenance: Provenance,
-    sppm: bool,
-) -> anyhow::Error {
-    let (photonmap::error::Error::Interrupted { signal }, Some(done)) = (&error, done) else {
-        return error.into();
-    };
-    let what = if sppm {
-        provenance.iterations = Some(done.count);
-        "SPPM iterations"
-    } else {
-        provenance.spp = done.count;
-        "eye samples"
-    };
-    let mut pairs = provenance.pairs();
-    pairs.push(("partial".into(), "true".into()));
-    pairs.push(("photonmap.samples_done".into(), done.count.to_string()));
-    let exrs: Vec<&Path> = outputs
-        .iter()
-        .filter(|(_, f)| *f == Format::Exr)
-        .map(|(p, _)| p.as_path())
-        .collect();
-    let written = (|| -> Result<()> {
-        if done.image.has_non_finite() {
-            bail!("the image done so far has NaN or infinite pixels");
-        }
-        let bytes = done.image.exr_bytes_placed(
-            &pairs,
-            provenance.origin(),
-            (provenance.width, provenance.height),
-        )?;
-        let files: Vec<(&Path, &[u8])> = exrs.iter().map(|p| (*p, bytes.as_slice())).collect();
-        write_all_atomically(&files)?;
-        Ok(())
-    })();
-    match written {
-        Ok(()) => photonmap::error::Error::InterruptedAfterWriting {
-            signal: *signal,
-            wrote: format!(
-                "the {} {what} done were written, marked partial, to {}",
-                done.count,
-                exrs.iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        }
-        .into(),
-        Err(e) => anyhow::Error::new(error).context(format!(
-            "--on-signal write-partial: the work done could not be written: {e:#}"
-        )),
-    }
-}
-
 pub(super) fn write_software_reference(
     out: &render::RenderOutput,
     scene: &Scene,

@@ -7,7 +7,7 @@ use photonmap::render::{self, StopReason, WithPhotons};
 
 use super::args::{RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{print_explain, provenance, write_done_on_signal, write_images, Report};
+use super::output::{print_explain, provenance, write_images, Report};
 use crate::cli::progress::Work;
 
 /// `--method sppm`: one view, iterations until --iterations or --time.
@@ -35,21 +35,8 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let render::Method::Sppm(WithPhotons { method: sppm, .. }) = &options.method else {
         unreachable!("--method sppm gives Method::Sppm");
     };
-    let out = match render::sppm::render_sppm(&gpu, scene, &options, sppm, &mut observer) {
-        Ok(out) => out,
-        Err(e) => {
-            let done = observer.done.take();
-            observer.finish()?;
-            return Err(write_done_on_signal(
-                e,
-                done,
-                outputs.images(),
-                provenance,
-                true,
-            ));
-        }
-    };
-    observer.finish()?;
+    let result = render::sppm::render_sppm(&gpu, scene, &options, sppm, &mut observer);
+    let out = observer.finish_with(result, outputs.images(), &provenance)?;
     provenance.iterations = Some(out.iterations);
     provenance.photons_emitted = Some(out.photons_emitted);
     let written = write_images(&out.image, outputs.images(), &provenance)?;
