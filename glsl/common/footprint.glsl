@@ -7,8 +7,8 @@
 //   footprint 0: centre p, w = area of the ellipse, pi |a x b|;
 //   footprint 1: a, w = 1 if the photon had been reflected diffusely;
 //   footprint 2: b, w = |c|;
-//   footprint 3: power, w = 0.
-// src/reference/differentials.rs is its twin.
+//   footprint 3: power, w = 1 for a caustic footprint left out (area 0), else 0.
+// src/twins/differentials.rs is its twin.
 
 ivec2 footprint_texel(int i, int width) {
     return ivec2(i % width, i / width);

@@ -22,7 +22,7 @@
 // Russian roulette) scales the differentials by 1 / sqrt(q) (section 4.2).
 // Diffuse bounce: re-emission from a virtual origin v behind the hit, so that
 // the new footprint's area equals the old one's (section 4.3, equation 13).
-// src/reference/differentials.rs is its twin.
+// src/twins/differentials.rs is its twin.
 #include "common/scene.glsl"
 #include "common/sampling.glsl"
 #include "common/specular.glsl"

@@ -6,6 +6,8 @@
 // range of radii), one that has been only specular (a caustic) s_c Delta dp;
 // each semi-axis is then clamped to the maximum radius. Degenerate footprints
 // (a zero or non-finite area) get area 0 and are skipped by every pass after.
+// With u_drop_caustics, a caustic photon's footprint gets area 0 and power 0
+// and w = 1 in footprint 3 (left out: a caustic footprint map carries it).
 // With u_coverage_samples > 0 the area kept is the ellipse's share on the
 // photon's own surface (footprint_coverage), so that a footprint overhanging
 // an edge, a corner or an occluder still spreads all its power over the
@@ -28,6 +30,7 @@ uniform float u_max_radius;
 uniform float u_power_scale;
 uniform int u_coverage_samples;   // 0: the whole ellipse counts
 uniform int u_epanechnikov;       // weigh the coverage by the kernel
+uniform int u_drop_caustics;      // leave out photons only specular so far
 
 layout(location = 0) out vec4 o_footprint0;
 layout(location = 1) out vec4 o_footprint1;
@@ -97,13 +100,18 @@ void main() {
     vec4 axis1 = texelFetch(u_axis1, t, 0);
     vec3 dp1 = axis1.xyz, dp2 = texelFetch(u_axis2, t, 0).xyz;
     bool diffuse = axis1.w != 0.0;
+    vec4 position = texelFetch(u_position, t, 0);
+    if (!diffuse && u_drop_caustics != 0) {
+        o_footprint0 = vec4(position.xyz, 0.0);
+        o_footprint3 = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
     vec3 a = semi_axis(dp1, diffuse), b = semi_axis(dp2, diffuse);
     // a x b faces the side the photon came from.
     if (dot(cross(a, b), texelFetch(u_incoming, t, 0).xyz) > 0.0) b = -b;
     float area = PI * length(cross(a, b));
     if (!(area > 0.0) || isinf(area)) area = 0.0;
     float thickness = FOOTPRINT_THICKNESS * max(length(a), length(b));
-    vec4 position = texelFetch(u_position, t, 0);
     if (area > 0.0) area *= footprint_coverage(position.xyz, a, b, thickness, int(position.w));
     o_footprint0 = vec4(position.xyz, area);
     o_footprint1 = vec4(a, diffuse ? 1.0 : 0.0);

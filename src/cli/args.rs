@@ -6,7 +6,7 @@ use photonmap::scene::import::ImportOptions;
 
 use photonmap::photon::build::MAX_HASH_BUCKETS;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
-use photonmap::render::differentials::COVERAGE_SAMPLES;
+use photonmap::render::differentials::{COVERAGE_SAMPLES, MAX_BOUNCES as DIFFERENTIALS_BOUNCES};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::radiosity::FormFactor;
 use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart};
@@ -381,6 +381,18 @@ pub struct DifferentialsArgs {
     #[arg(long, value_name = "N", default_value_t = COVERAGE_SAMPLES,
           value_parser = in_range(0, 256))]
     pub footprint_coverage: u32,
+    /// Differentials: photons stored by a second trace aimed at mirrors and
+    /// glass by projection maps, whose footprints carry the caustics (light
+    /// from an emitter through mirrors or glass onto a diffuse surface)
+    /// instead of the scene's photons' few caustic ones; 0: the paper's one
+    /// map; auto: the scene's stored count where it has a mirror or glass
+    /// and its map stores more than caustics, else 0.
+    #[arg(long, value_name = "N", default_value = "auto", value_parser = auto_or_caustic_photons)]
+    pub caustic_photons: AutoOr<u32>,
+    /// Differentials: photon bounces at most (1..=64; Russian roulette ends
+    /// most far sooner), in place of the scene's photon_map.max_bounces.
+    #[arg(long, value_name = "N", default_value_t = DIFFERENTIALS_BOUNCES, value_parser = in_range(1, 64))]
+    pub footprint_bounces: u32,
 }
 
 /// Progressive radiosity's switches (`--method radiosity`).
@@ -492,6 +504,19 @@ fn auto_or_positive(s: &str) -> Result<AutoOr<f32>, String> {
         .map_err(|_| format!("{s}: give a positive number, or auto"))
 }
 
+fn auto_or_caustic_photons(s: &str) -> Result<AutoOr<u32>, String> {
+    let max = photonmap::scene::defaults::MAX_PHOTONS_STORED;
+    if s.trim() == "auto" {
+        return Ok(AutoOr::Auto);
+    }
+    match s.trim().parse::<u32>() {
+        Ok(v) if v == 0 || (64..=max).contains(&i64::from(v)) => Ok(AutoOr::Value(v)),
+        _ => Err(format!(
+            "{s}: the allowed range is 64..={max}, or 0 (no caustic footprint map), or auto"
+        )),
+    }
+}
+
 fn auto_or_leaf_size(s: &str) -> Result<AutoOr<u32>, String> {
     if s.trim() == "auto" {
         return Ok(AutoOr::Auto);
@@ -511,6 +536,8 @@ impl DifferentialsArgs {
             || self.leaf_size != AutoOr::Auto
             || self.kernel != Kernel::Constant
             || self.footprint_coverage != COVERAGE_SAMPLES
+            || self.caustic_photons != AutoOr::Auto
+            || self.footprint_bounces != DIFFERENTIALS_BOUNCES
     }
 }
 
@@ -523,6 +550,8 @@ impl From<&DifferentialsArgs> for DifferentialsOptions {
             leaf_size: a.leaf_size.value(),
             kernel: a.kernel,
             coverage_samples: a.footprint_coverage,
+            caustic_photons: a.caustic_photons.value(),
+            max_bounces: a.footprint_bounces,
         }
     }
 }

@@ -151,6 +151,10 @@ pub struct FootprintOptions {
     /// whole ellipse counts); weighted by the Epanechnikov kernel if asked.
     pub coverage_samples: u32,
     pub coverage_epanechnikov: bool,
+    /// Leave out the footprints of photons that have been only specular: a
+    /// caustic footprint map of photons aimed by projection maps carries
+    /// that light instead.
+    pub drop_caustics: bool,
 }
 
 /// The footprints in Morton order and their BVH.
@@ -173,6 +177,8 @@ pub struct FootprintMap {
     pub auto_leaf_size: u32,
     /// Footprints whose photon had been reflected diffusely.
     pub diffuse: u32,
+    /// Caustic footprints left out (`FootprintOptions::drop_caustics`).
+    pub dropped_caustics: u32,
     /// Footprints with no area (skipped), and the share of the stored power
     /// they carry.
     pub degenerate: u32,
@@ -243,6 +249,7 @@ pub fn auto_leaf_size(total_area: f64, surface_area: f64) -> u32 {
 /// the power they carry, and those of diffusely reflected photons.
 struct FootprintTotals {
     area: f64,
+    dropped_caustics: u32,
     degenerate: u32,
     degenerate_power_fraction: f64,
     diffuse: u32,
@@ -254,12 +261,14 @@ impl FootprintTotals {
         let f1 = footprints[1].read_f32();
         let f3 = footprints[3].read_f32();
         let (mut area, mut degenerate, mut diffuse) = (0f64, 0u32, 0u32);
-        let (mut power, mut lost) = (0f64, 0f64);
+        let (mut power, mut lost, mut dropped_caustics) = (0f64, 0f64, 0u32);
         for i in 0..count as usize {
             let a = f0[4 * i + 3];
             let p: f64 = f3[4 * i..4 * i + 3].iter().map(|&c| f64::from(c)).sum();
             power += p;
-            if a > 0.0 {
+            if f3[4 * i + 3] != 0.0 {
+                dropped_caustics += 1;
+            } else if a > 0.0 {
                 area += f64::from(a);
             } else {
                 degenerate += 1;
@@ -269,6 +278,7 @@ impl FootprintTotals {
         }
         Self {
             area,
+            dropped_caustics,
             degenerate,
             degenerate_power_fraction: if power > 0.0 { lost / power } else { 0.0 },
             diffuse,
@@ -360,6 +370,7 @@ impl FootprintBuilder {
             .float("u_power_scale", frames.power_scale)
             .int("u_coverage_samples", options.coverage_samples as i32)
             .int("u_epanechnikov", i32::from(options.coverage_epanechnikov))
+            .int("u_drop_caustics", i32::from(options.drop_caustics))
             .draw_fullscreen(
                 &Target::new(gpu, &footprints.each_ref())?,
                 &DrawState::PLAIN,
@@ -390,6 +401,7 @@ impl FootprintBuilder {
             leaf_size,
             auto_leaf_size: auto,
             diffuse,
+            dropped_caustics: totals.dropped_caustics,
             degenerate,
             degenerate_power_fraction: totals.degenerate_power_fraction,
             total_area,

@@ -32,6 +32,7 @@ use crate::photon::differentials::{
     trace_differentials, DifferentialFrames, FootprintBuilder, FootprintMap, FootprintOptions,
 };
 use crate::photon::{PhotonFrames, PhotonTracer, TraceReport};
+use crate::scene::defaults::MAX_PHOTONS_STORED;
 use crate::scene::pack::SceneTextures;
 use crate::scene::Scene;
 
@@ -66,7 +67,20 @@ pub struct DifferentialsOptions {
     /// Probes a footprint for its share on its own surface, so one that
     /// overhangs an edge keeps its power (0: the whole ellipse counts).
     pub coverage_samples: u32,
+    /// Photons stored by a second trace aimed at mirrors and glass by
+    /// projection maps, whose footprints carry the caustics (L S+ D) in place
+    /// of the few the scene's own photons bring; 0: the paper's one map.
+    /// None: the scene's stored count where its map stores more than
+    /// caustics and it has a mirror or glass, else 0.
+    pub caustic_photons: Option<u32>,
+    /// Photon bounces at most, in place of the scene's photon_map.max_bounces:
+    /// the paper scenes' 8 leave out about 3% of a Cornell box ceiling's
+    /// light, which is all indirect. Russian roulette ends most far sooner.
+    pub max_bounces: u32,
 }
+
+/// Photon bounces by default: as SPPM's and IGI's.
+pub const MAX_BOUNCES: u32 = 32;
 
 /// Coverage probes a footprint by default: enough that one probe is 1/16 of
 /// the ellipse.
@@ -81,6 +95,8 @@ impl Default for DifferentialsOptions {
             leaf_size: None,
             kernel: Kernel::Constant,
             coverage_samples: COVERAGE_SAMPLES,
+            caustic_photons: None,
+            max_bounces: MAX_BOUNCES,
         }
     }
 }
@@ -109,6 +125,16 @@ impl DifferentialsOptions {
                 "the allowed range is 0..=256 (0: no coverage probes)",
             ));
         }
+        if let Some(n) = self.caustic_photons.filter(|&n| n > 0) {
+            if !(64..=MAX_PHOTONS_STORED as u32).contains(&n) {
+                return Err(Error::out_of_range(
+                    "differentials.caustic_photons",
+                    n,
+                    format!("the allowed range is 64..={MAX_PHOTONS_STORED}, or 0 (no caustic footprint map), or auto"),
+                ));
+            }
+        }
+        Error::check_range("differentials.max_bounces", self.max_bounces, 1..=64)?;
         if let Some(t) = self.leaf_size {
             if !(1..=1024).contains(&t) {
                 return Err(Error::out_of_range(
@@ -121,6 +147,38 @@ impl DifferentialsOptions {
         Ok(())
     }
 
+    /// The caustic footprint map's stored photons in `scene` (0: none).
+    /// Asked for where the scene's map already holds only caustics, or where
+    /// nothing is specular, it is refused.
+    pub fn caustic_photons_in(&self, scene: &Scene) -> Result<u32> {
+        let possible = scene.has_specular() && !scene.photon_map.caustics_only;
+        match self.caustic_photons {
+            None => Ok(if possible {
+                scene.photon_map.photons_stored
+            } else {
+                0
+            }),
+            Some(0) => Ok(0),
+            Some(_) if possible => Ok(self.caustic_photons.unwrap_or(0)),
+            Some(_) => Err(Error::InvalidOption(format!(
+                "differentials.caustic_photons: {} {}; give 0 or auto",
+                scene.name,
+                if scene.photon_map.caustics_only {
+                    "stores caustic photons only (caustics_only = true), already aimed by projection maps"
+                } else {
+                    "has no mirror or glass, so no caustic to aim photons at"
+                }
+            ))),
+        }
+    }
+
+    /// The scene as its photons are traced: up to `max_bounces` bounces.
+    pub fn photon_scene(&self, scene: &Scene) -> Scene {
+        let mut s = scene.clone();
+        s.photon_map.max_bounces = self.max_bounces;
+        s
+    }
+
     pub fn footprint_options(&self, scene: &Scene, smoothing: f32) -> FootprintOptions {
         FootprintOptions {
             smoothing,
@@ -129,6 +187,7 @@ impl DifferentialsOptions {
             leaf_size: self.leaf_size,
             coverage_samples: self.coverage_samples,
             coverage_epanechnikov: self.kernel == Kernel::Epanechnikov,
+            drop_caustics: false,
         }
     }
 }
@@ -344,6 +403,10 @@ pub struct DifferentialsReport {
     pub degenerate_footprints: u32,
     /// The share of the stored power those carry (lost to the estimate).
     pub degenerate_power_fraction: f64,
+    /// Caustic footprints of the scene's photons left out, and the caustic
+    /// footprint map that carries their light instead.
+    pub dropped_caustic_footprints: u32,
+    pub caustic_map: Option<CausticFootprintsReport>,
     /// s in use, and (auto) the pilot's mean footprints a hit at s = 1, all
     /// and diffuse.
     pub smoothing: f32,
@@ -362,11 +425,74 @@ pub struct DifferentialsReport {
     pub delta: f32,
 }
 
+/// The caustic footprint map: photons aimed at mirrors and glass by
+/// projection maps, stored at their first diffuse hit after only specular
+/// bounces (L S+ D), and each eye sample's estimate over their footprints.
+pub struct CausticFootprints {
+    pub photons: DifferentialPhotons,
+    pub map: Option<FootprintMap>,
+    pub stats: Vec<FootprintStats>,
+}
+
+impl CausticFootprints {
+    /// Traces `stored` caustic photons of `scene`, on a seed of their own.
+    fn trace(
+        p: &Prepare<'_>,
+        photon_scene: &Scene,
+        tracer: &PhotonTracer,
+        stored: u32,
+        timings: &mut Timings,
+    ) -> Result<Self> {
+        let mut scene = photon_scene.clone();
+        scene.photon_map.caustics_only = true;
+        scene.photon_map.specular_last_only = false;
+        scene.photon_map.store_direct = false;
+        scene.photon_map.photons_stored = stored;
+        // Not a seed the scene's own photons use for any render.
+        let seed = p.seed.wrapping_mul(0x9E37_79B9).rotate_left(16) ^ 0x85EB_CA6B;
+        let photons = DifferentialPhotons::trace(p.gpu, &scene, p.textures, tracer, seed, timings)?;
+        Ok(Self {
+            photons,
+            map: None,
+            stats: Vec::new(),
+        })
+    }
+
+    pub fn report(&self) -> Option<CausticFootprintsReport> {
+        let m = self.map.as_ref()?;
+        Some(CausticFootprintsReport {
+            trace: self.photons.trace.clone(),
+            footprints: m.count,
+            degenerate_footprints: m.degenerate,
+            leaves: m.leaves,
+            leaf_size: m.leaf_size,
+            estimate_passes: self.stats.iter().map(|s| s.passes).sum(),
+            mean_footprints: self.stats.first().map_or(0.0, |s| s.mean_footprints),
+        })
+    }
+}
+
+/// What the caustic footprint map was made of.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CausticFootprintsReport {
+    pub trace: TraceReport,
+    pub footprints: u32,
+    pub degenerate_footprints: u32,
+    pub leaves: u32,
+    pub leaf_size: u32,
+    /// Its estimate's walk passes over every eye sample, and the first
+    /// sample's mean footprints holding a hit.
+    pub estimate_passes: u32,
+    pub mean_footprints: f64,
+}
+
 /// Photon differentials' GPU state: the photons, the map (made on the first
 /// eye sample, after the pilot when s is automatic) and the estimate.
 pub struct DifferentialsRun {
     pub photons: DifferentialPhotons,
     pub map: Option<FootprintMap>,
+    /// The caustics' own map, when the scene's photons leave them out.
+    pub caustic: Option<Box<CausticFootprints>>,
     pub estimate: FootprintEstimate,
     builder: FootprintBuilder,
     options: DifferentialsOptions,
@@ -390,11 +516,19 @@ impl DifferentialsRun {
         observer.progress(&Progress::stage("photons", 0, 1));
         o.check()?;
         let tracer = PhotonTracer::with_config(gpu, with.photons.trace())?;
+        let scene = o.photon_scene(p.scene);
         let photons =
-            DifferentialPhotons::trace(gpu, p.scene, p.textures, &tracer, p.seed, timings)?;
+            DifferentialPhotons::trace(gpu, &scene, p.textures, &tracer, p.seed, timings)?;
+        let caustic = match o.caustic_photons_in(p.scene)? {
+            0 => None,
+            n => Some(Box::new(CausticFootprints::trace(
+                p, &scene, &tracer, n, timings,
+            )?)),
+        };
         Ok(Self {
             photons,
             map: None,
+            caustic,
             estimate: FootprintEstimate::new(gpu, w, h, o.kernel)?,
             builder: FootprintBuilder::new(gpu)?,
             options: o.clone(),
@@ -412,7 +546,7 @@ impl DifferentialsRun {
                 None => {
                     let t0 = std::time::Instant::now();
                     let mut pilot_timings = Timings::default();
-                    let options = self.options.footprint_options(f.scene, 1.0);
+                    let options = self.footprint_options(f.scene, 1.0);
                     let pilot = self.builder.build(
                         f.scene,
                         f.textures,
@@ -444,7 +578,7 @@ impl DifferentialsRun {
                     .unwrap_or(1.0)
                 }
             };
-            let options = self.options.footprint_options(f.scene, smoothing);
+            let options = self.footprint_options(f.scene, smoothing);
             let t0 = std::time::Instant::now();
             let mut stages = Timings::default();
             let map = self.builder.build(
@@ -458,7 +592,32 @@ impl DifferentialsRun {
             timings.add_folded("footprint map", &stages, t0);
             self.map = Some(map);
         }
+        if let Some(c) = self.caustic.as_mut().filter(|c| c.map.is_none()) {
+            // Only caustic footprints: s touches none of them.
+            let options = self.options.footprint_options(f.scene, 1.0);
+            let t0 = std::time::Instant::now();
+            let mut stages = Timings::default();
+            let map = self.builder.build(
+                f.scene,
+                f.textures,
+                &c.photons.frames,
+                &c.photons.differentials,
+                &options,
+                &mut stages,
+            )?;
+            timings.add_folded("caustic footprint map", &stages, t0);
+            c.map = Some(map);
+        }
         Ok(())
+    }
+
+    /// The footprint options at `smoothing`, leaving the scene's caustic
+    /// footprints out when the caustic map carries them.
+    fn footprint_options(&self, scene: &Scene, smoothing: f32) -> FootprintOptions {
+        FootprintOptions {
+            drop_caustics: self.caustic.is_some(),
+            ..self.options.footprint_options(scene, smoothing)
+        }
     }
 
     pub fn report(&self) -> Option<DifferentialsReport> {
@@ -470,6 +629,8 @@ impl DifferentialsRun {
             diffuse_footprints: m.diffuse,
             degenerate_footprints: m.degenerate,
             degenerate_power_fraction: m.degenerate_power_fraction,
+            dropped_caustic_footprints: m.dropped_caustics,
+            caustic_map: self.caustic.as_deref().and_then(CausticFootprints::report),
             smoothing: m.options.smoothing,
             pilot_mean_footprints: self.pilot_mean.map(|m| m.0),
             pilot_mean_diffuse_footprints: self.pilot_mean.map(|m| m.1),
@@ -511,6 +672,21 @@ impl FrameMethod for DifferentialsRun {
                 })?;
         self.stats.push(stats);
         image.add(&self.estimate.read_indirect());
+        if let Some(c) = self.caustic.as_mut() {
+            let map = c.map.as_ref().expect("ensure_map made it");
+            let stats =
+                self.estimate
+                    .run(f.textures, f.direct, map, timings, &mut |walking, hits| {
+                        observer.progress(&Progress::at(
+                            "caustic footprint estimate",
+                            hits - walking,
+                            hits,
+                            at,
+                        ))
+                    })?;
+            c.stats.push(stats);
+            image.add(&self.estimate.read_indirect());
+        }
         Ok(image)
     }
 }

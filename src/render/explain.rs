@@ -273,8 +273,9 @@ impl RenderOutput {
                 d.frames_traced as usize,
                 true,
                 format!(
-                    "{} photons traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {} caustic: {}), semi-axes at most {}; {}",
+                    "{} photons of up to {} bounces traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {}), semi-axes at most {}; {}",
                     d.trace.photons_used,
+                    o.max_bounces,
                     d.footprints,
                     d.diffuse_footprints,
                     match (d.diffuse_footprints, d.pilot_mean_diffuse_footprints) {
@@ -282,8 +283,10 @@ impl RenderOutput {
                         (_, Some(m)) => format!("s = {:.3}, chosen by a pilot map at s = 1 ({m:.4} diffuse footprints at a hit) to aim k_PD at the scene's k", d.smoothing),
                         (_, None) => format!("s = {:.3} as given", d.smoothing),
                     },
-                    d.footprints - d.diffuse_footprints,
-                    d.caustic_smoothing,
+                    match &d.caustic_map {
+                        Some(_) => format!("{} caustic, left out: the caustic footprint map below carries that light", d.dropped_caustic_footprints),
+                        None => format!("{} caustic: {}", d.footprints - d.diffuse_footprints, d.caustic_smoothing),
+                    },
                     d.max_radius,
                     match d.coverage_samples {
                         0 => "each footprint's whole ellipse counts, so the part overhanging an edge, a corner or an occluder is lost".to_string(),
@@ -313,6 +316,10 @@ impl RenderOutput {
                     crate::layout::FOOTPRINT_BUDGET,
                     o.kernel
                 ),
+            ));
+            lines.push(caustic_footprints_line(
+                d.caustic_map.as_ref(),
+                d.caustic_smoothing,
             ));
         }
         lines
@@ -450,6 +457,35 @@ fn caustic_shots(fraction: Option<f64>) -> String {
             100.0 * f
         ),
         None => "light that leaves a mirror or glass onto a diffuse surface never bounces on from there (L S+ D D+ is missing; --shoot-caustics true carries it)".into(),
+    }
+}
+
+/// The caustic footprint map of photon differentials, or why there is none.
+fn caustic_footprints_line(
+    map: Option<&super::differentials::CausticFootprintsReport>,
+    caustic_smoothing: f32,
+) -> ExplainLine {
+    match map {
+        Some(c) => line(
+            "caustic footprints",
+            c.estimate_passes as usize,
+            true,
+            format!(
+                "{} photons emitted only towards mirrors and glass ({}), {} stored at their first diffuse hit after specular bounces only (L S+ D), each a footprint at {caustic_smoothing} (no diffuse footprint among them); their own BVH of {} leaves of {} and walk at every first hit, {:.1} footprints holding a hit on average",
+                c.trace.emitted,
+                c.trace.projection.as_ref().map_or("no projection map".to_string(), |p| format!("projection maps: {} of {} cells kept", p.kept_cells, p.cells)),
+                c.footprints,
+                c.leaves,
+                c.leaf_size,
+                c.mean_footprints
+            ),
+        ),
+        None => line(
+            "caustic footprints",
+            0,
+            false,
+            "skipped: the scene's own photons carry the caustics (the scene stores caustics only, has no mirror or glass, or --caustic-photons 0)".into(),
+        ),
     }
 }
 

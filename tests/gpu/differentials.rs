@@ -3,8 +3,9 @@
 //! with both kinds of light, a mirror and a glass sphere; through a plane
 //! mirror and a ball lens they equal the analytic (paraxial) footprints; the
 //! Morton order and the BVH's boxes equal a CPU build on the same footprints;
-//! the walk finds exactly the footprints a brute-force check finds; and the
-//! estimate of a plane under a point light is its analytic irradiance.
+//! the walk finds exactly the footprints a brute-force check finds; the
+//! estimate of a plane under a point light is its analytic irradiance; and
+//! the photons bounce as the option says, not as the scene file does.
 
 use crate::common;
 
@@ -226,8 +227,10 @@ fn off_a_plane_mirror_the_footprint_is_the_mirror_images() {
 #[test]
 fn the_morton_order_and_the_bvh_equal_a_cpu_build_on_the_same_footprints() {
     let scene = common::fixture("mirror_box");
+    // The paper's one map, whose every record has a footprint.
     let o = DifferentialsOptions {
         smoothing: Some(2.0),
+        caustic_photons: Some(0),
         ..DifferentialsOptions::default()
     };
     let out = run(&scene, 8, 8, o.clone());
@@ -311,6 +314,7 @@ fn the_walk_finds_exactly_the_footprints_brute_force_finds() {
         smoothing: Some(3.0),
         leaf_size: Some(3),
         kernel: Kernel::Epanechnikov,
+        caustic_photons: Some(0),
         ..DifferentialsOptions::default()
     };
     let out = run(&scene, 32, 32, o);
@@ -477,4 +481,56 @@ fn footprints_overhanging_an_edge_keep_their_power_with_coverage_probes() {
         (with - 1.0).abs() <= bound,
         "power kept with probes: {with}"
     );
+}
+
+/// The furnace (a closed diffuse sphere around a point light) at albedo 0.8,
+/// whose photons its file lets bounce `bounces` times.
+fn bright_furnace(bounces: u32) -> Scene {
+    let text = common::replace_once(
+        &common::replace_once(
+            &common::fixture_text("furnace"),
+            "albedo = [0.5, 0.5, 0.5]",
+            "albedo = [0.8, 0.8, 0.8]",
+        ),
+        "max_bounces = 24",
+        &format!("max_bounces = {bounces}"),
+    );
+    photonmap::scene::load_scene_str(&text, std::path::Path::new("furnace.toml")).unwrap()
+}
+
+fn mean_radiance(scene: &Scene, max_bounces: u32, seed: u32) -> (f64, Vec<[f32; 3]>) {
+    let mut options = RenderOptions::for_scene(scene);
+    (options.width, options.height, options.seed) = (32, 32, seed);
+    options.method = Method::Differentials(WithPhotons {
+        method: DifferentialsOptions {
+            max_bounces,
+            ..DifferentialsOptions::default()
+        },
+        ..WithPhotons::default()
+    });
+    let out = render(&common::gpu(), scene, &options, &mut ()).unwrap();
+    let m = out.image.mean();
+    ((m[0] + m[1] + m[2]) / 3.0, out.image.pixels.clone())
+}
+
+/// The photons bounce `max_bounces` times, not the file's max_bounces: in
+/// the furnace at albedo 0.8 the light past the 8th bounce is rho^8 = 17% of
+/// all. The file's count changes nothing, and 8 bounces lose light by far
+/// more than the noise between seeds.
+#[test]
+fn differentials_photons_bounce_as_the_option_says_not_as_the_file_does() {
+    let (short_file, long_file) = (bright_furnace(8), bright_furnace(32));
+    let (a, image_a) = mean_radiance(&short_file, 32, 1);
+    let (b, image_b) = mean_radiance(&long_file, 32, 1);
+    assert!(image_a == image_b, "the file's max_bounces must not matter");
+    let others: Vec<f64> = [2, 3]
+        .iter()
+        .map(|&s| mean_radiance(&long_file, 32, s).0)
+        .collect();
+    let (eight, _) = mean_radiance(&long_file, 8, 1);
+    let all = [a, others[0], others[1]];
+    let mean = all.iter().sum::<f64>() / 3.0;
+    let sd = (all.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+    println!("32 bounces: {all:.4?} (sd {sd:.4}); 8 bounces: {eight:.4}; {b:.4}");
+    assert!(mean - eight > 6.0 * sd, "{mean} - {eight} against sd {sd}");
 }

@@ -10,6 +10,7 @@ mod adaptive;
 mod bias_compensation;
 mod bit_identical;
 mod bvh;
+mod caustic_footprints;
 mod differentials;
 mod final_gather;
 mod fused_eye_path;

@@ -1,5 +1,6 @@
 //! `photonmap bench differentials`: photon differentials (Fabianowski and
-//! Dingliana 2009) against the kNN-grid on one scene, at the same photons:
+//! Dingliana 2009) against the kNN-grid on one scene, at the same photons
+//! (the kNN map's bounces, and no caustic footprint map):
 //!
 //! - **Methods**: the kNN-grid at the scene's defaults and photon
 //!   differentials at theirs; time by component, error against the SPPM
@@ -114,7 +115,14 @@ impl Bench<'_> {
     }
 
     /// The bench's options with photon differentials `d`.
+    /// `d` on the kNN map's own photons, as the paper compares them: the
+    /// scene's bounces, and no caustic footprint map of photons of its own.
     fn with_differentials(&self, d: DifferentialsOptions) -> RenderOptions {
+        let d = DifferentialsOptions {
+            caustic_photons: Some(0),
+            max_bounces: self.scene.photon_map.max_bounces,
+            ..d
+        };
         let o = self.options();
         let map = o.method.photon_map().cloned().unwrap_or_default();
         o.with_method(Method::Differentials(WithPhotons::from_map(map, d)))

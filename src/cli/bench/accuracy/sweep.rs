@@ -230,7 +230,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
 }
 
 /// Photon differentials: automatic smoothing (k_PD = the scene's k), no
-/// coverage probes, four times the photons, the Epanechnikov kernel, and 4 spp.
+/// coverage probes, the paper's one map (no caustic footprint map), the
+/// paper scenes' 8 bounces, four times the photons, the Epanechnikov kernel,
+/// and 4 spp.
 fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     let pd = |label: &str, kernel: Kernel, spp: u32| {
         let o = DifferentialsOptions {
@@ -250,6 +252,16 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
             o.coverage_samples = 0;
         }
         out.push(whole);
+        let mut one_map = pd("differentials, one map", Kernel::Constant, 1);
+        if let RunMethod::Differentials(o) = &mut one_map.run.method {
+            o.caustic_photons = Some(0);
+        }
+        out.push(one_map);
+        let mut short = pd("differentials, 8 bounces", Kernel::Constant, 1);
+        if let RunMethod::Differentials(o) = &mut short.run.method {
+            o.max_bounces = 8;
+        }
+        out.push(short);
         out.push(pd("differentials, Epanechnikov", Kernel::Epanechnikov, 1));
         out.push(pd("differentials, 4 spp", Kernel::Constant, 4));
     }
