@@ -56,16 +56,9 @@ def bsdf(m):
     return {"type": "diffuse", "reflectance": rgb([0.0, 0.0, 0.0])}
 
 
-def main():
-    export, budget, out, integrator, variant = sys.argv[1:6]
-    checkpoints = sys.argv[6] if len(sys.argv) > 6 else ""
-    first_seed = int(sys.argv[7]) if len(sys.argv) > 7 else 0
-    budget = float(budget)
-    import mitsuba as mi
-    mi.set_variant(variant)
-    import numpy as np
-
-    s = json.load(open(export))
+def build_scene(mi, s, integrator):
+    """The Mitsuba scene dictionary of export `s` and the folder of its PLY
+    meshes, which the caller removes once the scene is loaded."""
     cam = s["camera"]
     scene = {
         "type": "scene",
@@ -98,6 +91,21 @@ def main():
     for i, p in enumerate(s["points"]):
         scene["point%d" % i] = {"type": "point", "position": p["position"],
                                 "intensity": rgb(p["intensity"])}
+    return scene, folder
+
+
+def main():
+    export, budget, out, integrator, variant = sys.argv[1:6]
+    checkpoints = sys.argv[6] if len(sys.argv) > 6 else ""
+    first_seed = int(sys.argv[7]) if len(sys.argv) > 7 else 0
+    budget = float(budget)
+    import mitsuba as mi
+    mi.set_variant(variant)
+    import numpy as np
+
+    s = json.load(open(export))
+    cam = s["camera"]
+    scene, folder = build_scene(mi, s, integrator)
     t = time.perf_counter()
     loaded = mi.load_dict(scene)
     load_seconds = time.perf_counter() - t

@@ -1,0 +1,91 @@
+"""Write an interior mask for a scene exported by `photonmap bench mitsuba`
+(its `export.json`), made as the ground truth's masks are made: a pixel is
+white where all 4 x 4 of its sub-pixel rays first hit the same diffuse,
+non-emitting plane (one shape, one normal, one offset). Edges, lights,
+mirrors, glass and curved surfaces are black. Mitsuba 3 intersects the rays,
+so the mask shares no code with photonmap.
+
+    python scripts/interior-mask.py EXPORT.json OUT.png [--scale N]
+
+--scale N: the export's size divided by N, a pixel white only where all
+N x N of its full-size pixels are (as the truth's half-size masks are).
+Needs `pip install mitsuba numpy` (LLVM variant: DRJIT_LIBLLVM_PATH naming
+libLLVM 16 or newer where the system's is older).
+"""
+import importlib.util
+import json
+import os
+import shutil
+import sys
+
+import drjit as dr
+import mitsuba as mi
+import numpy as np
+
+SUB = 4
+
+
+def load_builder():
+    here = os.path.dirname(os.path.abspath(__file__))
+    path = os.path.join(here, "..", "src", "cli", "bench", "mitsuba", "mitsuba_render.py")
+    spec = importlib.util.spec_from_file_location("mitsuba_render", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.build_scene
+
+
+def main():
+    args = sys.argv[1:]
+    scale = 1
+    if "--scale" in args:
+        i = args.index("--scale")
+        scale = int(args[i + 1])
+        del args[i:i + 2]
+    if len(args) != 2 or scale < 1:
+        sys.exit(__doc__)
+    export, out = args
+    mi.set_variant("llvm_ad_rgb")
+    s = json.load(open(export))
+    w, h = s["camera"]["width"] * scale, s["camera"]["height"] * scale
+    s["camera"]["width"], s["camera"]["height"] = w, h
+    scene_dict, folder = load_builder()(mi, s, "path")
+    scene = mi.load_dict(scene_dict)
+    shutil.rmtree(folder, ignore_errors=True)
+    sensor = scene.sensors()[0]
+    extent = float(dr.max(scene.bbox().extents()))
+
+    py, px = np.mgrid[0:h, 0:w]
+    keys = []
+    for sy in range(SUB):
+        for sx in range(SUB):
+            u = ((px + (sx + 0.5) / SUB) / w).ravel().astype(np.float32)
+            v = ((py + (sy + 0.5) / SUB) / h).ravel().astype(np.float32)
+            ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f(u, v), mi.Point2f(0.5, 0.5))
+            si = scene.ray_intersect(ray)
+            valid = np.array(si.is_valid())
+            shape = np.array(dr.reinterpret_array(mi.UInt32, si.shape))
+            emitter = np.array(si.shape.is_emitter())
+            flags = np.array(si.bsdf().flags())
+            diffuse = (flags & int(mi.BSDFFlags.Diffuse)) != 0
+            specular = (flags & int(mi.BSDFFlags.Delta)) != 0
+            n = np.stack([np.array(si.n.x), np.array(si.n.y), np.array(si.n.z)], axis=-1)
+            p = np.stack([np.array(si.p.x), np.array(si.p.y), np.array(si.p.z)], axis=-1)
+            offset = (n * p).sum(axis=-1) / extent
+            good = valid & ~emitter & diffuse & ~specular
+            keys.append((good, shape, n, offset))
+
+    good0, shape0, n0, d0 = keys[0]
+    white = good0.copy()
+    for good, shape, n, d in keys[1:]:
+        white &= good & (shape == shape0)
+        white &= np.abs(n - n0).max(axis=-1) < 1e-3
+        white &= np.abs(d - d0) < 1e-4
+    mask = white.reshape(h, w)
+    if scale > 1:
+        mask = mask.reshape(h // scale, scale, w // scale, scale).all(axis=(1, 3))
+    mi.Bitmap((mask * 255).astype(np.uint8)).write(out)
+    print("%s: %d x %d, %d white pixels" % (out, mask.shape[1], mask.shape[0], int(mask.sum())))
+
+
+if __name__ == "__main__":
+    main()
