@@ -159,10 +159,9 @@ impl FinalGather {
         max_radius: f32,
         total_rays: u32,
     ) -> Result<()> {
-        let mut b = self.accumulate.bind();
-        scene.bind(&mut b);
-        direct.bind_weights(&mut b);
-        self.estimate.bind_result(&mut b, k, max_radius);
+        let mut b = self
+            .estimate
+            .bind_result(&self.accumulate, scene, direct, k, max_radius);
         b.texture("u_gather_normal", &self.normal)
             .texture("u_gather_throughput", &self.throughput)
             .int("u_batch", rays as i32)

@@ -368,14 +368,26 @@ impl RadianceEstimate {
         Ok(counter.count())
     }
 
-    /// The finished search as the passes that turn it into light read it
-    /// (compose.frag, gather_accumulate.frag): each query's flux and
+    /// `program`, a pass that turns the finished search into light at the
+    /// first hits (compose.frag, gather_accumulate.frag), bound to what both
+    /// read: the scene, the first hits' weights, and each query's flux and
     /// radius, its accepted photons, and the k and radius of the estimate.
-    pub fn bind_result(&self, b: &mut Bindings<'_>, k: u32, max_radius: f32) {
+    pub fn bind_result<'a>(
+        &self,
+        program: &'a Program,
+        scene: &SceneTextures,
+        direct: &DirectLight,
+        k: u32,
+        max_radius: f32,
+    ) -> Bindings<'a> {
+        let mut b = program.bind();
+        scene.bind(&mut b);
+        direct.bind_weights(&mut b);
         b.texture("u_state_flux", &self.flux)
             .texture("u_state_cursor", &self.cursor)
             .int("u_k", k as i32)
             .float("u_max_radius", max_radius);
+        b
     }
 
     /// The image `draw_composed` left in `image`, read back.
@@ -395,10 +407,7 @@ impl RadianceEstimate {
         include_direct: bool,
         include_indirect: bool,
     ) -> Result<()> {
-        let mut b = self.compose.bind();
-        scene.bind(&mut b);
-        direct.bind_weights(&mut b);
-        self.bind_result(&mut b, k, max_radius);
+        let mut b = self.bind_result(&self.compose, scene, direct, k, max_radius);
         b.texture("u_direct", &direct.radiance)
             .int("u_include_direct", include_direct as i32)
             .int("u_include_indirect", include_indirect as i32)

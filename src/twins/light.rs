@@ -1,10 +1,27 @@
 //! Twin of `sample_light_triangle` in glsl/common/scene.glsl: a point
 //! uniform over a triangle-mesh light, shared by the photon tracer's emission
-//! and the ray tracer's sampled direct light.
+//! and the ray tracer's sampled direct light; and a point of an area light,
+//! shared by the ray tracer's and the path tracer's direct light.
 
 use glam::{Vec3, Vec4};
 
 use crate::scene::pack::PackedScene;
+use crate::scene::Light;
+
+/// The point of an `Area` light's parallelogram at (u, v) in [0, 1)^2 (the
+/// origin for another kind of light).
+pub fn area_light_point(light: &Light, u: f32, v: f32) -> Vec3 {
+    let Light::Area {
+        corner,
+        edge1,
+        edge2,
+        ..
+    } = *light
+    else {
+        return Vec3::ZERO;
+    };
+    corner + u * edge1 + v * edge2
+}
 
 /// glsl/common/scene.glsl `sample_light_triangle`: a point of the
 /// LIGHT_TRIANGLES light l uniform over its area (u1 picks the triangle by

@@ -16,6 +16,7 @@ use glam::{DVec3, Vec3};
 use crate::sampling::sample_cosine;
 use crate::scene::{triangle_area, Geometry, Light, Material, Scene};
 
+use super::light::area_light_point;
 use super::ray_trace::{closest_hit, eye_ray_at, offset_scale, point_light, toward_emitter};
 use super::shading::facing_shading_normal;
 
@@ -166,17 +167,11 @@ fn direct(
                 continue;
             }
             Light::Area {
-                corner,
-                edge1,
-                edge2,
-                normal,
-                radiance,
-            } => (
-                corner + rng.next() * edge1 + rng.next() * edge2,
-                normal,
-                radiance,
-                edge1.cross(edge2).length(),
-            ),
+                normal, radiance, ..
+            } => {
+                let q = area_light_point(light, rng.next(), rng.next());
+                (q, normal, radiance, light.area(&scene.shapes))
+            }
             Light::Triangles { radiance, .. } => {
                 let (q, normal) = triangle_light_point(scene, light, rng);
                 (q, normal, radiance, light.area(&scene.shapes))

@@ -10,7 +10,7 @@ use crate::scene::{triangle_area, Geometry, Light, Material, Scene, Shape};
 use crate::scene::pack::PackedScene;
 
 use super::intersect::intersect_geometry;
-use super::light::sample_light_triangle;
+use super::light::{area_light_point, sample_light_triangle};
 use super::random::{rng_init, rng_next};
 use super::shading::{facing_shading_normal, fresnel_dielectric, specular_about};
 
@@ -256,17 +256,12 @@ fn direct_irradiance(
                 intensity,
             } => sum += point_light(scene, origin, nf, (position, intensity), cosine),
             Light::Area {
-                corner,
-                edge1,
-                edge2,
-                normal,
-                radiance,
+                normal, radiance, ..
             } => {
-                let area = edge1.cross(edge2).length();
                 let ls: Vec3 = cells()
-                    .map(|(u, v)| from(corner + u * edge1 + v * edge2, normal, radiance))
+                    .map(|(u, v)| from(area_light_point(l, u, v), normal, radiance))
                     .sum();
-                sum += ls * area * per_cell;
+                sum += ls * l.area(&scene.shapes) * per_cell;
             }
             Light::Triangles {
                 first,

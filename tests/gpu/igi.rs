@@ -7,6 +7,7 @@
 use crate::common;
 
 use glam::Vec3;
+use photonmap::gpu::Texture;
 use photonmap::render::{render, IgiOptions, Method, RenderOptions, RenderOutput, WithCausticMap};
 use photonmap::scene::{Material, Scene};
 use photonmap::twins::igi::{incident, Vpl};
@@ -37,6 +38,34 @@ fn vpls(out: &RenderOutput) -> Vec<Vpl> {
             intensity: Vec3::from(i),
         })
         .collect()
+}
+
+/// A texture's texels as rgb.
+fn rgb_texels(t: &Texture) -> Vec<Vec3> {
+    common::texels(t).into_iter().map(common::v3).collect()
+}
+
+/// The CPU twin's light incident from `vpls`, bounded at `m`, at pixel `p`'s
+/// first diffuse hit (`pos`, `nor`: the first-hit texels); zero without one.
+fn twin_incident(
+    scene: &Scene,
+    vpls: &[Vpl],
+    (pos, nor): (&[[f32; 4]], &[[f32; 4]]),
+    p: usize,
+    m: f32,
+    imperfect: bool,
+) -> Vec3 {
+    if pos[p][3] <= 0.0 {
+        return Vec3::ZERO;
+    }
+    incident(
+        scene,
+        vpls,
+        common::v3(pos[p]),
+        common::v3(nor[p]),
+        m,
+        imperfect,
+    )
 }
 
 /// Pixels whose GPU and CPU values differ by more than float rounding allows.
@@ -70,25 +99,9 @@ fn the_vpl_gather_equals_its_cpu_twin() {
         let v = vpls(&out);
         let pos = common::texels(&out.state.direct.diffuse_position);
         let nor = common::texels(&out.state.direct.diffuse_normal);
-        let got: Vec<Vec3> = common::texels(&out.igi_run().unwrap().igi.incident)
-            .into_iter()
-            .map(common::v3)
-            .collect();
+        let got = rgb_texels(&out.igi_run().unwrap().igi.incident);
         let twin: Vec<Vec3> = (0..pos.len())
-            .map(|i| {
-                if pos[i][3] > 0.0 {
-                    incident(
-                        &scene,
-                        &v,
-                        common::v3(pos[i]),
-                        common::v3(nor[i]),
-                        m,
-                        imperfect,
-                    )
-                } else {
-                    Vec3::ZERO
-                }
-            })
+            .map(|i| twin_incident(&scene, &v, (&pos, &nor), i, m, imperfect))
             .collect();
         let lit = twin.iter().filter(|c| c.max_element() > 0.0).count();
         let (n, worst) = apart(&got, &twin);
@@ -138,38 +151,38 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
         );
         (y * w as i32 + x) as usize
     };
+    // The lattice points at offsets lo..lo + side (both axes, rows outer)
+    // from `corner` that lie inside the lattice and have a first hit:
+    // (offset, lattice point, pixel).
+    let hit_neighbours = |corner: (i32, i32), lo: i32, side: i32| {
+        let (pos, shading) = (&pos, &shading);
+        (lo..lo + side)
+            .flat_map(move |j| (lo..lo + side).map(move |i| (i, j)))
+            .filter_map(move |(i, j)| {
+                let (x, y) = (corner.0 + i, corner.1 + j);
+                if x < 0 || y < 0 || x >= lw || y >= lh {
+                    return None;
+                }
+                let p = shading(x, y);
+                (pos[p][3] > 0.0).then_some(((i, j), (x, y), p))
+            })
+    };
     // The gather, subset by subset.
-    let gathered: Vec<Vec3> = common::texels(&state.incident)
-        .into_iter()
-        .map(common::v3)
-        .collect();
+    let gathered = rgb_texels(&state.incident);
     let subsets = (n * n) as usize;
     let twin: Vec<Vec3> = (0..lw * lh)
         .map(|q| {
             let (qx, qy) = (q % lw, q / lw);
-            let p = shading(qx, qy);
-            if pos[p][3] <= 0.0 {
-                return Vec3::ZERO;
-            }
             let s = ((qx % n) + n * (qy % n)) as usize;
             let mine: Vec<Vpl> = v.iter().copied().skip(s).step_by(subsets).collect();
-            incident(
-                &scene,
-                &mine,
-                common::v3(pos[p]),
-                common::v3(nor[p]),
-                m,
-                false,
-            ) * subsets as f32
+            let p = shading(qx, qy);
+            twin_incident(&scene, &mine, (&pos, &nor), p, m, false) * subsets as f32
         })
         .collect();
     let (gather_apart, gather_worst) = apart(&gathered, &twin);
     // The discontinuity buffer on the GPU's gather.
     let eye = scene.camera.position;
-    let filtered: Vec<Vec3> = common::texels(state.filtered_incident())
-        .into_iter()
-        .map(common::v3)
-        .collect();
+    let filtered = rgb_texels(state.filtered_incident());
     let ncos = photonmap::layout::VPL_NORMAL_COS;
     let depth = photonmap::layout::VPL_DEPTH_TOLERANCE;
     let filter_twin: Vec<Vec3> = (0..lw * lh)
@@ -183,25 +196,15 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
             let tol = depth * eye.distance(x);
             let lo = -(n - 1) / 2;
             let (mut sum, mut count) = (Vec3::ZERO, 0.0);
-            for j in lo..lo + n {
-                for i in lo..lo + n {
-                    let (ox, oy) = (qx + i, qy + j);
-                    if ox < 0 || oy < 0 || ox >= lw || oy >= lh {
-                        continue;
-                    }
-                    let op = shading(ox, oy);
-                    if pos[op][3] <= 0.0 {
-                        continue;
-                    }
-                    if (i, j) != (0, 0)
-                        && (common::v3(nor[op]).dot(nx) < ncos
-                            || (common::v3(pos[op]) - x).dot(nx).abs() > tol)
-                    {
-                        continue;
-                    }
-                    sum += gathered[(oy * lw + ox) as usize];
-                    count += 1.0;
+            for ((i, j), (ox, oy), op) in hit_neighbours((qx, qy), lo, n) {
+                if (i, j) != (0, 0)
+                    && (common::v3(nor[op]).dot(nx) < ncos
+                        || (common::v3(pos[op]) - x).dot(nx).abs() > tol)
+                {
+                    continue;
                 }
+                sum += gathered[(oy * lw + ox) as usize];
+                count += 1.0;
             }
             sum / count
         })
@@ -219,10 +222,7 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
             _ => Vec3::ZERO,
         }
     };
-    let indirect: Vec<Vec3> = common::texels(&state.indirect)
-        .into_iter()
-        .map(common::v3)
-        .collect();
+    let indirect = rgb_texels(&state.indirect);
     let up_twin: Vec<Vec3> = (0..(w * h) as i32)
         .map(|p| {
             let (px, py) = (p % w as i32, p / w as i32);
@@ -237,29 +237,19 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
             );
             let (bx, by) = (ux.floor() as i32 - 1, uy.floor() as i32 - 1);
             let (mut sum, mut k) = (Vec3::ZERO, 0.0f32);
-            for j in 0..4 {
-                for i in 0..4 {
-                    let (qx, qy) = (bx + i, by + j);
-                    if qx < 0 || qy < 0 || qx >= lw || qy >= lh {
-                        continue;
-                    }
-                    let qp = shading(qx, qy);
-                    if pos[qp][3] <= 0.0 {
-                        continue;
-                    }
-                    let x = common::v3(pos[pi]);
-                    if (common::v3(pos[qp]) - x).dot(np).abs() > depth * eye.distance(x) {
-                        continue;
-                    }
-                    let range = np.dot(common::v3(nor[qp]));
-                    if range <= 0.0 {
-                        continue;
-                    }
-                    let (dx, dy) = (ux - qx as f32, uy - qy as f32);
-                    let wgt = (-0.5 * (dx * dx + dy * dy)).exp() * range;
-                    sum += wgt * filtered[(qy * lw + qx) as usize];
-                    k += wgt;
+            for (_, (qx, qy), qp) in hit_neighbours((bx, by), 0, 4) {
+                let x = common::v3(pos[pi]);
+                if (common::v3(pos[qp]) - x).dot(np).abs() > depth * eye.distance(x) {
+                    continue;
                 }
+                let range = np.dot(common::v3(nor[qp]));
+                if range <= 0.0 {
+                    continue;
+                }
+                let (dx, dy) = (ux - qx as f32, uy - qy as f32);
+                let wgt = (-0.5 * (dx * dx + dy * dy)).exp() * range;
+                sum += wgt * filtered[(qy * lw + qx) as usize];
+                k += wgt;
             }
             let e = if k > 0.0 {
                 sum / k

@@ -180,7 +180,7 @@ fn obj_scene() -> Scene {
          o b\nusemtl cold\nv 1 2.5 1\nv 2 2.8 1\nv 1 2.6 2\nf 8 9 10\n",
     )
     .unwrap();
-    let text = r#"
+    let mut text = r#"
 [camera]
 position = [0.0, 2.0, 6.0]
 look_at = [0.0, 0.5, 0.0]
@@ -200,29 +200,19 @@ corner = [-3.0, 0.0, -3.0]
 edge1 = [0.0, 0.0, 6.0]
 edge2 = [6.0, 0.0, 0.0]
 material = "floor"
-[[shape]]
-type = "mesh"
-file = "sphere.obj"
-scale = 0.6
-translate = [-0.8, 0.6, 0.0]
-material = "glass"
-[[shape]]
-type = "mesh"
-file = "sphere.obj"
-scale = 0.4
-translate = [0.8, 0.4, 0.5]
-material = "mirror"
-[[shape]]
-type = "mesh"
-file = "sphere.obj"
-scale = 0.5
-translate = [0.3, 0.5, -1.2]
-material = "clay"
-[[shape]]
-type = "mesh"
-file = "lamps.obj"
-"#;
-    load_scene_str(text, &dir.join("obj_twin.toml")).unwrap()
+"#
+    .to_string();
+    for (scale, translate, material) in [
+        (0.6, [-0.8, 0.6, 0.0], "glass"),
+        (0.4, [0.8, 0.4, 0.5], "mirror"),
+        (0.5, [0.3, 0.5, -1.2], "clay"),
+    ] {
+        text += &format!(
+            "[[shape]]\ntype = \"mesh\"\nfile = \"sphere.obj\"\nscale = {scale}\ntranslate = {translate:?}\nmaterial = \"{material}\"\n"
+        );
+    }
+    text += "[[shape]]\ntype = \"mesh\"\nfile = \"lamps.obj\"\n";
+    load_scene_str(&text, &dir.join("obj_twin.toml")).unwrap()
 }
 
 #[test]
@@ -368,6 +358,7 @@ fn projection_maps_keep_every_direction_that_reaches_a_specular_shape() {
     use photonmap::photon::ProjectionMaps;
     use photonmap::scene::Light;
     use photonmap::twins::intersect::intersect_geometry;
+    use photonmap::twins::light::area_light_point;
     use photonmap::twins::random::{rng_init, rng_next};
     for name in ["glass_ball", "ring", "cornell_box"] {
         let mut scene = common::paper_scene(name);
@@ -386,12 +377,7 @@ fn projection_maps_keep_every_direction_that_reaches_a_specular_shape() {
                 let (u, v) = (rng_next(&mut rng), rng_next(&mut rng));
                 let origin = match *light {
                     Light::Point { position, .. } => position,
-                    Light::Area {
-                        corner,
-                        edge1,
-                        edge2,
-                        ..
-                    } => corner + a * edge1 + b * edge2,
+                    Light::Area { .. } => area_light_point(light, a, b),
                     Light::Triangles { .. } => unreachable!("the paper scenes have none"),
                 };
                 let d = emission_direction(light, u, v);

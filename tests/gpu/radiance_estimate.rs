@@ -11,6 +11,13 @@ use photonmap::render::{
 use photonmap::scene::Scene;
 use photonmap::twins::knn::{knn_grid, CpuPhotonMap, KnnResult};
 
+/// The paper's three scenes, each at the small size its tests render.
+const PAPER_SCENES: [(&str, u32, u32); 3] = [
+    ("glass_ball", 64, 48),
+    ("cornell_box", 48, 48),
+    ("ring", 64, 48),
+];
+
 fn render_gi(
     scene: &Scene,
     width: u32,
@@ -109,11 +116,7 @@ fn assert_agrees_with_twin(
 
 #[test]
 fn gpu_knn_grid_equals_the_cpu_knn_grid_for_both_builds() {
-    for (name, w, h) in [
-        ("glass_ball", 64, 48),
-        ("cornell_box", 48, 48),
-        ("ring", 64, 48),
-    ] {
+    for (name, w, h) in PAPER_SCENES {
         let scene = common::paper_scene(name);
         for build in [BuildMethod::Bitonic, BuildMethod::Stencil] {
             let out = render_gi(&scene, w, h, build, EstimateMode::Tiled { tile: 16 });
@@ -196,34 +199,13 @@ fn tiled_full_screen_and_masked_runs_give_identical_images() {
     // 100 x 70: the last column and row of 16-pixel tiles are cut to 4 and 6
     // pixels, less than half a tile, so their points' centres fall outside the
     // image (such tiles were once clipped whole and their pixels never searched).
-    let tiled = render_gi(
-        &scene,
-        100,
-        70,
-        BuildMethod::Bitonic,
+    let [tiled, tiled8, full, masked] = [
         EstimateMode::Tiled { tile: 16 },
-    );
-    let tiled8 = render_gi(
-        &scene,
-        100,
-        70,
-        BuildMethod::Bitonic,
         EstimateMode::Tiled { tile: 8 },
-    );
-    let full = render_gi(
-        &scene,
-        100,
-        70,
-        BuildMethod::Bitonic,
         EstimateMode::FullScreen,
-    );
-    let masked = render_gi(
-        &scene,
-        100,
-        70,
-        BuildMethod::Bitonic,
         EstimateMode::Masked { every: 2 },
-    );
+    ]
+    .map(|mode| render_gi(&scene, 100, 70, BuildMethod::Bitonic, mode));
     assert_eq!(tiled.image, full.image, "tiled vs full screen");
     assert_eq!(tiled8.image, full.image, "8 x 8 tiles vs full screen");
     assert_eq!(masked.image, full.image, "masked vs full screen");
@@ -422,11 +404,7 @@ fn gpu_leak_tests_equal_their_cpu_twins() {
 #[test]
 fn culled_searches_end_in_the_paper_search_s_state_bit_for_bit() {
     use photonmap::twins::knn::knn_grid_counted;
-    for (name, w, h) in [
-        ("glass_ball", 64, 48),
-        ("cornell_box", 48, 48),
-        ("ring", 64, 48),
-    ] {
+    for (name, w, h) in PAPER_SCENES {
         let scene = common::paper_scene(name);
         for build in [BuildMethod::Bitonic, BuildMethod::Stencil] {
             let mut states = Vec::new();

@@ -64,6 +64,20 @@ impl Config {
             r.spp = spp;
         })
     }
+
+    /// This run by the method `method` makes of its default options
+    /// changed by `tweak`, at `spp` eye samples.
+    fn by_tweaked<O: Default>(
+        &self,
+        label: &str,
+        method: fn(O) -> RunMethod,
+        spp: u32,
+        tweak: impl FnOnce(&mut O),
+    ) -> Self {
+        let mut o = O::default();
+        tweak(&mut o);
+        self.by(label, method(o), spp)
+    }
 }
 
 /// The sweep: one parameter at a time around the scene's defaults, the leak
@@ -162,11 +176,8 @@ pub(super) fn sweep(scene: &Scene, quick: bool) -> Vec<Config> {
 /// antialiased reference).
 fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     let mut out = Vec::new();
-    let igi = |label: &str, f: &dyn Fn(&mut IgiOptions)| {
-        let mut o = IgiOptions::default();
-        f(&mut o);
-        base.by(label, RunMethod::Igi(o), 1)
-    };
+    let igi =
+        |label: &str, f: &dyn Fn(&mut IgiOptions)| base.by_tweaked(label, RunMethod::Igi, 1, f);
     let all_three = |o: &mut IgiOptions| {
         o.imperfect_visibility = true;
         o.interleave = 3;
@@ -234,36 +245,26 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// paper scenes' 8 bounces, four times the photons, the Epanechnikov kernel,
 /// and 4 spp.
 fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
-    let pd = |label: &str, kernel: Kernel, spp: u32| {
-        let o = DifferentialsOptions {
-            kernel,
-            ..DifferentialsOptions::default()
-        };
-        base.by(label, RunMethod::Differentials(o), spp)
+    let pd = |label: &str, spp: u32, f: &dyn Fn(&mut DifferentialsOptions)| {
+        base.by_tweaked(label, RunMethod::Differentials, spp, f)
     };
-    let mut out = vec![pd("differentials", Kernel::Constant, 1)];
+    let mut out = vec![pd("differentials", 1, &|_| {})];
     if !quick {
         // The estimate is cheap: more photons at about the kNN-grid's time.
-        let mut more = pd("differentials, photons x4", Kernel::Constant, 1);
+        let mut more = pd("differentials, photons x4", 1, &|_| {});
         more.run.photons_stored *= 4;
         out.push(more);
-        let mut whole = pd("differentials, no coverage probes", Kernel::Constant, 1);
-        if let RunMethod::Differentials(o) = &mut whole.run.method {
-            o.coverage_samples = 0;
-        }
-        out.push(whole);
-        let mut one_map = pd("differentials, one map", Kernel::Constant, 1);
-        if let RunMethod::Differentials(o) = &mut one_map.run.method {
-            o.caustic_photons = Some(0);
-        }
-        out.push(one_map);
-        let mut short = pd("differentials, 8 bounces", Kernel::Constant, 1);
-        if let RunMethod::Differentials(o) = &mut short.run.method {
-            o.max_bounces = 8;
-        }
-        out.push(short);
-        out.push(pd("differentials, Epanechnikov", Kernel::Epanechnikov, 1));
-        out.push(pd("differentials, 4 spp", Kernel::Constant, 4));
+        out.push(pd("differentials, no coverage probes", 1, &|o| {
+            o.coverage_samples = 0
+        }));
+        out.push(pd("differentials, one map", 1, &|o| {
+            o.caustic_photons = Some(0)
+        }));
+        out.push(pd("differentials, 8 bounces", 1, &|o| o.max_bounces = 8));
+        out.push(pd("differentials, Epanechnikov", 1, &|o| {
+            o.kernel = Kernel::Epanechnikov
+        }));
+        out.push(pd("differentials, 4 spp", 4, &|_| {}));
     }
     out
 }
@@ -272,42 +273,29 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// not shot on, at the scene's k, at k = 32 and on the scene's grid, the chapter's ~10,000 elements of
 /// CORNELL BOX (32 x 32 a patch side), and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
-    let rad = |label: &str, resolution: u32, spp: u32| {
-        let o = RadiosityOptions {
-            resolution,
-            ..RadiosityOptions::default()
-        };
-        base.by(label, RunMethod::Radiosity(o), spp)
+    let rad = |label: &str, spp: u32, f: &dyn Fn(&mut RadiosityOptions)| {
+        base.by_tweaked(label, RunMethod::Radiosity, spp, f)
     };
-    let mut out = vec![rad("radiosity", 16, 1)];
+    let mut out = vec![rad("radiosity", 1, &|_| {})];
     if !quick {
-        let mut from_lights = rad("radiosity, caustics from lights", 16, 1);
-        if let RunMethod::Radiosity(o) = &mut from_lights.run.method {
-            o.caustic_paths = CausticPaths::FromLights;
-        }
-        out.push(from_lights);
-        let mut not_shot = rad("radiosity, caustics not shot", 16, 1);
-        if let RunMethod::Radiosity(o) = &mut not_shot.run.method {
-            o.shoot_caustics = false;
-        }
-        out.push(not_shot);
-        let mut scene_k = rad("radiosity, caustic map at the scene's k", 16, 1);
-        if let RunMethod::Radiosity(o) = &mut scene_k.run.method {
-            o.caustic_k = Some(base.run.k);
-        }
-        out.push(scene_k);
-        let mut k32 = rad("radiosity, caustic map at k = 32", 16, 1);
-        if let RunMethod::Radiosity(o) = &mut k32.run.method {
-            o.caustic_k = Some(32);
-        }
-        out.push(k32);
-        let mut scene_grid = rad("radiosity, caustic map on the scene's grid", 16, 1);
-        if let RunMethod::Radiosity(o) = &mut scene_grid.run.method {
-            o.caustic_scene_grid = true;
-        }
-        out.push(scene_grid);
-        out.push(rad("radiosity, 32 elements", 32, 1));
-        out.push(rad("radiosity, 4 spp", 16, 4));
+        out.push(rad("radiosity, caustics from lights", 1, &|o| {
+            o.caustic_paths = CausticPaths::FromLights
+        }));
+        out.push(rad("radiosity, caustics not shot", 1, &|o| {
+            o.shoot_caustics = false
+        }));
+        let scene_k = base.run.k;
+        out.push(rad("radiosity, caustic map at the scene's k", 1, &|o| {
+            o.caustic_k = Some(scene_k)
+        }));
+        out.push(rad("radiosity, caustic map at k = 32", 1, &|o| {
+            o.caustic_k = Some(32)
+        }));
+        out.push(rad("radiosity, caustic map on the scene's grid", 1, &|o| {
+            o.caustic_scene_grid = true
+        }));
+        out.push(rad("radiosity, 32 elements", 1, &|o| o.resolution = 32));
+        out.push(rad("radiosity, 4 spp", 4, &|_| {}));
     }
     out
 }

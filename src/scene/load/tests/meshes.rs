@@ -145,47 +145,31 @@ fn mtl_materials_map_as_the_readme_says() {
     let obj = every_material_obj();
     let s = load(&[("mesh.obj", &obj), ("m.mtl", MTL)], "", true).unwrap();
     let rgb = Vec3::new;
-    assert_eq!(
-        material_at(&s, 0.0),
-        Material::Diffuse {
-            albedo: rgb(0.5, 0.25, 0.125)
-        }
-    );
-    assert_eq!(
-        material_at(&s, 1.0),
-        Material::Mirror {
-            reflectance: rgb(0.9, 0.8, 0.7)
-        }
-    );
-    assert_eq!(
-        material_at(&s, 2.0),
-        Material::Mirror {
-            reflectance: rgb(0.5, 0.5, 0.5)
-        }
-    );
-    assert_eq!(material_at(&s, 3.0), Material::Glass { ior: 1.5 });
-    assert_eq!(material_at(&s, 4.0), Material::Glass { ior: 1.33 });
-    // Ni 1 bends nothing: illum 4 is then its Kd.
-    assert_eq!(
-        material_at(&s, 5.0),
-        Material::Diffuse {
-            albedo: rgb(0.3, 0.3, 0.3)
-        }
-    );
-    // illum 3 with a black Ks is its Kd.
-    assert_eq!(
-        material_at(&s, 6.0),
-        Material::Diffuse {
-            albedo: rgb(0.4, 0.4, 0.4)
-        }
-    );
-    assert_eq!(
-        material_at(&s, 7.0),
+    let diffuse = |r, g, b| Material::Diffuse {
+        albedo: rgb(r, g, b),
+    };
+    let mirror = |r, g, b| Material::Mirror {
+        reflectance: rgb(r, g, b),
+    };
+    // In the order of `every_material_obj`'s names: the quad at y = i.
+    let expected = [
+        diffuse(0.5, 0.25, 0.125),
+        mirror(0.9, 0.8, 0.7),
+        mirror(0.5, 0.5, 0.5),
+        Material::Glass { ior: 1.5 },
+        Material::Glass { ior: 1.33 },
+        // Ni 1 bends nothing: illum 4 is then its Kd.
+        diffuse(0.3, 0.3, 0.3),
+        // illum 3 with a black Ks is its Kd.
+        diffuse(0.4, 0.4, 0.4),
         Material::Emitter {
             radiance: rgb(4.0, 3.0, 2.0),
-            normal: None
-        }
-    );
+            normal: None,
+        },
+    ];
+    for (y, material) in expected.into_iter().enumerate() {
+        assert_eq!(material_at(&s, y as f32), material, "the quad at y = {y}");
+    }
     // The emitter's two triangles are one light (beside the point light),
     // of power pi * area * Ke.
     let lights: Vec<&Light> = s
@@ -341,22 +325,18 @@ fn vertex_normals_become_shading_normals() {
 #[test]
 fn a_face_without_material_names_the_file_and_line() {
     // No MTL at all, and no `material`.
-    expect_error(
-        &[("mesh.obj", &format!("{QUAD}g box\nf 1 2 3\n"))],
-        "",
-        "mesh.obj",
-        6,
-        "no material",
-    );
+    let no_mtl = format!("{QUAD}g box\nf 1 2 3\n");
     // With an MTL, a face before any usemtl.
-    let obj = format!("mtllib m.mtl\n{QUAD}f 1 2 3\nusemtl plain\nf 1 3 4\n");
-    expect_error(
-        &[("mesh.obj", &obj), ("m.mtl", MTL)],
-        "",
-        "mesh.obj",
-        6,
-        "\"unnamed_object\"",
-    );
+    let before_usemtl = format!("mtllib m.mtl\n{QUAD}f 1 2 3\nusemtl plain\nf 1 3 4\n");
+    for (files, says) in [
+        (vec![("mesh.obj", no_mtl.as_str())], "no material"),
+        (
+            vec![("mesh.obj", before_usemtl.as_str()), ("m.mtl", MTL)],
+            "\"unnamed_object\"",
+        ),
+    ] {
+        expect_error(&files, "", "mesh.obj", 6, says);
+    }
 }
 
 #[test]
@@ -365,49 +345,23 @@ fn a_missing_mtl_names_the_obj_file_and_line() {
     expect_error(&[("mesh.obj", &obj)], "", "mesh.obj", 2, "nowhere.mtl");
     // An unknown material name.
     let obj = format!("mtllib m.mtl\n{QUAD}usemtl shiny\nf 1 2 3\n");
-    expect_error(
-        &[("mesh.obj", &obj), ("m.mtl", MTL)],
-        "",
-        "mesh.obj",
-        6,
-        "shiny",
-    );
+    let files = [("mesh.obj", obj.as_str()), ("m.mtl", MTL)];
+    expect_error(&files, "", "mesh.obj", 6, "shiny");
 }
 
 #[test]
 fn bad_face_indices_name_the_file_and_line() {
     let m = "material = \"grey\"";
-    expect_error(
-        &[("mesh.obj", &format!("{QUAD}f 1 2 3\nf 1 2 5\n"))],
-        m,
-        "mesh.obj",
-        6,
-        "vertex 5",
-    );
-    expect_error(
-        &[("mesh.obj", &format!("{QUAD}f 0 1 2\n"))],
-        m,
-        "mesh.obj",
-        5,
-        "vertex 0",
-    );
-    expect_error(
-        &[("mesh.obj", &format!("{QUAD}f -1 -2 -5\n"))],
-        m,
-        "mesh.obj",
-        5,
-        "vertex -5",
-    );
-    // A normal index beyond the normals given.
-    let obj = format!("{QUAD}vn 0 1 0\nf 1//1 2//2 3//1\n");
-    expect_error(&[("mesh.obj", &obj)], m, "mesh.obj", 6, "normal 2");
-    expect_error(
-        &[("mesh.obj", &format!("{QUAD}f 1 2\n"))],
-        m,
-        "mesh.obj",
-        5,
-        "3 corners",
-    );
+    for (text, line, says) in [
+        (format!("{QUAD}f 1 2 3\nf 1 2 5\n"), 6, "vertex 5"),
+        (format!("{QUAD}f 0 1 2\n"), 5, "vertex 0"),
+        (format!("{QUAD}f -1 -2 -5\n"), 5, "vertex -5"),
+        // A normal index beyond the normals given.
+        (format!("{QUAD}vn 0 1 0\nf 1//1 2//2 3//1\n"), 6, "normal 2"),
+        (format!("{QUAD}f 1 2\n"), 5, "3 corners"),
+    ] {
+        expect_error(&[("mesh.obj", &text)], m, "mesh.obj", line, says);
+    }
 }
 
 #[test]
