@@ -200,6 +200,29 @@ pub struct DifferentialPhotons {
 }
 
 impl DifferentialPhotons {
+    /// Their footprint map, its stages folded into `timings` as `stage`.
+    fn footprint_map(
+        &self,
+        builder: &FootprintBuilder,
+        f: &SampleFrame<'_>,
+        options: &FootprintOptions,
+        stage: &str,
+        timings: &mut Timings,
+    ) -> Result<FootprintMap> {
+        let t0 = std::time::Instant::now();
+        let mut stages = Timings::default();
+        let map = builder.build(
+            f.scene,
+            f.textures,
+            &self.frames,
+            &self.differentials,
+            options,
+            &mut stages,
+        )?;
+        timings.add_folded(stage, &stages, t0);
+        Ok(map)
+    }
+
     /// Traces the scene's photons (to its stored count) and their differentials.
     pub fn trace(
         gpu: &Gpu,
@@ -579,33 +602,21 @@ impl DifferentialsRun {
                 }
             };
             let options = self.footprint_options(f.scene, smoothing);
-            let t0 = std::time::Instant::now();
-            let mut stages = Timings::default();
-            let map = self.builder.build(
-                f.scene,
-                f.textures,
-                &self.photons.frames,
-                &self.photons.differentials,
-                &options,
-                &mut stages,
-            )?;
-            timings.add_folded("footprint map", &stages, t0);
+            let map =
+                self.photons
+                    .footprint_map(&self.builder, f, &options, "footprint map", timings)?;
             self.map = Some(map);
         }
         if let Some(c) = self.caustic.as_mut().filter(|c| c.map.is_none()) {
             // Only caustic footprints: s touches none of them.
             let options = self.options.footprint_options(f.scene, 1.0);
-            let t0 = std::time::Instant::now();
-            let mut stages = Timings::default();
-            let map = self.builder.build(
-                f.scene,
-                f.textures,
-                &c.photons.frames,
-                &c.photons.differentials,
+            let map = c.photons.footprint_map(
+                &self.builder,
+                f,
                 &options,
-                &mut stages,
+                "caustic footprint map",
+                timings,
             )?;
-            timings.add_folded("caustic footprint map", &stages, t0);
             c.map = Some(map);
         }
         Ok(())
@@ -659,33 +670,23 @@ impl FrameMethod for DifferentialsRun {
         let mut image = f.direct.read_radiance();
         self.ensure_map(f, timings)?;
         let map = self.map.as_ref().expect("ensure_map made it");
-        let at = f.at;
-        let stats =
-            self.estimate
-                .run(f.textures, f.direct, map, timings, &mut |walking, hits| {
-                    observer.progress(&Progress::at(
-                        "footprint estimate",
-                        hits - walking,
-                        hits,
-                        at,
-                    ))
+        let estimate = &mut self.estimate;
+        let mut walk = |map: &FootprintMap,
+                        stage: &'static str,
+                        timings: &mut Timings|
+         -> Result<FootprintStats> {
+            let stats =
+                estimate.run(f.textures, f.direct, map, timings, &mut |walking, hits| {
+                    observer.progress(&Progress::at(stage, hits - walking, hits, f.at))
                 })?;
-        self.stats.push(stats);
-        image.add(&self.estimate.read_indirect());
+            image.add(&estimate.read_indirect());
+            Ok(stats)
+        };
+        self.stats.push(walk(map, "footprint estimate", timings)?);
         if let Some(c) = self.caustic.as_mut() {
             let map = c.map.as_ref().expect("ensure_map made it");
-            let stats =
-                self.estimate
-                    .run(f.textures, f.direct, map, timings, &mut |walking, hits| {
-                        observer.progress(&Progress::at(
-                            "caustic footprint estimate",
-                            hits - walking,
-                            hits,
-                            at,
-                        ))
-                    })?;
-            c.stats.push(stats);
-            image.add(&self.estimate.read_indirect());
+            c.stats
+                .push(walk(map, "caustic footprint estimate", timings)?);
         }
         Ok(image)
     }
