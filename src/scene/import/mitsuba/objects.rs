@@ -126,11 +126,23 @@ pub fn sensor(r: &mut Reader, at: &At, n: Node) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// The integrator's `max_depth` counts a path's segments from the camera
+/// (1: emitters seen directly, 2: direct light), one more than the bounces
+/// photonmap counts (as pbrt-v4's `maxdepth` does): `max_depth` D gives
+/// D - 1 bounces. -1 (unbounded, Mitsuba's default) leaves photonmap's.
 pub fn integrator(r: &mut Reader, at: &At, n: Node) -> Result<(), SceneError> {
     let p = Props::read(at, n)?;
     let depth = p.float(at, "max_depth", -1.0)?;
+    if depth > 0.0 && depth < 2.0 {
+        r.cx.unsupported(
+            at.file,
+            p.line_of(at, "max_depth"),
+            &format!("max_depth {depth} (no light on any surface)"),
+            "max_depth 2 (direct light)",
+        )?;
+    }
     if depth > 0.0 {
-        r.model.hints.max_depth = Some(depth.min(64.0) as u32);
+        r.model.hints.max_depth = Some((depth - 1.0).clamp(1.0, 64.0) as u32);
     }
     if n.attribute("type") == Some("sppm") {
         let photons = p.float(at, "photon_count", -1.0)?;

@@ -126,3 +126,45 @@ fn mitsuba_defines_set_defaults_and_dollar_parameters() {
     let c = convert_text("cornell_box.xml", &old, &ImportOptions::default()).unwrap();
     assert_cornell(&load_scene_str(&c.toml, Path::new("t")).unwrap());
 }
+
+#[test]
+fn mitsuba_max_depth_counts_the_camera_segment() {
+    // Mitsuba's max_depth D is D - 1 bounces (2: direct light); pbrt's
+    // maxdepth 8 above gives 8.
+    let text = std::fs::read_to_string(dir().join("cornell_box.xml")).unwrap();
+    let depth = |d: &str, opts: &ImportOptions| {
+        let t = replace_once(&text, "name=\"max_depth\" value=\"8\"", d);
+        convert_text("cornell_box.xml", &t, opts)
+    };
+    let lenient = ImportOptions {
+        lenient: true,
+        ..ImportOptions::default()
+    };
+    for (d, bounces) in [("8", 7), ("2", 1), ("65", 64), ("1000", 64), ("-1", 10)] {
+        let c = depth(
+            &format!("name=\"max_depth\" value=\"{d}\""),
+            &ImportOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{d}: {e}"));
+        for line in [
+            format!("max_specular_depth = {bounces}\n"),
+            format!("max_bounces = {bounces}\n"),
+        ] {
+            assert!(c.toml.contains(&line), "{d}: {line}\n{}", c.toml);
+        }
+        assert!(c.notes.is_empty(), "{d}: {:?}", c.notes);
+    }
+    // 1 renders emitters alone, which photonmap cannot
+    let one = "name=\"max_depth\" value=\"1\"";
+    let e = depth(one, &ImportOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("--lenient: max_depth 2"), "{e}");
+    let c = depth(one, &lenient).unwrap();
+    assert!(c.toml.contains("max_specular_depth = 1\n"), "{}", c.toml);
+    assert_eq!(c.notes.len(), 1, "{:?}", c.notes);
+}
+
+/// `text` with `from`, which it holds once, replaced by `to`.
+fn replace_once(text: &str, from: &str, to: &str) -> String {
+    assert_eq!(text.matches(from).count(), 1, "{from}");
+    text.replacen(from, to, 1)
+}
