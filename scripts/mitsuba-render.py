@@ -1,20 +1,125 @@
-"""Render a Mitsuba 3 scene file to a linear EXR: the import trial's
-Mitsuba side (docs/src/evaluation/import-trial.md).
+"""Render a Mitsuba 3 scene file to a linear EXR, or write its interior
+mask: the import trial's Mitsuba side (docs/src/evaluation/import-trial.md).
 
-    python scripts/mitsuba-render.py VARIANT SCENE.xml SPP SEED OUT.exr [NAME=VALUE ...]
+    python scripts/mitsuba-render.py VARIANT SCENE.xml SPP SEED OUT.exr [OPTIONS] [NAME=VALUE ...]
+    python scripts/mitsuba-render.py VARIANT SCENE.xml --mask OUT.png [--edges EDGES.png] [OPTIONS] [NAME=VALUE ...]
 
-NAME=VALUE set the scene's <default> parameters (res=256, resx=256, ...).
+NAME=VALUE set the scene's <default> parameters (res=256, max_depth=64, ...).
+The file is read into memory and changed there (the file itself is not):
+every film's reconstruction filter becomes a box of one pixel, as
+photonmap's (--keep-filter keeps the file's), and --black-emitters gives
+every emitting shape a black BSDF, as photonmap's lights reflect nothing.
+
+--mask writes a PNG that is white where all 4 x 4 of a pixel's sub-pixel
+rays first hit the same diffuse, non-emitting plane (one shape, one normal,
+one offset), as scripts/interior-mask.py makes the truth's masks; edges,
+lights, mirrors, glass and curved surfaces are black. --edges writes the
+pixels whose sub-pixel rays all hit diffuse, non-emitting surfaces but not
+one plane: the edges between walls. The LLVM variants need
+DRJIT_LIBLLVM_PATH naming libLLVM 16 or newer where the system's is older.
 """
+import os
 import sys
 import time
+import xml.etree.ElementTree as ET
 
 import mitsuba as mi
 
-variant, scene_path, spp, seed, out = sys.argv[1:6]
-mi.set_variant(variant)
-params = dict(a.split("=", 1) for a in sys.argv[6:])
-scene = mi.load_file(scene_path, spp=spp, **params)
-start = time.time()
-img = mi.render(scene, seed=int(seed), spp=int(spp))
-mi.Bitmap(img).write(out)
-print(f"{out}: {spp} spp, seed {seed}, {time.time() - start:.1f} s")
+SUB = 4
+
+
+def scene_text(path, keep_filter, black_emitters):
+    """The scene file's XML with the film filters and emitters changed."""
+    root = ET.parse(path).getroot()
+    if not keep_filter:
+        for film in root.iter("film"):
+            for f in film.findall("rfilter"):
+                film.remove(f)
+            ET.SubElement(film, "rfilter", {"type": "box"})
+    if black_emitters:
+        for shape in root.iter("shape"):
+            if shape.find("emitter") is None:
+                continue
+            for b in shape.findall("bsdf") + shape.findall("ref"):
+                shape.remove(b)
+            bsdf = ET.SubElement(shape, "bsdf", {"type": "diffuse"})
+            ET.SubElement(bsdf, "rgb", {"name": "reflectance", "value": "0"})
+    return ET.tostring(root, encoding="unicode")
+
+
+def load(path, params, keep_filter=False, black_emitters=False):
+    # Relative file names (meshes, includes) resolve against the file's folder.
+    mi.file_resolver().prepend(os.path.dirname(os.path.abspath(path)))
+    return mi.load_string(scene_text(path, keep_filter, black_emitters), **params)
+
+
+def mask(scene, out, edges=None):
+    import drjit as dr
+    import numpy as np
+
+    sensor = scene.sensors()[0]
+    w, h = sensor.film().crop_size()
+    extent = float(dr.max(scene.bbox().extents()))
+    py, px = np.mgrid[0:h, 0:w]
+    keys = []
+    for sy in range(SUB):
+        for sx in range(SUB):
+            u = ((px + (sx + 0.5) / SUB) / w).ravel().astype(np.float32)
+            v = ((py + (sy + 0.5) / SUB) / h).ravel().astype(np.float32)
+            ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f(u, v), mi.Point2f(0.5, 0.5))
+            si = scene.ray_intersect(ray)
+            valid = np.array(si.is_valid())
+            shape = np.array(dr.reinterpret_array(mi.UInt32, si.shape))
+            emitter = np.array(si.shape.is_emitter())
+            flags = np.array(si.bsdf().flags())
+            diffuse = (flags & int(mi.BSDFFlags.Diffuse)) != 0
+            specular = (flags & int(mi.BSDFFlags.Delta)) != 0
+            n = np.stack([np.array(si.n.x), np.array(si.n.y), np.array(si.n.z)], axis=-1)
+            p = np.stack([np.array(si.p.x), np.array(si.p.y), np.array(si.p.z)], axis=-1)
+            offset = (n * p).sum(axis=-1) / extent
+            keys.append((valid & ~emitter & diffuse & ~specular, shape, n, offset))
+    good0, shape0, n0, d0 = keys[0]
+    white, diffuse = good0.copy(), good0.copy()
+    for good, shape, n, d in keys[1:]:
+        diffuse &= good
+        white &= good & (shape == shape0)
+        white &= np.abs(n - n0).max(axis=-1) < 1e-3
+        white &= np.abs(d - d0) < 1e-4
+    white = white.reshape(h, w)
+    mi.Bitmap((white * 255).astype(np.uint8)).write(out)
+    print(f"{out}: {w} x {h}, {int(white.sum())} white pixels")
+    if edges:
+        edge = diffuse.reshape(h, w) & ~white
+        mi.Bitmap((edge * 255).astype(np.uint8)).write(edges)
+        print(f"{edges}: {w} x {h}, {int(edge.sum())} white pixels")
+
+
+def main():
+    args = sys.argv[1:]
+    keep_filter = "--keep-filter" in args
+    black_emitters = "--black-emitters" in args
+    args = [a for a in args if a not in ("--keep-filter", "--black-emitters")]
+    if len(args) >= 4 and args[2] == "--mask":
+        variant, scene_path, _, out = args[:4]
+        rest, edges = args[4:], None
+        if rest[:1] == ["--edges"] and len(rest) >= 2:
+            edges, rest = rest[1], rest[2:]
+        mi.set_variant(variant)
+        params = dict(a.split("=", 1) for a in rest)
+        mask(load(scene_path, params, keep_filter, black_emitters), out, edges)
+        return
+    if len(args) < 5:
+        sys.exit(__doc__)
+    variant, scene_path, spp, seed, out = args[:5]
+    mi.set_variant(variant)
+    params = dict(a.split("=", 1) for a in args[5:])
+    params.setdefault("spp", spp)
+    scene = load(scene_path, params, keep_filter, black_emitters)
+    start = time.time()
+    img = mi.render(scene, seed=int(seed), spp=int(spp))
+    mi.Bitmap(img).write(out)
+    print(f"{out}: {spp} spp, seed {seed}, {time.time() - start:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
