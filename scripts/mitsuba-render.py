@@ -25,8 +25,6 @@ import xml.etree.ElementTree as ET
 
 import mitsuba as mi
 
-SUB = 4
-
 
 def scene_text(path, keep_filter, black_emitters):
     """The scene file's XML with the film filters and emitters changed."""
@@ -54,42 +52,21 @@ def load(path, params, keep_filter=False, black_emitters=False):
 
 
 def mask(scene, out, edges=None):
-    import drjit as dr
+    import importlib.util
+
     import numpy as np
 
-    sensor = scene.sensors()[0]
-    w, h = sensor.film().crop_size()
-    extent = float(dr.max(scene.bbox().extents()))
-    py, px = np.mgrid[0:h, 0:w]
-    keys = []
-    for sy in range(SUB):
-        for sx in range(SUB):
-            u = ((px + (sx + 0.5) / SUB) / w).ravel().astype(np.float32)
-            v = ((py + (sy + 0.5) / SUB) / h).ravel().astype(np.float32)
-            ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f(u, v), mi.Point2f(0.5, 0.5))
-            si = scene.ray_intersect(ray)
-            valid = np.array(si.is_valid())
-            shape = np.array(dr.reinterpret_array(mi.UInt32, si.shape))
-            emitter = np.array(si.shape.is_emitter())
-            flags = np.array(si.bsdf().flags())
-            diffuse = (flags & int(mi.BSDFFlags.Diffuse)) != 0
-            specular = (flags & int(mi.BSDFFlags.Delta)) != 0
-            n = np.stack([np.array(si.n.x), np.array(si.n.y), np.array(si.n.z)], axis=-1)
-            p = np.stack([np.array(si.p.x), np.array(si.p.y), np.array(si.p.z)], axis=-1)
-            offset = (n * p).sum(axis=-1) / extent
-            keys.append((valid & ~emitter & diffuse & ~specular, shape, n, offset))
-    good0, shape0, n0, d0 = keys[0]
-    white, diffuse = good0.copy(), good0.copy()
-    for good, shape, n, d in keys[1:]:
-        diffuse &= good
-        white &= good & (shape == shape0)
-        white &= np.abs(n - n0).max(axis=-1) < 1e-3
-        white &= np.abs(d - d0) < 1e-4
-    white = white.reshape(h, w)
+    here = os.path.dirname(os.path.abspath(__file__))
+    spec = importlib.util.spec_from_file_location(
+        "interior_mask", os.path.join(here, "interior-mask.py"))
+    interior = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(interior)
+    white, diffuse = interior.masks(scene)
+    h, w = white.shape
     mi.Bitmap((white * 255).astype(np.uint8)).write(out)
     print(f"{out}: {w} x {h}, {int(white.sum())} white pixels")
     if edges:
-        edge = diffuse.reshape(h, w) & ~white
+        edge = diffuse & ~white
         mi.Bitmap((edge * 255).astype(np.uint8)).write(edges)
         print(f"{edges}: {w} x {h}, {int(edge.sum())} white pixels")
 
