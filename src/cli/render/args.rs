@@ -498,7 +498,7 @@ impl RenderArgs {
             (
                 Method::Differentials,
                 self.differentials.any_given(),
-                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel and --footprint-coverage are photon differentials': add --method differentials",
+                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --caustic-photons and --footprint-bounces are photon differentials': add --method differentials",
                 "--method differentials replaces the kNN estimate with footprints",
             ),
             (
