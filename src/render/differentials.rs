@@ -159,7 +159,7 @@ impl DifferentialsOptions {
                 0
             }),
             Some(0) => Ok(0),
-            Some(_) if possible => Ok(self.caustic_photons.unwrap_or(0)),
+            Some(n) if possible => Ok(n),
             Some(_) => Err(Error::InvalidOption(format!(
                 "differentials.caustic_photons: {} {}; give 0 or auto",
                 scene.name,
@@ -170,13 +170,6 @@ impl DifferentialsOptions {
                 }
             ))),
         }
-    }
-
-    /// The scene as its photons are traced: up to `max_bounces` bounces.
-    pub fn photon_scene(&self, scene: &Scene) -> Scene {
-        let mut s = scene.clone();
-        s.photon_map.max_bounces = self.max_bounces;
-        s
     }
 
     pub fn footprint_options(&self, scene: &Scene, smoothing: f32) -> FootprintOptions {
@@ -539,7 +532,7 @@ impl DifferentialsRun {
         observer.progress(&Progress::stage("photons", 0, 1));
         o.check()?;
         let tracer = PhotonTracer::with_config(gpu, with.photons.trace())?;
-        let scene = o.photon_scene(p.scene);
+        let scene = p.scene.with_max_bounces(o.max_bounces);
         let photons =
             DifferentialPhotons::trace(gpu, &scene, p.textures, &tracer, p.seed, timings)?;
         let caustic = match o.caustic_photons_in(p.scene)? {

@@ -173,8 +173,7 @@ impl Vpls {
         seed: u32,
         timings: &mut Timings,
     ) -> Result<Self> {
-        let mut s = scene.clone();
-        s.photon_map.max_bounces = bounces;
+        let mut s = scene.with_max_bounces(bounces);
         s.photon_map.caustics_only = false;
         s.photon_map.store_direct = true;
         let wall = std::time::Instant::now();

@@ -316,6 +316,14 @@ impl Scene {
         far / self.size()
     }
 
+    /// This scene with its photons bouncing up to `bounces` times: the
+    /// methods that trace their own photons choose their bounces.
+    pub fn with_max_bounces(&self, bounces: u32) -> Scene {
+        let mut s = self.clone();
+        s.photon_map.max_bounces = bounces;
+        s
+    }
+
     pub fn has_specular(&self) -> bool {
         self.shapes
             .iter()

@@ -527,8 +527,7 @@ fn sppm_scene(scene: &Scene, o: &SppmOptions) -> Result<Scene> {
             "--sppm-direct photons needs every photon path, but the scene stores caustics only (caustics_only = true)".into(),
         ));
     }
-    let mut s = scene.clone();
-    s.photon_map.max_bounces = o.max_bounces.max(1);
+    let mut s = scene.with_max_bounces(o.max_bounces.max(1));
     s.render.shadow_rays = o.shadow_rays.max(1);
     s.photon_map.store_direct = o.direct == DirectLighting::Photons;
     Ok(s)
