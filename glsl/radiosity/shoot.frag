@@ -35,6 +35,12 @@ uniform int u_item_columns;
 uniform int u_polygon;                // 1: the polygon form factor; 0: the disc's
 uniform int u_block;                  // elements a shooter a side
 
+// `sees`: the sine of the angle between h and a texel's plane below which
+// the plane does not decide visibility; and how far behind a plane, over the
+// receiver's distance, a receiver still counts as in it (float rounding).
+const float GRAZING = 0.1;
+const float COPLANAR = 1e-4;
+
 layout(location = 0) out vec4 o_shot;
 
 // The signed axis nearest direction d, as 1 + index (x, y, z), negative for
@@ -52,16 +58,52 @@ vec3 item_normal(vec2 zw) {
     return vec3(zw.x, y, s * sqrt(max(0.0, 1.0 - zw.x * zw.x - y * y)));
 }
 
-// Whether an item-buffer texel lets a receiver (patch, normal n) be seen:
-// it holds the receiver's own patch, or a surface facing the way the
-// receiver does no nearer than `nearest` (the receiver's distance less its
-// own size and two texels' width): an edge it shares (a mesh's next
-// triangle), where the chapter's IDs alone lose every element along the
-// edge. The facing test keeps a closed surface's near side blocking its far
-// side's inside at the silhouette, where the two are as near.
-bool sees(vec4 item, int patch_id, vec3 n, float nearest) {
-    return int(item.x) == patch_id
-        || (item.x > -1.5 && item.y >= nearest && dot(item_normal(item.zw), n) > 0.9);
+// Whether an item-buffer texel lets a receiver (patch, normal n, size
+// sqrt of its area, at distance d in unit direction h from the shooter) be
+// seen, the texel's own ray running along hc:
+// - it holds the receiver's own patch; or
+// - a surface facing the way the receiver does, which the texel's ray
+//   meets no nearer than `nearest` (the receiver's distance less its own
+//   size and two texels' width), or whose plane holds the receiver: an edge
+//   it shares with a coplanar neighbour (a mesh's next triangle), where the
+//   chapter's IDs alone lose every element along the edge, and where, seen
+//   edge-on, one texel spans depths far apart; or
+// - a surface beside the receiver, which the texel's ray meets no farther
+//   than the receiver's distance plus the slack, whose plane has the
+//   receiver a quarter of its size or more on the shooter's side, h
+//   crossing it at more than a grazing angle: an edge it shares with
+//   another plane (a wall meeting the floor).
+// The facing test keeps a closed surface's near side blocking its far
+// side's inside at the silhouette, where the two are as near; a facet's
+// plane has the rest of a convex surface behind it, but for its own bulge
+// (the chord's sagitta), less than the margin; and a surface far behind a
+// receiver at its silhouette (the floor past a ball) does not let in its
+// inside.
+bool sees(vec4 item, int patch_id, vec3 n, float size, vec3 h, vec3 hc, float d, float slack) {
+    if (int(item.x) == patch_id) return true;
+    if (item.x < -1.5) return false;
+    vec3 m = item_normal(item.zw);
+    float plane = item.y;                 // the shooter's distance from the texel's plane
+    float along_h = -dot(h, m);           // > 0: h runs into the plane's shown side
+    float along_texel = -dot(hc, m);
+    float in_front = plane - d * along_h; // the receiver's distance in front of the plane
+    // The texel's ray meets its surface at plane / along_texel.
+    bool meets_past = along_texel <= 0.0 || plane >= (d - slack) * along_texel;
+    if (dot(m, n) > 0.9 && (meets_past || abs(in_front) <= COPLANAR * d)) return true;
+    bool meets_beside = along_texel > 0.0 && plane <= (d + slack) * along_texel;
+    return along_h > GRAZING && meets_beside && in_front >= 0.25 * size;
+}
+
+// The unit direction of the ray through texel `texel` (within its tile) of
+// an item buffer whose shooter has frame (t, b, a).
+vec3 texel_direction(ivec2 texel, vec3 t, vec3 b, vec3 a) {
+    vec2 xy = (vec2(texel) + 0.5) / float(u_item_size) * 2.0 - 1.0;
+    float r2 = dot(xy, xy);
+    if (r2 > 1.0) {
+        xy *= inversesqrt(r2);
+        r2 = 1.0;
+    }
+    return normalize(t * xy.x + b * xy.y + a * sqrt(1.0 - r2));
 }
 
 // The texel of a shooter's item buffer holding hemisphere point xy.
@@ -98,22 +140,34 @@ void main() {
         vec3 h = -r;
         vec2 xy = vec2(dot(h, t), dot(h, b));
         ivec2 tile = ivec2(k % u_item_columns, k / u_item_columns) * u_item_size;
-        ivec2 at = tile + item_texel(xy);
+        ivec2 texel = item_texel(xy);
+        ivec2 at = tile + texel;
         float d = sqrt(d2);
         float slack = sqrt(e.w) + 4.0 * d / float(u_item_size);
-        bool visible = sees(texelFetch(u_item_buffers, at, 0), int(en.w), en.xyz, d - slack);
-        // Nothing at all there (-2, the clear value): the receiver is at its
-        // own surface's silhouette (a disc's rim) or the texel at the
-        // projection's rim, its centre outside the projected disc. A texel
-        // beside it that holds the receiver's surface decides (at no
-        // depth); a closed surface's near side there still blocks its far
-        // side's inside.
-        if (!visible && texelFetch(u_item_buffers, at, 0).x < -1.5) {
-            for (int n = 0; n < 4 && !visible; ++n) {
-                ivec2 step = n < 2 ? ivec2(2 * n - 1, 0) : ivec2(0, 2 * n - 5);
-                ivec2 q = clamp(at + step, tile, tile + ivec2(u_item_size - 1));
-                vec4 beside = texelFetch(u_item_buffers, q, 0);
-                visible = beside.x > -1.5 && sees(beside, int(en.w), en.xyz, -1e30);
+        vec3 hc = texel_direction(texel, t, b, s1.xyz);
+        bool visible = sees(texelFetch(u_item_buffers, at, 0), int(en.w), en.xyz, sqrt(e.w), h, hc, d, slack);
+        // Not seen there: the receiver may lie just past the texel that
+        // holds its own flat patch, where the rasteriser's chords and texel
+        // centres misplace the patch's edge (a mesh's edge seen edge-on) by
+        // a texel. A texel beside it that holds the receiver's own patch, in
+        // a plane through the receiver, decides (a curved patch's facets are
+        // chords, off the receiver by their sagitta). Where nothing at all is there (-2, the clear value: the
+        // receiver at its own surface's silhouette, such as a disc's rim, or
+        // the texel at the projection's rim, its centre outside the
+        // projected disc), a texel beside it that lets the receiver be seen
+        // at any depth decides. Either way, a closed surface's near side
+        // still blocks its far side's inside: the two are different patches.
+        vec4 item = texelFetch(u_item_buffers, at, 0);
+        for (int n = 0; n < 4 && !visible; ++n) {
+            ivec2 step = n < 2 ? ivec2(2 * n - 1, 0) : ivec2(0, 2 * n - 5);
+            ivec2 q = clamp(at + step, tile, tile + ivec2(u_item_size - 1));
+            vec4 beside = texelFetch(u_item_buffers, q, 0);
+            if (item.x < -1.5) {
+                hc = texel_direction(q - tile, t, b, s1.xyz);
+                visible = beside.x > -1.5 && sees(beside, int(en.w), en.xyz, sqrt(e.w), h, hc, d, 1e30);
+            } else {
+                vec3 m = item_normal(beside.zw);
+                visible = int(beside.x) == int(en.w) && abs(beside.y + d * dot(h, m)) <= COPLANAR * d;
             }
         }
         if (!visible) continue;
