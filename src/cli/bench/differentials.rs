@@ -29,7 +29,7 @@ use photonmap::render::{
 use photonmap::scene::Scene;
 
 use super::output::{folder, write_json, write_row_png, BenchOutput};
-use super::reference::reference_options;
+use super::reference::{reference_options, scaled_size};
 use super::scene::{BenchScene, Loaded, SEED};
 
 #[derive(Args)]
@@ -250,10 +250,11 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
     let leaf_sizes = leaf_rows(&mut bench, &auto, a.quick)?;
     let k_pairs = k_rows(&mut bench, &scene, &auto, a.quick)?;
 
+    let (width, height) = scaled_size(&scene, scale);
     let report = DifferentialsBench {
         scene: name,
-        width: (scene.camera.width / scale).max(1),
-        height: (scene.camera.height / scale).max(1),
+        width,
+        height,
         reference: reference.as_ref().map(|(p, _)| p.display().to_string()),
         indirect_pixels: bench
             .indirect

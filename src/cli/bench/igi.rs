@@ -17,7 +17,7 @@ use photonmap::metrics::compare;
 use photonmap::render::{render, IgiOptions, Image, Method, RenderOptions, WithCausticMap};
 
 use super::output::{folder, write_json, write_row_png, BenchOutput};
-use super::reference::reference_options;
+use super::reference::{reference_options, scaled_size};
 use super::scene::{BenchScene, Loaded, SEED};
 use crate::cli::args::in_range;
 
@@ -177,11 +177,12 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
             canonical = Some(r.image);
         }
     }
+    let (width, height) = scaled_size(&scene, scale);
     let report = IgiBench {
         scene: name,
         triangles: scene.shapes.len(),
-        width: (scene.camera.width / scale).max(1),
-        height: (scene.camera.height / scale).max(1),
+        width,
+        height,
         reference: reference.map(|(p, _)| p.display().to_string()),
         renderer: gpu.capabilities().gl_renderer,
         rows: out,
