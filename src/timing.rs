@@ -66,6 +66,16 @@ impl Timings {
         self.stages.iter().map(|s| s.wall_seconds).sum()
     }
 
+    /// Wall seconds summed into `N` components, `component` giving each
+    /// stage's (a benchmark's split of a render's time).
+    pub fn wall_by_component<const N: usize>(&self, component: impl Fn(&str) -> usize) -> [f64; N] {
+        let mut parts = [0.0f64; N];
+        for s in &self.stages {
+            parts[component(&s.name)] += s.wall_seconds;
+        }
+        parts
+    }
+
     /// A small table for stderr.
     pub fn table(&self) -> String {
         let mut out = format!(

@@ -21,7 +21,6 @@ use clap::Args;
 use serde::Serialize;
 
 use photonmap::gpu::{Gpu, Platform};
-use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
 use photonmap::render::{
     render, DifferentialsOptions, DifferentialsReport, Image, Method, RenderOptions, RenderOutput,
@@ -29,8 +28,8 @@ use photonmap::render::{
 };
 use photonmap::scene::Scene;
 
-use super::output::{folder, slug, write_json, BenchOutput};
-use super::reference::reference_options;
+use super::output::{folder, write_json, write_row_png, BenchOutput};
+use super::reference::{reference_options, scaled_size};
 use super::scene::{BenchScene, Loaded, SEED};
 
 #[derive(Args)]
@@ -141,10 +140,7 @@ impl Bench<'_> {
     ) -> Result<(Row, RenderOutput)> {
         (self.progress)(label);
         let r = render(self.gpu, scene, o, &mut ())?;
-        let mut parts = [0.0f64; 4];
-        for s in &r.timings.stages {
-            parts[component(&s.name)] += s.wall_seconds;
-        }
+        let parts: [f64; 4] = r.timings.wall_by_component(component);
         let (rmse, rel_mse, ssim, indirect_rmse, ratio) = match self.reference {
             Some(img) => {
                 let m = compare(&r.image, img, None)?;
@@ -169,9 +165,8 @@ impl Bench<'_> {
             }
             None => (None, None, None, None, None),
         };
-        let file = format!("{:02}_{}.png", self.rendered, slug(label));
+        write_row_png(&self.dir, self.rendered, label, &r.image)?;
         self.rendered += 1;
-        write_atomically(&self.dir.join(file), &r.image.png_bytes()?)?;
         let pd = r.differentials();
         let pd = pd.as_ref();
         let stats = r.footprint_estimates().first();
@@ -255,10 +250,11 @@ pub fn run(a: &DifferentialsBenchArgs, platform: Platform) -> Result<()> {
     let leaf_sizes = leaf_rows(&mut bench, &auto, a.quick)?;
     let k_pairs = k_rows(&mut bench, &scene, &auto, a.quick)?;
 
+    let (width, height) = scaled_size(&scene, scale);
     let report = DifferentialsBench {
         scene: name,
-        width: (scene.camera.width / scale).max(1),
-        height: (scene.camera.height / scale).max(1),
+        width,
+        height,
         reference: reference.as_ref().map(|(p, _)| p.display().to_string()),
         indirect_pixels: bench
             .indirect

@@ -13,12 +13,11 @@ use clap::Args;
 use serde::Serialize;
 
 use photonmap::gpu::Platform;
-use photonmap::image::write_atomically;
 use photonmap::metrics::compare;
 use photonmap::render::{render, IgiOptions, Image, Method, RenderOptions, WithCausticMap};
 
-use super::output::{folder, slug, write_json, BenchOutput};
-use super::reference::reference_options;
+use super::output::{folder, write_json, write_row_png, BenchOutput};
+use super::reference::{reference_options, scaled_size};
 use super::scene::{BenchScene, Loaded, SEED};
 use crate::cli::args::in_range;
 
@@ -147,10 +146,7 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
         let map = o.method.photon_map().cloned().unwrap_or_default();
         let o = o.with_method(Method::Igi(WithCausticMap::from_map(map, igi.clone())));
         let r = render(&gpu, &scene, &o, &mut ())?;
-        let mut parts = [0.0f64; 5];
-        for s in &r.timings.stages {
-            parts[component(&s.name)] += s.wall_seconds;
-        }
+        let parts: [f64; 5] = r.timings.wall_by_component(component);
         let (rmse, ssim) = match &reference {
             Some((_, img)) => {
                 let m = compare(&r.image, img, None)?;
@@ -162,8 +158,7 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
             Some(c) => compare(&r.image, c, None)?.rmse,
             None => 0.0,
         };
-        let file = format!("{:02}_{}.png", i, slug(label));
-        write_atomically(&dir.join(file), &r.image.png_bytes()?)?;
+        write_row_png(&dir, i, label, &r.image)?;
         out.push(IgiRow {
             label: label.to_string(),
             options: igi.clone(),
@@ -182,11 +177,12 @@ pub fn run(a: &IgiBenchArgs, platform: Platform) -> Result<()> {
             canonical = Some(r.image);
         }
     }
+    let (width, height) = scaled_size(&scene, scale);
     let report = IgiBench {
         scene: name,
         triangles: scene.shapes.len(),
-        width: (scene.camera.width / scale).max(1),
-        height: (scene.camera.height / scale).max(1),
+        width,
+        height,
         reference: reference.map(|(p, _)| p.display().to_string()),
         renderer: gpu.capabilities().gl_renderer,
         rows: out,

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 
-use photonmap::image::write_atomically;
+use photonmap::image::{write_atomically, Image};
 
 /// How a benchmark reports: a table on stdout, or its report as JSON; with
 /// progress on stderr, or without.
@@ -55,6 +55,14 @@ pub fn folder(out: Option<&Path>, kind: &str, name: Option<&str>) -> Result<Path
 /// `value` as pretty JSON at `path`, written all or nothing.
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     write_atomically(path, serde_json::to_string_pretty(value)?.as_bytes())?;
+    Ok(())
+}
+
+/// The `index`th row's image, labelled `label`, as a PNG in `dir`
+/// (`03_downsampling_4x4.png`), written all or nothing.
+pub fn write_row_png(dir: &Path, index: usize, label: &str, image: &Image) -> Result<()> {
+    let file = format!("{index:02}_{}.png", slug(label));
+    write_atomically(&dir.join(file), &image.png_bytes()?)?;
     Ok(())
 }
 

@@ -119,13 +119,20 @@ pub fn run(a: &ReferenceArgs, platform: Platform) -> Result<()> {
     Ok(())
 }
 
+/// `scene`'s frame at 1/`scale` of its resolution, at least a pixel a side.
+pub fn scaled_size(scene: &Scene, scale: u32) -> (u32, u32) {
+    (
+        (scene.camera.width / scale).max(1),
+        (scene.camera.height / scale).max(1),
+    )
+}
+
 /// The size and seed every reference half runs with (and the visibility leak
 /// test for the paper's estimate; SPPM's own is set in `make_reference`, so
 /// that thin walls do not leak while the radius is still large).
 pub fn reference_options(scene: &Scene, scale: u32, seed: u32) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
-    o.width = (scene.camera.width / scale).max(1);
-    o.height = (scene.camera.height / scale).max(1);
+    (o.width, o.height) = scaled_size(scene, scale);
     o.seed = seed;
     let mut map = PhotonMapOptions::default();
     map.estimate.leak = LeakTest::Visibility;

@@ -18,6 +18,7 @@ use photonmap::scene::{embedded, Scene};
 
 use super::report::{ConvergenceRow, Figure8, Table1Cell, Table1Total, FIGURE8_BUDGET, STAGES};
 use super::staged::Staged;
+use crate::cli::bench::reference::scaled_size;
 use crate::cli::render::{SnapshotEvery, SnapshotWriter};
 
 /// Table 1 of the paper (GeForce FX 5900 Ultra, seconds).
@@ -52,8 +53,7 @@ pub(crate) fn table1_options(
     mode: EstimateMode,
 ) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
-    o.width = (scene.camera.width / scale).max(1);
-    o.height = (scene.camera.height / scale).max(1);
+    (o.width, o.height) = scaled_size(scene, scale);
     let mut gi = PhotonMapOptions {
         photons: PhotonConfig {
             build,

@@ -65,8 +65,8 @@ fn pbrt_cornell_box_is_the_obj_one() {
 
 #[test]
 fn pbrt_cornell_box_keeps_its_materials_names_and_hints() {
-    let text = std::fs::read_to_string(dir().join("cornell_box.pbrt")).unwrap();
-    let c = convert_text("cornell_box.pbrt", &text, &ImportOptions::default()).unwrap();
+    let text = fixture_text("cornell_box.pbrt");
+    let c = convert_default("cornell_box.pbrt", &text).unwrap();
     for line in [
         "white = { type = \"diffuse\", albedo = [0.725, 0.71, 0.68] }",
         "render with --spp 4.",
@@ -80,12 +80,12 @@ fn pbrt_cornell_box_keeps_its_materials_names_and_hints() {
 
 #[test]
 fn the_ply_block_reads_the_same_in_every_encoding() {
-    let text = std::fs::read_to_string(dir().join("cornell_box.pbrt")).unwrap();
-    let ascii = convert_text("cornell_box.pbrt", &text, &ImportOptions::default()).unwrap();
+    let text = fixture_text("cornell_box.pbrt");
+    let ascii = convert_default("cornell_box.pbrt", &text).unwrap();
     for enc in ["le", "be"] {
         let other = text.replace("tall_block_ascii.ply", &format!("tall_block_{enc}.ply"));
         assert_ne!(other, text);
-        let c = convert_text("cornell_box.pbrt", &other, &ImportOptions::default()).unwrap();
+        let c = convert_default("cornell_box.pbrt", &other).unwrap();
         assert_eq!(c, ascii, "{enc}");
     }
     // and the three files really are the three encodings
@@ -109,7 +109,7 @@ fn mitsuba_cornell_box_is_the_obj_one() {
 
 #[test]
 fn mitsuba_defines_set_defaults_and_dollar_parameters() {
-    let text = std::fs::read_to_string(dir().join("cornell_box.xml")).unwrap();
+    let text = fixture_text("cornell_box.xml");
     let opts = ImportOptions {
         defines: vec![("res".into(), "64".into())],
         ..ImportOptions::default()
@@ -123,15 +123,15 @@ fn mitsuba_defines_set_defaults_and_dollar_parameters() {
         .replace("fov_axis", "fovAxis")
         .replace("to_world", "toWorld")
         .replace("sample_count", "sampleCount");
-    let c = convert_text("cornell_box.xml", &old, &ImportOptions::default()).unwrap();
-    assert_cornell(&load_scene_str(&c.toml, Path::new("t")).unwrap());
+    let (_, s) = convert_and_load("cornell_box.xml", &old);
+    assert_cornell(&s);
 }
 
 #[test]
 fn mitsuba_max_depth_counts_the_camera_segment() {
     // Mitsuba's max_depth D is D - 1 bounces (2: direct light); pbrt's
     // maxdepth 8 above gives 8.
-    let text = std::fs::read_to_string(dir().join("cornell_box.xml")).unwrap();
+    let text = fixture_text("cornell_box.xml");
     let depth = |d: &str, opts: &ImportOptions| {
         let t = replace_once(&text, "name=\"max_depth\" value=\"8\"", d);
         convert_text("cornell_box.xml", &t, opts)

@@ -8,7 +8,7 @@ const HEAD: &str = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBeg
 /// The error converting `body` after a valid head (4 lines).
 fn pbrt_error(body: &str) -> SceneError {
     let text = format!("{HEAD}{body}");
-    convert_text("bad.pbrt", &text, &ImportOptions::default()).unwrap_err()
+    convert_default("bad.pbrt", &text).unwrap_err()
 }
 
 fn assert_at(e: &SceneError, file: &str, line: usize, words: &str) {
@@ -126,19 +126,10 @@ fn what_photonmap_cannot_render_is_refused_or_mapped_with_a_note() {
 
 #[test]
 fn a_scene_without_camera_or_light_is_refused() {
-    let e = convert_text(
-        "bad.pbrt",
-        "WorldBegin\nLightSource \"point\"\n",
-        &ImportOptions::default(),
-    )
-    .unwrap_err();
+    let e = convert_default("bad.pbrt", "WorldBegin\nLightSource \"point\"\n").unwrap_err();
     assert!(e.to_string().contains("no camera"), "{e}");
-    let e = convert_text(
-        "bad.pbrt",
-        "Camera \"perspective\"\nWorldBegin\nShape \"sphere\"\n",
-        &ImportOptions::default(),
-    )
-    .unwrap_err();
+    let text = "Camera \"perspective\"\nWorldBegin\nShape \"sphere\"\n";
+    let e = convert_default("bad.pbrt", text).unwrap_err();
     assert!(e.to_string().contains("no light"), "{e}");
 }
 
@@ -146,7 +137,7 @@ const XML_HEAD: &str = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\">
 
 fn xml_error(body: &str) -> SceneError {
     let text = format!("{XML_HEAD}{body}</scene>\n");
-    convert_text("bad.xml", &text, &ImportOptions::default()).unwrap_err()
+    convert_default("bad.xml", &text).unwrap_err()
 }
 
 #[test]

@@ -55,10 +55,28 @@ fn convert_with(
     convert_bytes(format(&path), text.as_bytes(), &path, files, opts)
 }
 
+/// `text` converted as the file `name` with the default options.
+fn convert_default(name: &str, text: &str) -> Result<Converted, SceneError> {
+    convert_text(name, text, &ImportOptions::default())
+}
+
+/// A fixture's text, for a test to edit.
+fn fixture_text(name: &str) -> String {
+    std::fs::read_to_string(dir().join(name)).unwrap()
+}
+
+/// `text` converted as the file `name` with the default options, and loaded;
+/// with the TOML it converted to.
+fn convert_and_load(name: &str, text: &str) -> (String, Scene) {
+    let c = convert_default(name, text).unwrap();
+    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    (c.toml, s)
+}
+
 /// A fixture converted and loaded.
 fn load(name: &str) -> Scene {
-    let text = std::fs::read_to_string(dir().join(name)).unwrap();
-    let c = convert_text(name, &text, &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let text = fixture_text(name);
+    let c = convert_default(name, &text).unwrap_or_else(|e| panic!("{e}"));
     load_scene_str(&c.toml, Path::new(name)).unwrap_or_else(|e| panic!("{e}\n{}", c.toml))
 }
 

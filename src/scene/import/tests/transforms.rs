@@ -10,6 +10,24 @@ fn flat() -> Scene {
     crate::scene::load_scene(&dir().join("transforms_flat.toml")).unwrap()
 }
 
+/// The fixture `name` with `edit`, which must change it, converted and
+/// loaded; with the TOML it converted to.
+fn load_edited(name: &str, edit: impl FnOnce(&str) -> String) -> (String, Scene) {
+    let text = fixture_text(name);
+    let edited = edit(&text);
+    assert_ne!(edited, text);
+    convert_and_load(name, &edited)
+}
+
+/// The scene's vertical field of view is `expected` degrees.
+fn assert_vfov(s: &Scene, expected: f64) {
+    assert!(
+        (f64::from(s.camera.vfov_degrees) - expected).abs() < 1e-4,
+        "{}",
+        s.camera.vfov_degrees
+    );
+}
+
 /// The shapes (lights' included) and lights of two scenes agree, in order.
 fn assert_same(a: &Scene, b: &Scene) {
     assert_eq!(a.shapes.len(), b.shapes.len());
@@ -42,11 +60,9 @@ fn a_stack_of_transforms_loads_as_its_flattened_toml() {
 
 #[test]
 fn without_reverse_orientation_the_quad_light_faces_up() {
-    let text = std::fs::read_to_string(dir().join("transforms.pbrt")).unwrap();
-    let plain = text.replacen("  ReverseOrientation\n", "", 1);
-    assert_ne!(plain, text);
-    let c = convert_text("transforms.pbrt", &plain, &ImportOptions::default()).unwrap();
-    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    let (_, s) = load_edited("transforms.pbrt", |t| {
+        t.replacen("  ReverseOrientation\n", "", 1)
+    });
     let n = light_normals(&s);
     assert_eq!(n[1], Some([0.0, 1.0, 0.0]), "{n:?}");
     assert_eq!(n[2], Some([0.0, -1.0, 0.0]), "{n:?}");
@@ -54,12 +70,8 @@ fn without_reverse_orientation_the_quad_light_faces_up() {
 
 #[test]
 fn a_left_handed_camera_mirrors_the_world() {
-    let text = std::fs::read_to_string(dir().join("transforms.pbrt")).unwrap();
-    let left = text.replacen("Scale -1 1 1\n", "", 1);
-    assert_ne!(left, text);
-    let c = convert_text("transforms.pbrt", &left, &ImportOptions::default()).unwrap();
-    assert!(c.toml.contains("mirrored"), "{}", c.toml);
-    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    let (toml, s) = load_edited("transforms.pbrt", |t| t.replacen("Scale -1 1 1\n", "", 1));
+    assert!(toml.contains("mirrored"), "{toml}");
     // The camera stands at x = 0 looking along -z: the mirror is x -> -x.
     let sphere = s
         .shapes
@@ -74,20 +86,14 @@ fn a_left_handed_camera_mirrors_the_world() {
 
 #[test]
 fn pbrt_fov_spans_the_shorter_side() {
-    let text = std::fs::read_to_string(dir().join("transforms.pbrt")).unwrap();
-    let tall = text.replace(
-        "xresolution\" [ 64 ] \"integer yresolution\" [ 48 ]",
-        "xresolution\" [ 48 ] \"integer yresolution\" [ 96 ]",
-    );
-    assert_ne!(tall, text);
-    let c = convert_text("transforms.pbrt", &tall, &ImportOptions::default()).unwrap();
-    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    let (_, s) = load_edited("transforms.pbrt", |t| {
+        t.replace(
+            "xresolution\" [ 64 ] \"integer yresolution\" [ 48 ]",
+            "xresolution\" [ 48 ] \"integer yresolution\" [ 96 ]",
+        )
+    });
     let expected = 2.0 * ((15f64.to_radians()).tan() * 2.0).atan().to_degrees();
-    assert!(
-        (f64::from(s.camera.vfov_degrees) - expected).abs() < 1e-4,
-        "{}",
-        s.camera.vfov_degrees
-    );
+    assert_vfov(&s, expected);
 }
 
 #[test]
@@ -97,17 +103,11 @@ fn the_mitsuba_scene_loads_as_the_same_flattened_toml() {
 
 #[test]
 fn mitsuba_fov_axis_x_is_converted_to_the_vertical_fov() {
-    let text = std::fs::read_to_string(dir().join("transforms.xml")).unwrap();
-    let x = text.replace("value=\"y\"", "value=\"x\"");
-    let c = convert_text("transforms.xml", &x, &ImportOptions::default()).unwrap();
-    let s = load_scene_str(&c.toml, Path::new("t")).unwrap();
+    let x = fixture_text("transforms.xml").replace("value=\"y\"", "value=\"x\"");
+    let (_, s) = convert_and_load("transforms.xml", &x);
     let expected = 2.0
         * ((15f64.to_radians()).tan() * 48.0 / 64.0)
             .atan()
             .to_degrees();
-    assert!(
-        (f64::from(s.camera.vfov_degrees) - expected).abs() < 1e-4,
-        "{}",
-        s.camera.vfov_degrees
-    );
+    assert_vfov(&s, expected);
 }

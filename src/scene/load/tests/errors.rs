@@ -26,6 +26,14 @@ fn expect(from: &str, to: &str, line: usize, field: &str, says: &str) {
     );
 }
 
+/// Loads `text` and expects an error at `line` on `field`; returns it for
+/// the caller's checks of its message.
+fn error_at(text: &str, line: usize, field: &str) -> SceneError {
+    let e = load(text).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (line, field), "{e}");
+    e
+}
+
 /// The good scene with its point light's fields replaced by `fields`.
 fn with_light(fields: &str) -> String {
     good().replace(
@@ -175,8 +183,7 @@ fn area_light_normal_off_its_plane() {
     let text = with_light(
         "type = \"area\"\ncorner = [0.0, 3.0, 0.0]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [0.0, 0.0, 1.0]\nnormal = [1.0, 0.0, 0.0]\nradiance = [1.0, 1.0, 1.0]",
     );
-    let e = load(&text).unwrap_err();
-    assert_eq!((e.line, e.field.as_str()), (23, "light[0].normal"), "{e}");
+    error_at(&text, 23, "light[0].normal");
 }
 
 #[test]
@@ -184,8 +191,7 @@ fn zero_area_light() {
     let text = with_light(
         "type = \"area\"\ncorner = [0.0, 3.0, 0.0]\nedge1 = [1.0, 0.0, 0.0]\nedge2 = [2.0, 0.0, 0.0]\nradiance = [1.0, 1.0, 1.0]",
     );
-    let e = load(&text).unwrap_err();
-    assert_eq!((e.line, e.field.as_str()), (22, "light[0].edge2"), "{e}");
+    let e = error_at(&text, 22, "light[0].edge2");
     assert!(e.message.contains("no area"), "{e}");
 }
 
@@ -194,8 +200,7 @@ fn non_planar_polygon() {
     let text = with_shape(
         "type = \"polygon\"\nvertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.5]]",
     );
-    let e = load(&text).unwrap_err();
-    assert_eq!((e.line, e.field.as_str()), (14, "shape[0].vertices"), "{e}");
+    let e = error_at(&text, 14, "shape[0].vertices");
     assert!(e.message.contains("planar"), "{e}");
 }
 
