@@ -1,9 +1,12 @@
 """Write an interior mask for a scene exported by `photonmap bench mitsuba`
-(its `export.json`), made as the ground truth's masks are made: a pixel is
-white where all 4 x 4 of its sub-pixel rays first hit the same diffuse,
-non-emitting plane (one shape, one normal, one offset). Edges, lights,
-mirrors, glass and curved surfaces are black. Mitsuba 3 intersects the rays,
-so the mask shares no code with photonmap.
+(its `export.json`), made as the ground truth's masks are made but
+stricter: a pixel is white where all 4 x 4 of its sub-pixel rays, and the
+rays through its corners and along its border (a 9 x 9 lattice at eighths
+of the pixel), first hit the same diffuse, non-emitting plane (one shape,
+one normal, one offset). The border rays drop pixels whose square ends in a
+silhouette that the 4 x 4 rays pass by, as on a face seen edge-on. Edges,
+lights, mirrors, glass and curved surfaces are black. Mitsuba 3 intersects
+the rays, so the mask shares no code with photonmap.
 
     python scripts/interior-mask.py EXPORT.json OUT.png [--scale N] [--check MASK.png]
 
@@ -24,7 +27,9 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-SUB = 4
+# Offsets within a pixel: the truth's 4 x 4 rays at odd eighths, and the
+# even eighths, which put rays on the pixel's border.
+OFFSETS = [i / 8 for i in range(9)]
 
 
 def load_builder():
@@ -45,10 +50,10 @@ def masks(scene):
     extent = float(dr.max(scene.bbox().extents()))
     py, px = np.mgrid[0:h, 0:w]
     keys = []
-    for sy in range(SUB):
-        for sx in range(SUB):
-            u = ((px + (sx + 0.5) / SUB) / w).ravel().astype(np.float32)
-            v = ((py + (sy + 0.5) / SUB) / h).ravel().astype(np.float32)
+    for oy in OFFSETS:
+        for ox in OFFSETS:
+            u = ((px + ox) / w).ravel().astype(np.float32)
+            v = ((py + oy) / h).ravel().astype(np.float32)
             ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f(u, v), mi.Point2f(0.5, 0.5))
             si = scene.ray_intersect(ray)
             valid = np.array(si.is_valid())

@@ -10,9 +10,10 @@ every film's reconstruction filter becomes a box of one pixel, as
 photonmap's (--keep-filter keeps the file's), and --black-emitters gives
 every emitting shape a black BSDF, as photonmap's lights reflect nothing.
 
---mask writes a PNG that is white where all 4 x 4 of a pixel's sub-pixel
-rays first hit the same diffuse, non-emitting plane (one shape, one normal,
-one offset), as scripts/interior-mask.py makes the truth's masks; edges,
+--mask writes a PNG that is white where all of a pixel's sub-pixel rays
+(4 x 4, and along its border) first hit the same diffuse, non-emitting
+plane (one shape, one normal, one offset), as scripts/interior-mask.py
+makes its masks, the truth's rule made stricter at silhouettes; edges,
 lights, mirrors, glass and curved surfaces are black. --edges writes the
 pixels whose sub-pixel rays all hit diffuse, non-emitting surfaces but not
 one plane: the edges between walls. The LLVM variants need
