@@ -27,8 +27,8 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-# Offsets within a pixel: the truth's 4 x 4 rays at odd eighths, and the
-# even eighths, which put rays on the pixel's border.
+# Offsets within a pixel: the truth's 4 x 4 rays at the odd eighths, and
+# the even eighths between and around them, 0 and 1 on the pixel's border.
 OFFSETS = [i / 8 for i in range(9)]
 
 

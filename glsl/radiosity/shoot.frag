@@ -58,6 +58,17 @@ vec3 item_normal(vec2 zw) {
     return vec3(zw.x, y, s * sqrt(max(0.0, 1.0 - zw.x * zw.x - y * y)));
 }
 
+// How far the receiver at distance d in unit direction h from the shooter
+// lies in front of (on the shooter's side of) an item-buffer texel's plane.
+float in_front(vec4 item, vec3 h, float d) {
+    return item.y + d * dot(h, item_normal(item.zw));
+}
+
+// Whether that receiver lies in the texel's plane, to float rounding.
+bool in_plane(vec4 item, vec3 h, float d) {
+    return abs(in_front(item, h, d)) <= COPLANAR * d;
+}
+
 // Whether an item-buffer texel lets a receiver (patch, normal n, size
 // sqrt of its area, at distance d in unit direction h from the shooter) be
 // seen, the texel's own ray running along hc:
@@ -84,14 +95,12 @@ bool sees(vec4 item, int patch_id, vec3 n, float size, vec3 h, vec3 hc, float d,
     if (item.x < -1.5) return false;
     vec3 m = item_normal(item.zw);
     float plane = item.y;                 // the shooter's distance from the texel's plane
-    float along_h = -dot(h, m);           // > 0: h runs into the plane's shown side
-    float along_texel = -dot(hc, m);
-    float in_front = plane - d * along_h; // the receiver's distance in front of the plane
+    float along_texel = -dot(hc, m);      // > 0: the texel's ray runs into the plane's shown side
     // The texel's ray meets its surface at plane / along_texel.
     bool meets_past = along_texel <= 0.0 || plane >= (d - slack) * along_texel;
-    if (dot(m, n) > 0.9 && (meets_past || abs(in_front) <= COPLANAR * d)) return true;
+    if (dot(m, n) > 0.9 && (meets_past || in_plane(item, h, d))) return true;
     bool meets_beside = along_texel > 0.0 && plane <= (d + slack) * along_texel;
-    return along_h > GRAZING && meets_beside && in_front >= 0.25 * size;
+    return -dot(h, m) > GRAZING && meets_beside && in_front(item, h, d) >= 0.25 * size;
 }
 
 // The unit direction of the ray through texel `texel` (within its tile) of
@@ -143,32 +152,30 @@ void main() {
         ivec2 texel = item_texel(xy);
         ivec2 at = tile + texel;
         float d = sqrt(d2);
-        float slack = sqrt(e.w) + 4.0 * d / float(u_item_size);
-        vec3 hc = texel_direction(texel, t, b, s1.xyz);
-        bool visible = sees(texelFetch(u_item_buffers, at, 0), int(en.w), en.xyz, sqrt(e.w), h, hc, d, slack);
+        float size = sqrt(e.w);
+        float slack = size + 4.0 * d / float(u_item_size);
+        vec4 item = texelFetch(u_item_buffers, at, 0);
+        bool visible = sees(item, int(en.w), en.xyz, size, h, texel_direction(texel, t, b, s1.xyz), d, slack);
         // Not seen there: the receiver may lie just past the texel that
         // holds its own flat patch, where the rasteriser's chords and texel
         // centres misplace the patch's edge (a mesh's edge seen edge-on) by
         // a texel. A texel beside it that holds the receiver's own patch, in
         // a plane through the receiver, decides (a curved patch's facets are
-        // chords, off the receiver by their sagitta). Where nothing at all is there (-2, the clear value: the
-        // receiver at its own surface's silhouette, such as a disc's rim, or
-        // the texel at the projection's rim, its centre outside the
-        // projected disc), a texel beside it that lets the receiver be seen
-        // at any depth decides. Either way, a closed surface's near side
-        // still blocks its far side's inside: the two are different patches.
-        vec4 item = texelFetch(u_item_buffers, at, 0);
+        // chords, off the receiver by their sagitta). Where nothing at all
+        // is there (-2, the clear value: the receiver at its own surface's
+        // silhouette, such as a disc's rim, or the texel at the projection's
+        // rim, its centre outside the projected disc), a texel beside it
+        // that lets the receiver be seen at any depth decides. Either way, a
+        // closed surface's near side still blocks its far side's inside:
+        // the two are different patches.
+        bool nothing = item.x < -1.5;
         for (int n = 0; n < 4 && !visible; ++n) {
             ivec2 step = n < 2 ? ivec2(2 * n - 1, 0) : ivec2(0, 2 * n - 5);
             ivec2 q = clamp(at + step, tile, tile + ivec2(u_item_size - 1));
             vec4 beside = texelFetch(u_item_buffers, q, 0);
-            if (item.x < -1.5) {
-                hc = texel_direction(q - tile, t, b, s1.xyz);
-                visible = beside.x > -1.5 && sees(beside, int(en.w), en.xyz, sqrt(e.w), h, hc, d, 1e30);
-            } else {
-                vec3 m = item_normal(beside.zw);
-                visible = int(beside.x) == int(en.w) && abs(beside.y + d * dot(h, m)) <= COPLANAR * d;
-            }
+            visible = nothing
+                ? sees(beside, int(en.w), en.xyz, size, h, texel_direction(q - tile, t, b, s1.xyz), d, 1e30)
+                : int(beside.x) == int(en.w) && in_plane(beside, h, d);
         }
         if (!visible) continue;
         float f;

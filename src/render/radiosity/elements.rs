@@ -471,18 +471,24 @@ impl Elements {
 }
 
 /// A triangle's segments a side in the item buffers: as a parallelogram's
-/// (16) where the scene is small, so that its projected edges bend as
+/// where the scene is small, so that its projected edges bend as
 /// closely (coarser chords misplace the edges a receiver is seen across: a
 /// closed box of triangles lost 1.2% of its power at 4); fewer as the
 /// scene grows, at most TESSELLATED_TRIANGLES in all, and at least one.
 fn triangle_segments(shapes: usize) -> u32 {
     let per_shape = TESSELLATED_TRIANGLES / shapes.max(1);
-    (per_shape as f64).sqrt().floor().clamp(1.0, 16.0) as u32
+    (per_shape as f64)
+        .sqrt()
+        .floor()
+        .clamp(1.0, f64::from(PLANAR_SEGMENTS)) as u32
 }
 
 /// The item buffers' triangles at most, from triangle primitives: as many
 /// as 4096 triangles at 4 segments a side.
 const TESSELLATED_TRIANGLES: usize = 65536;
+
+/// A parallelogram's segments a side in the item buffers.
+const PLANAR_SEGMENTS: u32 = 16;
 
 /// Every primitive as triangles for the item buffers: (x, y, z, primitive)
 /// a vertex. Planar shapes are subdivided, since the hemispherical projection
@@ -495,7 +501,7 @@ pub fn tessellate(scene: &Scene) -> Vec<f32> {
         let (nu, nv) = match g {
             Geometry::Sphere { .. } => (CURVED_SEGMENTS, CURVED_SEGMENTS / 2),
             Geometry::Cylinder { .. } => (CURVED_SEGMENTS, 4),
-            Geometry::Parallelogram { .. } => (16, 16),
+            Geometry::Parallelogram { .. } => (PLANAR_SEGMENTS, PLANAR_SEGMENTS),
             Geometry::Triangle { .. } => (triangle_segments, triangle_segments),
         };
         let triangle = matches!(g, Geometry::Triangle { .. });
