@@ -3,8 +3,8 @@
 //! leaves below), no source file imports a file that imports it back (in src/
 //! and tests/), the twins in src/twins/ are compiled only for tests, every
 //! unsafe block says why it is sound, no function is longer than a screen, no
-//! file in src/ is longer than 800 lines, and main.rs only parses and
-//! dispatches.
+//! file in src/ is longer than 800 lines, main.rs only parses and
+//! dispatches, and only test modules name the source tree's folder.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -285,6 +285,34 @@ fn no_source_file_is_too_long() {
         ("files", MAX_FILE_LINES),
         &too_long,
         ("OVERSIZED_FILES", &shrunk),
+    );
+}
+
+#[test]
+fn only_test_modules_name_the_source_tree() {
+    // `env!("CARGO_MANIFEST_DIR")` bakes the build's folder into the
+    // binary: an installed photonmap must not need its source tree beside
+    // it. Unit tests may, in a `tests` folder declared `#[cfg(test)]`.
+    let mut outside = Vec::new();
+    for (file, text) in sources() {
+        if !text.contains("CARGO_MANIFEST_DIR") {
+            continue;
+        }
+        let Some((parent, _)) = file.split_once("/tests/") else {
+            outside.push(file);
+            continue;
+        };
+        let declared = [format!("{parent}/mod.rs"), format!("{parent}.rs")]
+            .iter()
+            .filter_map(|d| std::fs::read_to_string(common::root().join(d)).ok())
+            .any(|t| t.contains("#[cfg(test)]\nmod tests;"));
+        if !declared {
+            outside.push(file);
+        }
+    }
+    assert!(
+        outside.is_empty(),
+        "CARGO_MANIFEST_DIR outside a #[cfg(test)] tests module: {outside:?}"
     );
 }
 
