@@ -187,6 +187,7 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
     out.push(igi("IGI, all three accelerations", &all_three));
     if !quick {
         out.push(igi("IGI 64 paths", &|o| o.vpl_paths = 64));
+        out.push(igi("IGI 256 paths", &|o| o.vpl_paths = 256));
         out.push(igi("IGI, no bias compensation", &|o| {
             o.bias_compensation = 0
         }));
@@ -271,7 +272,8 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 
 /// Progressive radiosity: its defaults, its caustic map from lights only,
 /// not shot on, at the scene's k, at k = 32 and on the scene's grid, the chapter's ~10,000 elements of
-/// CORNELL BOX (32 x 32 a patch side), and 4 spp.
+/// CORNELL BOX (32 x 32 a patch side), shooters of 2 x 2 elements, a finer
+/// item buffer, and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, spp: u32, f: &dyn Fn(&mut RadiosityOptions)| {
         base.by_tweaked(label, RunMethod::Radiosity, spp, f)
@@ -295,6 +297,8 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
             o.caustic_scene_grid = true
         }));
         out.push(rad("radiosity, 32 elements", 1, &|o| o.resolution = 32));
+        out.push(rad("radiosity, substructure 8", 1, &|o| o.substructure = 8));
+        out.push(rad("radiosity, item buffer 1024", 1, &|o| o.item_buffer = 1024));
         out.push(rad("radiosity, 4 spp", 4, &|_| {}));
     }
     out
