@@ -245,7 +245,7 @@ impl RenderOutput {
                 0,
                 true,
                 format!(
-                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side; {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; {}",
+                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side, the widest {:.3} across: a receiver nearer a shooter than its width, as a face is where it meets the floor, gets the shooter's mean radiosity, not the light beside it (each doubling of --substructure halves the width); {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; {}",
                     r.patches,
                     r.elements,
                     r.element_resolution,
@@ -254,6 +254,7 @@ impl RenderOutput {
                     o.substructure,
                     o.substructure,
                     o.item_buffer,
+                    r.largest_shooter,
                     if r.converged { "converged" } else { "stopped at --max-shots" },
                     100.0 * r.unshot_fraction,
                     caustic_map(o.caustic_paths),

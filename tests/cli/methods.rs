@@ -297,6 +297,16 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
         "{unshot:?}"
     );
     assert!(r["tiles"].as_u64().unwrap() >= r["patches"].as_u64().unwrap());
+    // The widest shooter is a quarter (2 x 2 shooters) of a 2 x 2 wall's
+    // tile, unsplit or split once (the default --subdivide 1): its diagonal,
+    // which `--explain` names.
+    let widest = r["largest_shooter"].as_f64().unwrap();
+    assert!(
+        [2f64.sqrt(), 2f64.sqrt() / 2.0]
+            .iter()
+            .any(|w| (widest - w).abs() < 1e-4),
+        "{widest}"
+    );
     let refused: [(&[&str], &str); 14] = [
         (&["--elements", "8"], "--method radiosity"),
         (

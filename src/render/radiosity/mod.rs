@@ -83,6 +83,20 @@ struct Shooter {
     block_base: [u32; 2],
 }
 
+impl Shooter {
+    /// The largest distance between two points of its outline (a disc's of
+    /// its area where it has none).
+    fn width(&self) -> f32 {
+        let o = &self.outline;
+        if o.is_empty() {
+            return 2.0 * (self.area / std::f32::consts::PI).sqrt();
+        }
+        o.iter()
+            .flat_map(|a| o.iter().map(move |b| a.distance(*b)))
+            .fold(0.0, f32::max)
+    }
+}
+
 /// The radiosity solution's textures and passes.
 pub struct Radiosity {
     gpu: Gpu,
@@ -343,6 +357,9 @@ impl Radiosity {
                 break;
             };
             let shooters = self.sub_shooters(scene, tile)?;
+            for s in &shooters {
+                report.largest_shooter = report.largest_shooter.max(s.width());
+            }
             let light = self.elements.patches[self.elements.tiles[tile].patch as usize].emitter;
             // Zeroed before the shot: a curved patch (the inside of a
             // sphere) receives some of its own light.

@@ -169,6 +169,10 @@ pub struct RadiosityReport {
     /// The split test's absolute floor (SPLIT_FLOOR x the mean irradiance).
     pub split_floor: f32,
     pub shots: u32,
+    /// The widest sub-element shooter shot (the largest distance between
+    /// two points of its outline): a receiver nearer a shooter than this
+    /// gets its mean radiosity, not the light beside it.
+    pub largest_shooter: f32,
     pub converged: bool,
     pub unshot_fraction: f64,
     pub seconds: f64,

@@ -298,7 +298,9 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
         }));
         out.push(rad("radiosity, 32 elements", 1, &|o| o.resolution = 32));
         out.push(rad("radiosity, substructure 8", 1, &|o| o.substructure = 8));
-        out.push(rad("radiosity, item buffer 1024", 1, &|o| o.item_buffer = 1024));
+        out.push(rad("radiosity, item buffer 1024", 1, &|o| {
+            o.item_buffer = 1024
+        }));
         out.push(rad("radiosity, 4 spp", 4, &|_| {}));
     }
     out
