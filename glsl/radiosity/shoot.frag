@@ -165,16 +165,19 @@ void main() {
         // is there (-2, the clear value: the receiver at its own surface's
         // silhouette, such as a disc's rim, or the texel at the projection's
         // rim, its centre outside the projected disc), a texel beside it
-        // that lets the receiver be seen at any depth decides. Either way, a
-        // closed surface's near side still blocks its far side's inside:
-        // the two are different patches.
+        // that lets the receiver be seen, within the same slack, decides:
+        // at any depth, a surface far past it (the light beyond a ball's
+        // silhouette, seen from the floor) would let in the ball's inside,
+        // where the ray has passed between its chords and the true surface.
+        // Either way, a closed surface's near side still blocks its far
+        // side's inside: the two are different patches.
         bool nothing = item.x < -1.5;
         for (int n = 0; n < 4 && !visible; ++n) {
             ivec2 step = n < 2 ? ivec2(2 * n - 1, 0) : ivec2(0, 2 * n - 5);
             ivec2 q = clamp(at + step, tile, tile + ivec2(u_item_size - 1));
             vec4 beside = texelFetch(u_item_buffers, q, 0);
             visible = nothing
-                ? sees(beside, int(en.w), en.xyz, size, h, texel_direction(q - tile, t, b, s1.xyz), d, 1e30)
+                ? sees(beside, int(en.w), en.xyz, size, h, texel_direction(q - tile, t, b, s1.xyz), d, slack)
                 : int(beside.x) == int(en.w) && in_plane(beside, h, d);
         }
         if (!visible) continue;

@@ -7,6 +7,8 @@
 
 use glam::Vec3;
 
+use crate::layout::LUMINANCE;
+
 /// A shooter: position, normal, area, residual radiosity and outline.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Shooter {
@@ -19,14 +21,17 @@ pub struct Shooter {
 }
 
 /// Tile `tile`'s sub x sub shooters, from the atlas's element positions
-/// (w = area), normals and residuals (each `width` texels a row); block k's
-/// outline from `outline(k)`.
+/// (w = area), normals and residuals (each `width` texels a row), each at
+/// its elements' centre weighted by residual power on a flat patch
+/// (`flat`; by area where it has none) and by area on a curved one; block
+/// k's outline from `outline(k)`.
 pub fn sub_shooters(
     position: &[[f32; 4]],
     normal: &[[f32; 4]],
     residual: &[[f32; 4]],
     width: u32,
     (tile, res, tile_columns, sub): (u32, u32, u32, u32),
+    flat: bool,
     outline: &dyn Fn(u32) -> Vec<Vec3>,
 ) -> Vec<Shooter> {
     let block = res / sub;
@@ -37,6 +42,7 @@ pub fn sub_shooters(
             (tile / tile_columns) * res + (k / sub) * block,
         );
         let (mut p, mut n, mut e, mut area) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0.0);
+        let (mut at_power, mut power) = (Vec3::ZERO, 0.0);
         for j in 0..block {
             for i in 0..block {
                 let t = ((base.1 + j) * width + base.0 + i) as usize;
@@ -44,15 +50,24 @@ pub fn sub_shooters(
                 if a <= 0.0 {
                     continue;
                 }
-                p += a * Vec3::from_slice(&position[t][..3]);
+                let x = Vec3::from_slice(&position[t][..3]);
+                let b = Vec3::from_slice(&residual[t][..3]);
+                let w = a * b.dot(Vec3::from(LUMINANCE));
+                p += a * x;
+                at_power += w * x;
                 n += a * Vec3::from_slice(&normal[t][..3]);
-                e += a * Vec3::from_slice(&residual[t][..3]);
+                e += a * b;
                 area += a;
+                power += w;
             }
         }
         if area > 0.0 {
             out.push(Shooter {
-                position: p / area,
+                position: if flat && power > 0.0 {
+                    at_power / power
+                } else {
+                    p / area
+                },
                 normal: n.normalize(),
                 area,
                 energy: e / area,

@@ -65,7 +65,7 @@ use crate::gpu::{
 use crate::layout::{SHOOTER_OUTLINE, SHOOTER_TEXELS, TILE_ROW};
 use crate::photon::PhotonFrames;
 use crate::scene::pack::SceneTextures;
-use crate::scene::{Light, Scene};
+use crate::scene::{Geometry, Light, Scene};
 
 use super::{DirectLight, Image, Timings};
 
@@ -81,6 +81,15 @@ struct Shooter {
     outline: Vec<Vec3>,
     /// The block's first texel in the atlas (its own elements).
     block_base: [u32; 2],
+}
+
+/// Whether a primitive is flat: its shooters stand at their power-weighted
+/// centre (shooters.frag).
+pub fn is_flat(g: &Geometry) -> bool {
+    matches!(
+        g,
+        Geometry::Parallelogram { .. } | Geometry::Triangle { .. }
+    )
 }
 
 impl Shooter {
@@ -475,6 +484,7 @@ impl Radiosity {
             .texture("u_element_normal", &self.normal)
             .int("u_tile", tile as i32)
             .int("u_sub", self.options.substructure as i32)
+            .int("u_power_centre", i32::from(is_flat(g)))
             .draw_region(
                 &self.shooters_target,
                 &DrawState::PLAIN,
