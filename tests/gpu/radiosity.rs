@@ -18,7 +18,7 @@ use crate::common;
 
 use glam::{Vec2, Vec3};
 use photonmap::layout::LUMINANCE;
-use photonmap::render::radiosity::{block_outline, is_flat, onto_surface, FormFactor};
+use photonmap::render::radiosity::{block_outline, is_curved, onto_surface, FormFactor};
 use photonmap::render::{
     render, Method, RadiosityOptions, RenderOptions, RenderOutput, WithCausticMap,
 };
@@ -158,7 +158,7 @@ fn the_item_buffer_sees_what_shadow_rays_see() {
         &e.emission,
         e.width,
         (light, e.res, e.tile_columns, o.substructure),
-        is_flat(g),
+        !is_curved(g),
         &|k| outline(g, k, e.res, o.substructure),
     );
     assert_eq!(shooters.len(), 16);
@@ -273,7 +273,7 @@ fn a_diffuse_sphere_around_a_point_light_reaches_its_steady_state() {
                     &residual,
                     e.width,
                     (inside, e.res, e.tile_columns, o.substructure),
-                    is_flat(g),
+                    !is_curved(g),
                     &|k| outline(g, k, e.res, o.substructure),
                 ),
                 &s,

@@ -165,6 +165,13 @@ pub fn onto_surface(g: &Geometry, p: Vec3, n: Vec3) -> Vec3 {
     }
 }
 
+/// Whether a primitive is curved: its blocks' outlines follow the surface,
+/// and its shooters stand at their area centroid moved onto it; a flat
+/// one's stand at their power-weighted centre (shooters.frag).
+pub fn is_curved(g: &Geometry) -> bool {
+    matches!(g, Geometry::Sphere { .. } | Geometry::Cylinder { .. })
+}
+
 /// The outline on the surface of cells [i0, i1) x [j0, j1) of a grid of n
 /// cells a side (a shooter's block): its corners on a parallelogram, the
 /// part with u + v <= 1 on a triangle, and on a sphere or cylinder its four
@@ -176,7 +183,7 @@ pub fn block_outline(g: &Geometry, [i0, j0, i1, j1]: [u32; 4], n: u32) -> Vec<Ve
     let (u0, v0, u1, v1) = (i0 as f32 / n, j0 as f32 / n, i1 as f32 / n, j1 as f32 / n);
     let square = [(u0, v0), (u1, v0), (u1, v1), (u0, v1)];
     let mut uv: Vec<(f32, f32)> = square.to_vec();
-    if matches!(g, Geometry::Sphere { .. } | Geometry::Cylinder { .. }) {
+    if is_curved(g) {
         let m = CURVED_OUTLINE_SEGMENTS;
         uv = (0..4)
             .flat_map(|edge| {

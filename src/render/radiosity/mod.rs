@@ -47,8 +47,8 @@ pub mod run;
 mod subdivide;
 
 pub use elements::{
-    block_outline, element_point, full_tree, onto_surface, tessellate, Elements, Node, Patch, Tile,
-    CURVED_SEGMENTS, MAX_ATLAS_TEXELS,
+    block_outline, element_point, full_tree, is_curved, onto_surface, tessellate, Elements, Node,
+    Patch, Tile, CURVED_SEGMENTS, MAX_ATLAS_TEXELS,
 };
 pub use options::{
     ConvergencePoint, FormFactor, RadiosityOptions, RadiosityReport, MAX_SUBDIVIDE, SPLIT_FLOOR,
@@ -65,7 +65,7 @@ use crate::gpu::{
 use crate::layout::{SHOOTER_OUTLINE, SHOOTER_TEXELS, TILE_ROW};
 use crate::photon::PhotonFrames;
 use crate::scene::pack::SceneTextures;
-use crate::scene::{Geometry, Light, Scene};
+use crate::scene::{Light, Scene};
 
 use super::{DirectLight, Image, Timings};
 
@@ -81,15 +81,6 @@ struct Shooter {
     outline: Vec<Vec3>,
     /// The block's first texel in the atlas (its own elements).
     block_base: [u32; 2],
-}
-
-/// Whether a primitive is flat: its shooters stand at their power-weighted
-/// centre (shooters.frag).
-pub fn is_flat(g: &Geometry) -> bool {
-    matches!(
-        g,
-        Geometry::Parallelogram { .. } | Geometry::Triangle { .. }
-    )
 }
 
 impl Shooter {
@@ -484,7 +475,7 @@ impl Radiosity {
             .texture("u_element_normal", &self.normal)
             .int("u_tile", tile as i32)
             .int("u_sub", self.options.substructure as i32)
-            .int("u_power_centre", i32::from(is_flat(g)))
+            .int("u_power_centre", i32::from(!is_curved(g)))
             .draw_region(
                 &self.shooters_target,
                 &DrawState::PLAIN,
