@@ -308,8 +308,9 @@ pub struct IgiArgs {
     #[arg(long)]
     pub imperfect_visibility: bool,
     /// IGI: interleaved sampling over N x N VPL subsets, merged by the
-    /// discontinuity buffer (1..=8; 1: off; the paper's 3).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = in_range(1, 8))]
+    /// discontinuity buffer (1..=8; 1: off, the paper's canonical IGI; 3: the
+    /// paper's acceleration).
+    #[arg(long, value_name = "N", default_value_t = IgiOptions::default().interleave, value_parser = in_range(1, 8))]
     pub interleave: u32,
     /// IGI: the VPL gather at one pixel per F x F block, joint-bilateral
     /// upsampled (1..=16; 1: off; the paper's 4).
@@ -329,7 +330,7 @@ impl IgiArgs {
             || self.vpl_bounces != 32
             || self.vpl_min_distance.is_some()
             || self.imperfect_visibility
-            || self.interleave != 1
+            || self.interleave != IgiOptions::default().interleave
             || self.downsample != 1
             || self.bias_compensation != IgiOptions::default().bias_compensation
     }

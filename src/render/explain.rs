@@ -51,10 +51,10 @@ impl RenderOutput {
     pub fn explain(&self, scene: &Scene, options: &RenderOptions) -> Vec<ExplainLine> {
         let mut lines = self.ray_tracing_lines(scene);
         if let Some(b) = options.pixel_bounds {
-            let how = if self.method.crops_eye_passes() {
-                "the eye passes draw only these (GL scissor); photons are the frame's"
-            } else {
-                "the eye passes draw the whole frame and the crop is cut from it (this method's pixels read one another's)"
+            let how = match self.method.crop_margin() {
+                Some(0) => "the eye passes draw only these (GL scissor); photons are the frame's".to_string(),
+                Some(m) => format!("the eye passes draw these and {m} pixels around them (GL scissor), which this method's pixels read; photons are the frame's"),
+                None => "the eye passes draw the whole frame and the crop is cut from it (this method's pixels read one another's)".to_string(),
             };
             lines.push(line(
                 "crop",
@@ -153,7 +153,15 @@ impl RenderOutput {
                 ),
             ));
         }
-        if let (Method::Igi(o), Some(v)) = (&options.method, self.vpls()) {
+        let vpls_skipped = self.vpls().is_some_and(|v| v.skipped);
+        if let (Method::Igi(_), true) = (&options.method, vpls_skipped) {
+            lines.push(line(
+                "IGI VPLs, gather",
+                0,
+                false,
+                "skipped: every diffuse surface lies in one plane, whose points see each other only edge-on, so a VPL could light nothing; the image is direct light and the caustic map".into(),
+            ));
+        } else if let (Method::Igi(o), Some(v)) = (&options.method, self.vpls()) {
             let o = &o.method;
             let passes: u32 = self.igi().iter().map(|s| s.passes).sum();
             lines.push(line(
@@ -190,6 +198,12 @@ impl RenderOutput {
         if let (Method::Igi(o), Some(run)) = (&options.method, self.igi_run()) {
             let m = o.method.min_distance_for(scene);
             lines.push(match &run.compensation {
+                None if run.report.skipped => line(
+                    "IGI bias compensation",
+                    0,
+                    false,
+                    "skipped: its gather rays would meet no diffuse surface (every one lies in one plane)".into(),
+                ),
                 Some(c) => {
                     let passes: u32 = c.stats.iter().map(|s| s.batches + s.estimate_passes).sum();
                     let hits: u64 = c.stats.iter().map(|s| s.queries).sum();

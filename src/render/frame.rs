@@ -67,16 +67,16 @@ pub fn render_views(
     // The method first: one map (or final gather's two) serves every view
     // and every eye sample.
     let mut method = MethodRun::prepare(gpu, scene, &textures, options, &mut timings, observer)?;
-    // A crop: the eye passes draw only its pixels where the method's pixels
-    // do not read one another's (`MethodRun::crops_eye_passes`); the image is
-    // cut from the frame's either way.
+    // A crop: the eye passes draw only its pixels and the margin its
+    // pixels read (`MethodRun::crop_margin`), or the whole frame where the
+    // reads are not local; the image is cut from the frame's either way.
     let crop = options.pixel_bounds;
     let _window = PixelWindowGuard::set(
         gpu,
-        crop.filter(|_| method.crops_eye_passes())
-            .map(|b| PixelWindow {
+        crop.zip(method.crop_margin())
+            .map(|(b, margin)| PixelWindow {
                 size: (w, h),
-                rect: b.gl_rect(h),
+                rect: b.grown(margin, w, h).gl_rect(h),
             }),
     );
     let cut = |image: Image| options.cut(image);

@@ -73,19 +73,20 @@ impl MethodRun {
         }
     }
 
-    /// Whether a crop may draw only its own pixels in the eye passes: true
-    /// where no pixel's light reads another pixel's or a compacted list of
-    /// pixels (tested: a crop then equals the frame's pixels bit for bit).
-    /// Otherwise the eye passes run over the whole frame and the crop is cut
-    /// from it.
-    pub fn crops_eye_passes(&self) -> bool {
+    /// How far beyond a crop the eye passes must draw, in pixels, for the
+    /// crop's pixels to be the frame's: 0 where no pixel's light reads
+    /// another's, the reach of the reads where they are local (tested: a crop
+    /// then equals the frame's pixels bit for bit). None: the eye passes run
+    /// over the whole frame and the crop is cut from it.
+    pub fn crop_margin(&self) -> Option<u32> {
         match self {
             // Adaptive sampling plans from neighbouring pixels and compacts
             // the pixels it computes; differentials' gather was measured to
             // differ at a crop's pixels when the others are not drawn.
-            MethodRun::PhotonMap(m) => m.pyramid.is_none(),
-            MethodRun::Differentials(_) => false,
-            MethodRun::DirectOnly | MethodRun::Igi(_) | MethodRun::Radiosity(_) => true,
+            MethodRun::PhotonMap(m) => m.pyramid.is_none().then_some(0),
+            MethodRun::Differentials(_) => None,
+            MethodRun::Igi(m) => Some(m.igi.neighbour_reach()),
+            MethodRun::DirectOnly | MethodRun::Radiosity(_) => Some(0),
         }
     }
 

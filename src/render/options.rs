@@ -70,6 +70,17 @@ impl PixelBounds {
         }
     }
 
+    /// These bounds grown by `margin` pixels on every side, within a
+    /// `width` x `height` frame.
+    pub fn grown(&self, margin: u32, width: u32, height: u32) -> Self {
+        Self {
+            x0: self.x0.saturating_sub(margin),
+            x1: (self.x1 + margin).min(width),
+            y0: self.y0.saturating_sub(margin),
+            y1: (self.y1 + margin).min(height),
+        }
+    }
+
     /// The rectangle in GL's window coordinates (x, y from the bottom, w, h)
     /// of a frame `height` pixels high.
     pub fn gl_rect(&self, height: u32) -> [i32; 4] {

@@ -329,6 +329,47 @@ impl Scene {
             .iter()
             .any(|s| self.materials[s.material].is_specular())
     }
+
+    /// Whether light can pass straight from one diffuse surface to another:
+    /// false where every diffuse shape is flat and lies in one plane (GLASS
+    /// BALL's and RING's floor), whose points see each other only edge-on.
+    /// Planes are compared to a hundred-thousandth of the scene's size.
+    pub fn has_diffuse_interreflection(&self) -> bool {
+        let tolerance = 1e-5 * self.size();
+        let mut plane: Option<(Vec3, f32)> = None;
+        for s in &self.shapes {
+            if !matches!(self.materials[s.material], Material::Diffuse { .. }) {
+                continue;
+            }
+            let corners = match s.geometry {
+                Geometry::Parallelogram {
+                    corner,
+                    edge1,
+                    edge2,
+                } => vec![
+                    corner,
+                    corner + edge1,
+                    corner + edge2,
+                    corner + edge1 + edge2,
+                ],
+                Geometry::Triangle { v0, v1, v2 } => vec![v0, v1, v2],
+                Geometry::Sphere { .. } | Geometry::Cylinder { .. } => return true,
+            };
+            let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            if normal.length() == 0.0 {
+                // No area: it reflects nothing.
+                continue;
+            }
+            let (n, d) = *plane.get_or_insert_with(|| {
+                let n = normal.normalize();
+                (n, n.dot(corners[0]))
+            });
+            if corners.iter().any(|c| (n.dot(*c) - d).abs() > tolerance) {
+                return true;
+            }
+        }
+        false
+    }
 }
 
 /// Axis-aligned bounds of these shapes (area lights included) and point lights.

@@ -96,6 +96,10 @@ fn bench_igi_splits_each_version_by_component() {
         assert!(parts <= f("seconds") && parts > 0.5 * f("seconds"), "{r}");
         assert!(r["rmse"].is_null());
     }
+    assert_eq!(
+        rows[0]["options"]["interleave"], 1,
+        "canonical IGI: no subsets"
+    );
     assert!(rows[3]["options"]["interleave"] == 3 && rows[3]["options"]["downsample"] == 4);
     assert!(d.join("igi.json").is_file() && d.join("00_igi.png").is_file());
 }

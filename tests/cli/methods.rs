@@ -114,6 +114,22 @@ fn final_gather_and_adaptive_sampling_run_and_refuse_what_they_cannot_do() {
     }
 }
 
+/// On RING, whose one diffuse surface is the floor, a VPL could light
+/// nothing: `--explain` says IGI skips its VPLs, gather and compensation.
+#[test]
+fn igi_says_it_skips_vpls_that_would_light_nothing() {
+    let d = TempDir::new("igi-skip");
+    let err = Run::new(["render", "--quiet", "--explain", "--width", "32"])
+        .args(["--height", "24", "--method", "igi"])
+        .output_to(d.join("x.png"))
+        .scene("ring")
+        .stderr();
+    assert!(
+        err.contains("skip IGI VPLs, gather") && err.contains("skip IGI bias compensation"),
+        "{err}"
+    );
+}
+
 /// IGI as a user runs it: the JSON reports the VPLs, the gather and the
 /// bias compensation; IGI's
 /// switches without `--method igi`, the one-shot estimate's accelerations
@@ -160,13 +176,13 @@ fn igi_runs_and_refuses_what_it_cannot_do() {
         "{compensation}"
     );
     let refused: [(&[&str], &str); 9] = [
-        (&["--interleave", "3"], "--method igi"),
+        (&["--interleave", "2"], "--method igi"),
         (&["--bias-compensation", "8"], "--method igi"),
         (
             &["--method", "igi", "--bias-compensation", "1025"],
             "0..=1024",
         ),
-        (&["--method", "sppm", "--interleave", "3"], "IGI's switches"),
+        (&["--method", "sppm", "--interleave", "2"], "IGI's switches"),
         (&["--method", "igi", "--direct-only"], "--direct-only"),
         (&["--method", "igi", "--adaptive"], "--adaptive"),
         (

@@ -27,11 +27,12 @@ fn render(out: &Path, scene: &str, args: &[&str]) -> Image {
 #[test]
 fn a_crop_holds_the_frames_own_pixels_under_every_method() {
     let d = TempDir::new("crop-methods");
-    let methods: [(&str, &[&str]); 8] = [
+    let methods: [(&str, &[&str]); 9] = [
         ("paper", &[]),
         ("final-gather", &["--final-gather", "8"]),
         ("adaptive", &["--final-gather", "8", "--adaptive"]),
         ("igi", &["--method", "igi"]),
+        ("igi-downsampled", &["--method", "igi", "--downsample", "2"]),
         ("differentials", &["--method", "differentials"]),
         ("radiosity", &["--method", "radiosity"]),
         ("direct", &["--direct-only"]),

@@ -87,6 +87,7 @@ fn compensated_igi_matches_the_path_tracer_where_the_bound_darkens_it() {
             .map(|&seed| {
                 let igi = IgiOptions {
                     vpl_paths: 2048,
+                    interleave: 1,
                     min_distance: Some(0.4),
                     bias_compensation: compensation,
                     ..IgiOptions::default()

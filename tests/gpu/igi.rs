@@ -1,14 +1,17 @@
 //! Instant global illumination: the VPL gather equals its CPU twin on the same
 //! VPLs (exact and imperfect visibility), the discontinuity buffer and the
-//! joint bilateral upsampling equal theirs on the gather's own output, and in
+//! joint bilateral upsampling equal theirs on the gather's own output, in
 //! the furnace, unbounded and with exact visibility, IGI converges to the
-//! analytic answer as the VPL paths grow.
+//! analytic answer as the VPL paths grow, and where no two diffuse surfaces
+//! face each other it traces no VPLs, which would light nothing there.
 
 use crate::common;
 
 use glam::Vec3;
 use photonmap::gpu::Texture;
-use photonmap::render::{render, IgiOptions, Method, RenderOptions, RenderOutput, WithCausticMap};
+use photonmap::render::{
+    render, IgiOptions, Method, RenderOptions, RenderOutput, Vpls, WithCausticMap,
+};
 use photonmap::scene::{Material, Scene};
 use photonmap::twins::igi::{incident, Vpl};
 
@@ -27,10 +30,12 @@ fn mirror_box() -> Scene {
 }
 
 fn vpls(out: &RenderOutput) -> Vec<Vpl> {
-    out.igi_run()
-        .unwrap()
-        .vpls
-        .read()
+    twin_vpls(&out.igi_run().unwrap().vpls)
+}
+
+/// The GPU's VPLs as the twin takes them.
+fn twin_vpls(vpls: &Vpls) -> Vec<Vpl> {
+    vpls.read()
         .into_iter()
         .map(|(p, n, i)| Vpl {
             position: Vec3::from(p),
@@ -92,6 +97,7 @@ fn the_vpl_gather_equals_its_cpu_twin() {
         let igi = IgiOptions {
             vpl_paths: 48,
             imperfect_visibility: imperfect,
+            interleave: 1,
             ..IgiOptions::default()
         };
         let m = igi.min_distance_for(&scene);
@@ -290,6 +296,7 @@ fn igi_in_the_furnace_converges_to_the_analytic_answer() {
         let igi = IgiOptions {
             vpl_paths: paths,
             min_distance: Some(0.0),
+            interleave: 1,
             ..IgiOptions::default()
         };
         let out = render(&gpu, &scene, &options(&scene, 16, 16, 1, igi), &mut ()).unwrap();
@@ -328,6 +335,7 @@ fn igi_converges_to_the_path_tracer_as_vpls_grow() {
                 let igi = IgiOptions {
                     vpl_paths: paths,
                     min_distance: Some(0.0),
+                    interleave: 1,
                     ..IgiOptions::default()
                 };
                 let mut o = options(&scene, 32, 32, seed, igi);
@@ -383,6 +391,7 @@ fn igi_lights_a_ceiling_from_the_floor_it_faces_as_the_path_tracer_does() {
             let igi = IgiOptions {
                 vpl_paths: 2048,
                 min_distance: Some(0.0),
+                interleave: 1,
                 ..IgiOptions::default()
             };
             let mut o = options(&scene, w, h, seed, igi);
@@ -405,4 +414,57 @@ fn igi_lights_a_ceiling_from_the_floor_it_faces_as_the_path_tracer_does() {
         (igi - pt_mean).abs() < 3.0 * sigma + 0.02 * pt_mean,
         "IGI {igi} against {pt_mean}"
     );
+}
+
+/// Where every diffuse surface lies in one plane (GLASS BALL's floor under
+/// the glass ball), VPLs light nothing: traced there anyway, the CPU twin's
+/// gather of them is zero at every first hit of the render. So IGI traces
+/// none and compensates nothing there, and its image is the caustic map's
+/// (with the direct light) alone.
+#[test]
+fn igi_skips_vpls_where_no_two_diffuse_surfaces_face() {
+    use photonmap::render::Timings;
+    use photonmap::scene::pack::SceneTextures;
+    let gpu = common::gpu();
+    let scene = common::paper_scene("glass_ball");
+    assert!(!scene.has_diffuse_interreflection());
+    let igi = IgiOptions::default();
+    let m = igi.min_distance_for(&scene);
+    let out = render(&gpu, &scene, &options(&scene, 32, 24, 3, igi), &mut ()).unwrap();
+    let run = out.igi_run().unwrap();
+    assert!(run.report.skipped && run.vpls.count == 0 && run.stats.is_empty());
+    assert!(run.compensation.is_none());
+    assert!(
+        out.image.mean()[0] > 0.0,
+        "direct light and caustics remain"
+    );
+
+    let textures = SceneTextures::new(&gpu, &scene).unwrap();
+    let traced = Vpls::trace(
+        &gpu,
+        &scene,
+        &textures,
+        (256, 32),
+        7,
+        &mut Timings::default(),
+    )
+    .unwrap();
+    let v = twin_vpls(&traced);
+    assert!(
+        v.len() >= 64,
+        "a quarter of the paths reach the floor: {}",
+        v.len()
+    );
+    let pos = common::texels(&out.state.direct.diffuse_position);
+    let nor = common::texels(&out.state.direct.diffuse_normal);
+    let hits = pos.iter().filter(|p| p[3] > 0.0).count();
+    assert!(hits * 2 > pos.len(), "most pixels see the floor: {hits}");
+    let lit = (0..pos.len())
+        .filter(|&i| twin_incident(&scene, &v, (&pos, &nor), i, m, false).max_element() > 0.0)
+        .count();
+    eprintln!(
+        "GLASS BALL: {} VPLs traced anyway light {lit} of {hits} first hits",
+        v.len()
+    );
+    assert_eq!(lit, 0);
 }

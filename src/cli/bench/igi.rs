@@ -72,9 +72,11 @@ pub struct IgiBench {
 
 /// The rows: the paper's four cumulative versions, then its remedies.
 fn rows(paths: u32) -> Vec<(&'static str, IgiOptions)> {
-    // The paper's versions: without the bias compensation added to the default.
+    // The paper's versions: without the interleaving and the bias
+    // compensation of the default.
     let base = IgiOptions {
         vpl_paths: paths,
+        interleave: 1,
         bias_compensation: 0,
         ..IgiOptions::default()
     };

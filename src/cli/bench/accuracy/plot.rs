@@ -46,6 +46,7 @@ pub fn csv(r: &AccuracyReport) -> String {
             RunMethod::Igi(o) => o.clone(),
             _ => IgiOptions {
                 vpl_paths: 0,
+                interleave: 1,
                 ..IgiOptions::default()
             },
         };

@@ -7,7 +7,7 @@ use glam::Vec3;
 use super::errors::load;
 use super::{good, paper_scene, root};
 use crate::scene::defaults::*;
-use crate::scene::{Geometry, Light, Material, RenderParams, Scene};
+use crate::scene::{Geometry, Light, Material, RenderParams, Scene, Shape};
 
 #[test]
 fn the_paper_scenes_match_the_pinned_numbers() {
@@ -135,4 +135,58 @@ fn absent_parameters_take_the_defaults_that_with_shapes_and_the_readme_use() {
     ] {
         assert!(line(key).contains(&says), "README: {:?} should say {says:?}", line(key));
     }
+}
+
+/// IGI skips its VPLs where no two diffuse surfaces face each other: GLASS
+/// BALL and RING (a diffuse floor under glass or metal), not the boxes; a
+/// plane's two sides and a shape off it by a hair are told apart.
+#[test]
+fn diffuse_interreflection_is_found_where_two_diffuse_surfaces_face() {
+    for (name, expected) in [
+        ("cornell_box", true),
+        ("cornell_box_obj", true),
+        ("glass_ball", false),
+        ("ring", false),
+    ] {
+        assert_eq!(
+            paper_scene(name).has_diffuse_interreflection(),
+            expected,
+            "{name}"
+        );
+    }
+    let white = Material::Diffuse {
+        albedo: Vec3::splat(0.5),
+    };
+    let mirror = Material::Mirror {
+        reflectance: Vec3::ONE,
+    };
+    let quad = |corner: Vec3, edge1: Vec3, edge2: Vec3, material: usize| {
+        Shape::new(
+            Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            },
+            material,
+        )
+    };
+    let scene = |shapes: Vec<Shape>| Scene::with_shapes(shapes, vec![white, mirror], vec![]);
+    // The floor's two sides, and a mirror standing on it.
+    let floor = quad(Vec3::ZERO, Vec3::X, Vec3::Z, 0);
+    let under = quad(Vec3::new(2.0, 0.0, 0.0), Vec3::Z, Vec3::X, 0);
+    let wall = |material| quad(Vec3::ZERO, Vec3::X, Vec3::Y, material);
+    assert!(!scene(vec![floor, under, wall(1)]).has_diffuse_interreflection());
+    assert!(scene(vec![floor, wall(0)]).has_diffuse_interreflection());
+    // A second floor a thousandth of the scene's size higher is another
+    // plane: its underside faces the first floor's light.
+    let raised = quad(Vec3::new(2.0, 0.003, 0.0), Vec3::X, Vec3::Z, 0);
+    assert!(scene(vec![floor, raised]).has_diffuse_interreflection());
+    let ball = Shape::new(
+        Geometry::Sphere {
+            center: Vec3::Y,
+            radius: 0.5,
+        },
+        0,
+    );
+    assert!(scene(vec![floor, ball]).has_diffuse_interreflection());
 }
