@@ -153,47 +153,48 @@ impl RenderOutput {
                 ),
             ));
         }
-        let vpls_skipped = self.vpls().is_some_and(|v| v.skipped);
-        if let (Method::Igi(_), true) = (&options.method, vpls_skipped) {
-            lines.push(line(
+        match (&options.method, self.vpls()) {
+            (Method::Igi(_), Some(v)) if v.skipped => lines.push(line(
                 "IGI VPLs, gather",
                 0,
                 false,
                 "skipped: every diffuse surface lies in one plane, whose points see each other only edge-on, so a VPL could light nothing; the image is direct light and the caustic map".into(),
-            ));
-        } else if let (Method::Igi(o), Some(v)) = (&options.method, self.vpls()) {
-            let o = &o.method;
-            let passes: u32 = self.igi().iter().map(|s| s.passes).sum();
-            lines.push(line(
-                "IGI VPLs",
-                0,
-                true,
-                format!(
-                    "{} VPLs at the diffuse hits of {} Halton light paths (traced by the photon passes, compacted by the HistoPyramid); VPLs reach the first hit only straight from a diffuse surface, so {}",
-                    v.vpls, v.paths, caustic_map(o.caustic_paths)
-                ),
-            ));
-            lines.push(line(
-                "IGI gather",
-                passes as usize,
-                true,
-                format!(
-                    "every shading point sums {} with the geometry term bounded at {} and a shadow ray each ({}), {} VPLs a pass; {}",
-                    if o.interleave > 1 {
-                        format!("1 of {} VPL subsets (interleaved sampling, merged by the discontinuity buffer)", o.interleave * o.interleave)
-                    } else {
-                        "every VPL".to_string()
-                    },
-                    v.min_distance,
-                    if o.imperfect_visibility { "against primitive bounding boxes: imperfect visibility" } else { "exact visibility" },
-                    crate::layout::VPL_BATCH,
-                    if o.downsample > 1 {
-                        format!("shading points at one pixel per {0} x {0} block, joint-bilateral upsampled", o.downsample)
-                    } else {
-                        "at every pixel".to_string()
-                    }
-                ),
-            ));
+            )),
+            (Method::Igi(o), Some(v)) => {
+                let o = &o.method;
+                let passes: u32 = self.igi().iter().map(|s| s.passes).sum();
+                lines.push(line(
+                    "IGI VPLs",
+                    0,
+                    true,
+                    format!(
+                        "{} VPLs at the diffuse hits of {} Halton light paths (traced by the photon passes, compacted by the HistoPyramid); VPLs reach the first hit only straight from a diffuse surface, so {}",
+                        v.vpls, v.paths, caustic_map(o.caustic_paths)
+                    ),
+                ));
+                lines.push(line(
+                    "IGI gather",
+                    passes as usize,
+                    true,
+                    format!(
+                        "every shading point sums {} with the geometry term bounded at {} and a shadow ray each ({}), {} VPLs a pass; {}",
+                        if o.interleave > 1 {
+                            format!("1 of {} VPL subsets (interleaved sampling, merged by the discontinuity buffer)", o.interleave * o.interleave)
+                        } else {
+                            "every VPL".to_string()
+                        },
+                        v.min_distance,
+                        if o.imperfect_visibility { "against primitive bounding boxes: imperfect visibility" } else { "exact visibility" },
+                        crate::layout::VPL_BATCH,
+                        if o.downsample > 1 {
+                            format!("shading points at one pixel per {0} x {0} block, joint-bilateral upsampled", o.downsample)
+                        } else {
+                            "at every pixel".to_string()
+                        }
+                    ),
+                ));
+            }
+            _ => {}
         }
         if let (Method::Igi(o), Some(run)) = (&options.method, self.igi_run()) {
             let m = o.method.min_distance_for(scene);

@@ -247,19 +247,6 @@ impl Vpls {
         })
     }
 
-    /// No VPLs, for a scene where none could light anything.
-    pub fn none(gpu: &Gpu) -> Result<Self> {
-        let texture = || Texture::new(gpu, 1, 1, TexFormat::Rgba32F);
-        Ok(Self {
-            position: texture()?,
-            normal: texture()?,
-            intensity: texture()?,
-            count: 0,
-            paths: 0,
-            frames_traced: 0,
-        })
-    }
-
     /// Every VPL read back: (position, normal, intensity) (for tests).
     pub fn read(&self) -> Vec<([f32; 3], [f32; 3], [f32; 3])> {
         let (p, n, i) = (
@@ -503,12 +490,18 @@ fn primitive_boxes(gpu: &Gpu, scene: &Scene) -> Result<Texture> {
     Texture::from_texels(gpu, PRIMITIVE_BOX_ROW, height, TexFormat::Rgba32F, &data)
 }
 
+/// The VPLs and the gather's textures and programs.
+pub struct VplGather {
+    pub vpls: Vpls,
+    pub igi: Igi,
+}
+
 /// IGI through a render: the caustic map, the VPLs, the gather's textures
 /// and each eye sample's gather.
 pub struct IgiRun {
     pub caustics: Option<MapEstimate>,
-    pub vpls: Vpls,
-    pub igi: Igi,
+    /// None where a VPL could light nothing (`VplReport::skipped`).
+    pub gather: Option<VplGather>,
     pub report: VplReport,
     pub stats: Vec<IgiStats>,
     /// The light the bound leaves out, where compensated.
@@ -527,22 +520,26 @@ impl IgiRun {
     ) -> Result<Self> {
         let (o, scene) = (&with.method, p.scene);
         let caustics = MapEstimate::caustics(p, with, o.caustic_map(), timings, observer)?;
-        let igi = Igi::new(p.gpu, scene, p.width, p.height, o)?;
         observer.progress(&Progress::stage("VPLs", 0, 1));
         let interreflects = scene.has_diffuse_interreflection();
-        let vpls = if interreflects {
+        let gather = if interreflects {
             let vpl_seed = crate::random::pcg_hash(p.seed ^ crate::layout::VPL_STREAM);
             let bounds = (o.vpl_paths, o.vpl_bounces);
-            Vpls::trace(p.gpu, scene, p.textures, bounds, vpl_seed, timings)?
+            Some(VplGather {
+                vpls: Vpls::trace(p.gpu, scene, p.textures, bounds, vpl_seed, timings)?,
+                igi: Igi::new(p.gpu, scene, p.width, p.height, o)?,
+            })
         } else {
-            Vpls::none(p.gpu)?
+            o.check()?;
+            None
         };
+        let vpls = gather.as_ref().map(|g| &g.vpls);
         let report = VplReport {
-            paths: vpls.paths,
-            vpls: vpls.count,
-            frames_traced: vpls.frames_traced,
+            paths: vpls.map_or(0, |v| v.paths),
+            vpls: vpls.map_or(0, |v| v.count),
+            frames_traced: vpls.map_or(0, |v| v.frames_traced),
             min_distance: o.min_distance_for(scene),
-            skipped: !interreflects,
+            skipped: gather.is_none(),
         };
         // Its gather rays would meet no diffuse surface either.
         let compensation = if interreflects {
@@ -559,8 +556,7 @@ impl IgiRun {
         };
         Ok(Self {
             caustics,
-            vpls,
-            igi,
+            gather,
             report,
             stats: Vec::new(),
             compensation,
@@ -578,14 +574,14 @@ impl FrameMethod for IgiRun {
         observer: &mut dyn RenderObserver,
     ) -> Result<Image> {
         let mut image = MapEstimate::image_or_direct(self.caustics.as_mut(), f, timings, observer)?;
-        if self.report.skipped {
+        let Some(VplGather { vpls, igi }) = &self.gather else {
             return Ok(image);
-        }
+        };
         let at = f.at;
-        let stats = self.igi.run(
+        let stats = igi.run(
             f.textures,
             f.direct,
-            &self.vpls,
+            vpls,
             f.camera_position,
             timings,
             &mut |done, total| {
@@ -593,7 +589,7 @@ impl FrameMethod for IgiRun {
             },
         )?;
         self.stats.push(stats);
-        image.add(&self.igi.read_indirect());
+        image.add(&igi.read_indirect());
         if let Some(c) = &mut self.compensation {
             image.add(&c.sample(f, timings, observer)?);
         }

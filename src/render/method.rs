@@ -85,7 +85,7 @@ impl MethodRun {
             // differ at a crop's pixels when the others are not drawn.
             MethodRun::PhotonMap(m) => m.pyramid.is_none().then_some(0),
             MethodRun::Differentials(_) => None,
-            MethodRun::Igi(m) => Some(m.igi.neighbour_reach()),
+            MethodRun::Igi(m) => Some(m.gather.as_ref().map_or(0, |g| g.igi.neighbour_reach())),
             MethodRun::DirectOnly | MethodRun::Radiosity(_) => Some(0),
         }
     }

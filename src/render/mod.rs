@@ -40,7 +40,7 @@ pub use explain::ExplainLine;
 pub use eye_paths::{trace_eye_paths, EyeSample};
 pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
 pub use frame::{render, render_views};
-pub use igi::{Igi, IgiOptions, IgiRun, IgiStats, VplReport, Vpls};
+pub use igi::{Igi, IgiOptions, IgiRun, IgiStats, VplGather, VplReport, Vpls};
 pub use method::MethodRun;
 pub use observer::{At, EstimatePass, Progress, RenderObserver, StopReason};
 pub use options::{Method, PixelBounds, RenderOptions};

@@ -94,6 +94,25 @@ pub enum Geometry {
 }
 
 impl Geometry {
+    /// A flat shape's corners (a triangle's last one twice, so that every
+    /// flat shape has four); None for a sphere or cylinder.
+    pub fn flat_corners(&self) -> Option<[Vec3; 4]> {
+        match *self {
+            Geometry::Parallelogram {
+                corner,
+                edge1,
+                edge2,
+            } => Some([
+                corner,
+                corner + edge1,
+                corner + edge2,
+                corner + edge1 + edge2,
+            ]),
+            Geometry::Triangle { v0, v1, v2 } => Some([v0, v1, v2, v2]),
+            Geometry::Sphere { .. } | Geometry::Cylinder { .. } => None,
+        }
+    }
+
     /// The shape scaled by `scale` and moved: `point` maps its points (the
     /// caller's scaling and move, in whatever precision it likes), and its
     /// lengths scale by `scale`; directions stay.
@@ -341,19 +360,8 @@ impl Scene {
             if !matches!(self.materials[s.material], Material::Diffuse { .. }) {
                 continue;
             }
-            let corners = match s.geometry {
-                Geometry::Parallelogram {
-                    corner,
-                    edge1,
-                    edge2,
-                } => vec![
-                    corner,
-                    corner + edge1,
-                    corner + edge2,
-                    corner + edge1 + edge2,
-                ],
-                Geometry::Triangle { v0, v1, v2 } => vec![v0, v1, v2],
-                Geometry::Sphere { .. } | Geometry::Cylinder { .. } => return true,
+            let Some(corners) = s.geometry.flat_corners() else {
+                return true;
             };
             let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
             if normal.length() == 0.0 {
@@ -397,24 +405,10 @@ fn bounds_of(shapes: &[Shape], lights: &[Light]) -> (Vec3, Vec3) {
                     add(end + Vec3::splat(radius));
                 }
             }
-            Geometry::Parallelogram {
-                corner,
-                edge1,
-                edge2,
-            } => {
-                for p in [
-                    corner,
-                    corner + edge1,
-                    corner + edge2,
-                    corner + edge1 + edge2,
-                ] {
+            Geometry::Parallelogram { .. } | Geometry::Triangle { .. } => {
+                for p in s.geometry.flat_corners().into_iter().flatten() {
                     add(p);
                 }
-            }
-            Geometry::Triangle { v0, v1, v2 } => {
-                add(v0);
-                add(v1);
-                add(v2);
             }
         }
     }

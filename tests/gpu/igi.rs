@@ -10,7 +10,7 @@ use crate::common;
 use glam::Vec3;
 use photonmap::gpu::Texture;
 use photonmap::render::{
-    render, IgiOptions, Method, RenderOptions, RenderOutput, Vpls, WithCausticMap,
+    render, IgiOptions, Method, RenderOptions, RenderOutput, VplGather, Vpls, WithCausticMap,
 };
 use photonmap::scene::{Material, Scene};
 use photonmap::twins::igi::{incident, Vpl};
@@ -29,8 +29,13 @@ fn mirror_box() -> Scene {
     common::fixture("mirror_box")
 }
 
+/// The VPLs and gather of an IGI render that traced them.
+fn gather(out: &RenderOutput) -> &VplGather {
+    out.igi_run().unwrap().gather.as_ref().unwrap()
+}
+
 fn vpls(out: &RenderOutput) -> Vec<Vpl> {
-    twin_vpls(&out.igi_run().unwrap().vpls)
+    twin_vpls(&gather(out).vpls)
 }
 
 /// The GPU's VPLs as the twin takes them.
@@ -105,7 +110,7 @@ fn the_vpl_gather_equals_its_cpu_twin() {
         let v = vpls(&out);
         let pos = common::texels(&out.state.direct.diffuse_position);
         let nor = common::texels(&out.state.direct.diffuse_normal);
-        let got = rgb_texels(&out.igi_run().unwrap().igi.incident);
+        let got = rgb_texels(&gather(&out).igi.incident);
         let twin: Vec<Vec3> = (0..pos.len())
             .map(|i| twin_incident(&scene, &v, (&pos, &nor), i, m, imperfect))
             .collect();
@@ -145,7 +150,7 @@ fn interleaving_and_upsampling_equal_their_cpu_twins() {
     let m = igi.min_distance_for(&scene);
     let out = render(&gpu, &scene, &options(&scene, w, h, 4, igi), &mut ()).unwrap();
     let v = vpls(&out);
-    let state = &out.igi_run().unwrap().igi;
+    let state = &gather(&out).igi;
     let pos = common::texels(&out.state.direct.diffuse_position);
     let nor = common::texels(&out.state.direct.diffuse_normal);
     let thr = common::texels(&out.state.direct.diffuse_throughput);
@@ -432,7 +437,7 @@ fn igi_skips_vpls_where_no_two_diffuse_surfaces_face() {
     let m = igi.min_distance_for(&scene);
     let out = render(&gpu, &scene, &options(&scene, 32, 24, 3, igi), &mut ()).unwrap();
     let run = out.igi_run().unwrap();
-    assert!(run.report.skipped && run.vpls.count == 0 && run.stats.is_empty());
+    assert!(run.report.skipped && run.gather.is_none() && run.stats.is_empty());
     assert!(run.compensation.is_none());
     assert!(
         out.image.mean()[0] > 0.0,
