@@ -1,8 +1,15 @@
 // A photon's footprint (Fabianowski and Dingliana 2009, section 4): the
-// skewed ellipsoid x = p + alpha a + beta b + gamma c, alpha^2 + beta^2 +
-// gamma^2 <= 1, whose semi-axes a and b lie on the surface the photon hit
-// (a x b facing the side it came from) and c along the normal,
-// FOOTPRINT_THICKNESS of the longer of a and b. Its records, in Morton order
+// ellipse p + alpha a + beta b, alpha^2 + beta^2 <= 1, whose semi-axes a and
+// b lie on the surface the photon hit (a x b facing the side it came from),
+// with depth along the normal: the paper's skewed ellipsoid, alpha^2 +
+// beta^2 + gamma^2 <= 1 for x = p + alpha a + beta b + gamma c, c along the
+// normal and FOOTPRINT_THICKNESS of the longer of a and b; or, by default,
+// the curved footprint, which holds x where its projection lies in the
+// ellipse and x lies as near the plane as a curved surface through p would
+// (footprint_distance2). On a ball the ellipsoid, thinning to nothing at its
+// rim, lets the rim's points out, and the power they should have had (the
+// kernel is normalised over the whole ellipse) is lost.
+// Its records, in Morton order
 // (footprint i at texel (i mod width, i / width) of textures of that width):
 //   footprint 0: centre p, w = area of the ellipse, pi |a x b|;
 //   footprint 1: a, w = 1 if the photon had been reflected diffusely;
@@ -19,17 +26,36 @@ vec3 footprint_normal_axis(vec3 a, vec3 b, float thickness) {
     return normalize(cross(a, b)) * thickness;
 }
 
-// Half the extent of the ellipsoid along each world axis.
-vec3 footprint_half_extent(vec3 a, vec3 b, vec3 c) {
-    return sqrt(a * a + b * b + c * c);
+// Half the extent of the footprint along each world axis: the ellipsoid's,
+// sqrt(a_i^2 + b_i^2 + c_i^2); the curved footprint's, the ellipse's
+// sqrt(a_i^2 + b_i^2) plus its deepest reach along the normal (below).
+vec3 footprint_half_extent(vec3 a, vec3 b, vec3 c, bool curved) {
+    if (!curved) return sqrt(a * a + b * b + c * c);
+    float tilted = sqrt((1.0 - COVERAGE_NORMAL_COS) / (1.0 + COVERAGE_NORMAL_COS));
+    float depth = length(c) + tilted * sqrt(dot(a, a) + dot(b, b));
+    return sqrt(a * a + b * b) + abs(normalize(c)) * depth;
 }
 
-// The query point's ellipsoid coordinates squared (alpha^2 + beta^2 +
-// gamma^2): <= 1 inside.
-float footprint_distance2(vec3 x, vec3 p, vec3 a, vec3 b, vec3 c) {
+// The squared distance in the footprint of query point x (unit normal nq):
+// alpha^2 + beta^2 + gamma^2 for the ellipsoid; for the curved footprint
+// alpha^2 + beta^2 of x's projection onto the ellipse's plane, where nq
+// tilts from the footprint's normal n by an angle phi of cosine at least
+// COVERAGE_NORMAL_COS and x lies no farther from the plane than |c| +
+// rho tan(phi / 2), rho its distance from p along the plane: a point of
+// any surface through p tangent to the plane, of curvature radius R >= rho,
+// lies at most there (a sphere's exactly: rho = R sin phi, depth
+// R (1 - cos phi)), while the other wall at a corner, tilted by a right
+// angle, does not count. Above 1 outside either.
+float footprint_distance2(vec3 x, vec3 nq, vec3 p, vec3 a, vec3 b, vec3 c, bool curved) {
     vec3 e = x - p;
     vec3 bc = cross(b, c), ca = cross(c, a), ab = cross(a, b);
     float det = dot(a, bc);
     vec3 u = vec3(dot(bc, e), dot(ca, e), dot(ab, e)) / det;
-    return dot(u, u);
+    if (!curved) return dot(u, u);
+    float thickness = length(c);
+    float cos_phi = dot(c, nq) / thickness;
+    if (!(cos_phi >= COVERAGE_NORMAL_COS)) return 2.0;
+    float tan_half = sqrt(max(0.0, 1.0 - cos_phi * cos_phi)) / (1.0 + cos_phi);
+    float rho = length(u.x * a + u.y * b);
+    return abs(u.z) * thickness <= thickness + rho * tan_half ? dot(u.xy, u.xy) : 2.0;
 }

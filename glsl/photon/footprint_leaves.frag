@@ -1,7 +1,7 @@
 #version 450 core
 // The footprint BVH's leaves: leaf j (node u_leaves + j of the implicit
 // tree: root 1, children 2i and 2i + 1) holds footprints [j T, (j + 1) T) of
-// the Morton order, and its box bounds their ellipsoids. A leaf with none
+// the Morton order, and its box bounds their footprints. A leaf with none
 // (past the count, or all degenerate) gets an empty box, which holds no point.
 #include "common/footprint.glsl"
 
@@ -13,6 +13,7 @@ uniform int u_count;
 uniform int u_leaves;     // P: leaves (a power of two)
 uniform int u_leaf_size;  // T
 uniform int u_box_width;
+uniform int u_curved;     // 1: the curved footprint, 0: the paper's ellipsoid
 
 layout(location = 0) out vec4 o_min;
 layout(location = 1) out vec4 o_max;
@@ -29,7 +30,7 @@ void main() {
         if (f0.w <= 0.0) continue;
         vec3 a = texelFetch(u_footprint1, t, 0).xyz;
         vec4 f2 = texelFetch(u_footprint2, t, 0);
-        vec3 e = footprint_half_extent(a, f2.xyz, footprint_normal_axis(a, f2.xyz, f2.w));
+        vec3 e = footprint_half_extent(a, f2.xyz, footprint_normal_axis(a, f2.xyz, f2.w), u_curved != 0);
         lo = min(lo, f0.xyz - e);
         hi = max(hi, f0.xyz + e);
     }

@@ -10,7 +10,8 @@
 // only its own texel, a texture barrier between passes) and finished pixels
 // discard, so an occlusion query counts the pixels still walking.
 // Kernels: constant, 1 / A; Epanechnikov, 2 (1 - u^2) / A (u^2 the
-// ellipsoid coordinates squared), both integrating to 1 over the ellipse.
+// footprint coordinates squared, common/footprint.glsl), both integrating
+// to 1 over the ellipse.
 // A footprint counts only where x's normal faces the side its photon came from.
 #include "common/footprint.glsl"
 
@@ -32,6 +33,7 @@ uniform int u_leaves;
 uniform int u_leaf_size;
 uniform int u_budget;
 uniform int u_epanechnikov;
+uniform int u_curved;                 // 1: the curved footprint, 0: the paper's ellipsoid
 
 layout(location = 0) out vec4 o_sum;
 layout(location = 1) out ivec4 o_walk;
@@ -68,7 +70,7 @@ void main() {
                 vec4 f2 = texelFetch(u_footprint2, f, 0);
                 vec3 c = footprint_normal_axis(a, f2.xyz, f2.w);
                 if (dot(c, nq) <= 0.0) continue;
-                float u2 = footprint_distance2(x, f0.xyz, a, f2.xyz, c);
+                float u2 = footprint_distance2(x, nq, f0.xyz, a, f2.xyz, c, u_curved != 0);
                 if (!(u2 <= 1.0)) continue;
                 float kernel = u_epanechnikov != 0 ? 2.0 * (1.0 - u2) : 1.0;
                 sum.rgb += texelFetch(u_footprint3, f, 0).rgb * (kernel / f0.w);

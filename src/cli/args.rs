@@ -5,6 +5,7 @@ use clap::Args;
 use photonmap::scene::import::ImportOptions;
 
 use photonmap::photon::build::MAX_HASH_BUCKETS;
+use photonmap::photon::differentials::FootprintShape;
 use photonmap::photon::{BuildMethod, GridKind, PhotonConfig, VertexFeed};
 use photonmap::render::differentials::{COVERAGE_SAMPLES, MAX_BOUNCES as DIFFERENTIALS_BOUNCES};
 use photonmap::render::radiance_estimate::LeakTest;
@@ -382,6 +383,14 @@ pub struct DifferentialsArgs {
     #[arg(long, value_name = "N", default_value_t = COVERAGE_SAMPLES,
           value_parser = in_range(0, 256))]
     pub footprint_coverage: u32,
+    /// Differentials: which query points a footprint holds. curved: those
+    /// whose projection lies in its ellipse and which lie as near its plane
+    /// as a surface curving to their normal would, so that a curved surface
+    /// (a ball) stays in it; ellipsoid: the paper's thin ellipsoid, which
+    /// lets a curved surface's points near its rim out and loses their
+    /// light.
+    #[arg(long, value_enum, default_value_t = FootprintShape::Curved)]
+    pub footprint_shape: FootprintShape,
     /// Differentials: photons stored by a second trace aimed at mirrors and
     /// glass by projection maps, whose footprints carry the caustics (light
     /// from an emitter through mirrors or glass onto a diffuse surface)
@@ -537,6 +546,7 @@ impl DifferentialsArgs {
             || self.leaf_size != AutoOr::Auto
             || self.kernel != Kernel::Constant
             || self.footprint_coverage != COVERAGE_SAMPLES
+            || self.footprint_shape != FootprintShape::Curved
             || self.caustic_photons != AutoOr::Auto
             || self.footprint_bounces != DIFFERENTIALS_BOUNCES
     }
@@ -551,6 +561,7 @@ impl From<&DifferentialsArgs> for DifferentialsOptions {
             leaf_size: a.leaf_size.value(),
             kernel: a.kernel,
             coverage_samples: a.footprint_coverage,
+            footprint_shape: a.footprint_shape,
             caustic_photons: a.caustic_photons.value(),
             max_bounces: a.footprint_bounces,
         }

@@ -136,6 +136,29 @@ pub fn trace_differentials(
     Ok(out)
 }
 
+/// Which query points a footprint holds (glsl/common/footprint.glsl).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FootprintShape {
+    /// The ellipse on the surface, holding a query point whose projection
+    /// lies in it and which lies as near the ellipse's plane as a surface
+    /// through its centre, curving to the query's normal (tilted by up to
+    /// 60 degrees), would: a ball's points stay in it, the other wall at a
+    /// corner does not.
+    #[default]
+    Curved,
+    /// The paper's thin ellipsoid, which on a curved surface lets the points
+    /// near its rim out and loses their share of the power.
+    Ellipsoid,
+}
+
+impl FootprintShape {
+    /// The shaders' `u_curved`.
+    pub fn curved(self) -> bool {
+        self == FootprintShape::Curved
+    }
+}
+
 /// How footprints are made from differentials.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FootprintOptions {
@@ -155,6 +178,8 @@ pub struct FootprintOptions {
     /// caustic footprint map of photons aimed by projection maps carries
     /// that light instead.
     pub drop_caustics: bool,
+    /// Which query points a footprint holds.
+    pub shape: FootprintShape,
 }
 
 /// The footprints in Morton order and their BVH.
@@ -386,7 +411,7 @@ impl FootprintBuilder {
 
         let clock = StageClock::start(gpu, &query);
         let (box_min, box_max, box_width, leaves, passes) =
-            self.boxes(&footprints, w, count, leaf_size)?;
+            self.boxes(&footprints, w, count, leaf_size, options.shape)?;
         clock.stop(timings, "footprint BVH", passes);
         gpu.check("footprint BVH")?;
         Ok(FootprintMap {
@@ -421,6 +446,7 @@ impl FootprintBuilder {
         w: u32,
         count: u32,
         leaf_size: u32,
+        shape: FootprintShape,
     ) -> Result<(Texture, Texture, u32, u32, usize)> {
         let gpu = &self.gpu;
         let leaves = count.div_ceil(leaf_size).next_power_of_two();
@@ -438,6 +464,7 @@ impl FootprintBuilder {
             .int("u_leaves", leaves as i32)
             .int("u_leaf_size", leaf_size as i32)
             .int("u_box_width", box_width as i32)
+            .int("u_curved", i32::from(shape.curved()))
             .draw_region(&target, &DrawState::PLAIN, level_region(leaves, box_width))?;
         drop(b);
         let mut passes = 1;

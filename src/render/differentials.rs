@@ -30,6 +30,7 @@ use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Text
 use crate::layout::FOOTPRINT_BUDGET;
 use crate::photon::differentials::{
     trace_differentials, DifferentialFrames, FootprintBuilder, FootprintMap, FootprintOptions,
+    FootprintShape,
 };
 use crate::photon::{PhotonFrames, PhotonTracer, TraceReport};
 use crate::scene::defaults::MAX_PHOTONS_STORED;
@@ -67,6 +68,9 @@ pub struct DifferentialsOptions {
     /// Probes a footprint for its share on its own surface, so one that
     /// overhangs an edge keeps its power (0: the whole ellipse counts).
     pub coverage_samples: u32,
+    /// Which query points a footprint holds: by default it follows a curved
+    /// surface; the paper's ellipsoid loses light on one.
+    pub footprint_shape: FootprintShape,
     /// Photons stored by a second trace aimed at mirrors and glass by
     /// projection maps, whose footprints carry the caustics (L S+ D) in place
     /// of the few the scene's own photons bring; 0: the paper's one map.
@@ -95,6 +99,7 @@ impl Default for DifferentialsOptions {
             leaf_size: None,
             kernel: Kernel::Constant,
             coverage_samples: COVERAGE_SAMPLES,
+            footprint_shape: FootprintShape::Curved,
             caustic_photons: None,
             max_bounces: MAX_BOUNCES,
         }
@@ -181,6 +186,7 @@ impl DifferentialsOptions {
             coverage_samples: self.coverage_samples,
             coverage_epanechnikov: self.kernel == Kernel::Epanechnikov,
             drop_caustics: false,
+            shape: self.footprint_shape,
         }
     }
 }
@@ -337,7 +343,8 @@ impl FootprintEstimate {
                 .int(
                     "u_epanechnikov",
                     i32::from(self.kernel == Kernel::Epanechnikov),
-                );
+                )
+                .int("u_curved", i32::from(map.options.shape.curved()));
             hits.around(|| b.draw_fullscreen(&self.state_target, &DrawState::PLAIN))?;
             drop(b);
             // The fragments drawn are the pixels that were still walking.
@@ -436,6 +443,7 @@ pub struct DifferentialsReport {
     pub leaves: u32,
     /// Coverage probes a footprint (0: the whole ellipse counts).
     pub coverage_samples: u32,
+    pub footprint_shape: FootprintShape,
     pub total_footprint_area: f64,
     pub surface_area: f64,
     pub delta: f32,
@@ -645,6 +653,7 @@ impl DifferentialsRun {
             auto_leaf_size: m.auto_leaf_size,
             leaves: m.leaves,
             coverage_samples: m.options.coverage_samples,
+            footprint_shape: m.options.shape,
             total_footprint_area: m.total_area,
             surface_area: m.surface_area,
             delta: m.delta,

@@ -1,6 +1,7 @@
 //! `--explain`: every pass a render ran or skipped, and why, written after the
 //! render from its plan and the stages' reports.
 
+use crate::photon::differentials::FootprintShape;
 use crate::scene::Scene;
 
 use super::adaptive;
@@ -289,7 +290,7 @@ impl RenderOutput {
                 d.frames_traced as usize,
                 true,
                 format!(
-                    "{} photons of up to {} bounces traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {}), semi-axes at most {}; {}",
+                    "{} photons of up to {} bounces traced to the scene's stored count, each record given two positional and two directional differentials (one pass a frame); {} footprints ({} after a diffuse bounce: {}; {}), semi-axes at most {}; {}; {}",
                     d.trace.photons_used,
                     o.max_bounces,
                     d.footprints,
@@ -307,6 +308,10 @@ impl RenderOutput {
                     match d.coverage_samples {
                         0 => "each footprint's whole ellipse counts, so the part overhanging an edge, a corner or an occluder is lost".to_string(),
                         n => format!("each footprint's area is its share on its own surface, found by {n} probes, so one overhanging an edge, a corner or an occluder keeps its power"),
+                    },
+                    match d.footprint_shape {
+                        FootprintShape::Curved => "a footprint holds the points whose projection lies in its ellipse and which lie as near its plane as a surface curving to their normal would, so a curved surface stays in it",
+                        FootprintShape::Ellipsoid => "a footprint is the paper's thin ellipsoid, so on a curved surface the points near its rim fall outside it and their light is lost",
                     }
                 ),
             ));

@@ -222,6 +222,8 @@ pub struct Footprint {
     pub b: Vec3,
     pub thickness: f32,
     pub power: Vec3,
+    /// The curved footprint (true) or the paper's ellipsoid.
+    pub curved: bool,
 }
 
 impl Footprint {
@@ -230,21 +232,59 @@ impl Footprint {
         self.a.cross(self.b).normalize() * self.thickness
     }
 
-    /// The box of the ellipsoid.
+    /// The footprint's box.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let c = self.c();
-        let e = (self.a * self.a + self.b * self.b + c * c).map(f32::sqrt);
+        let (a, b, c) = (self.a, self.b, self.c());
+        let e = if self.curved {
+            let tilted = ((1.0 - COVERAGE_NORMAL_COS) / (1.0 + COVERAGE_NORMAL_COS)).sqrt();
+            let depth = self.thickness + tilted * (a.dot(a) + b.dot(b)).sqrt();
+            (a * a + b * b).map(f32::sqrt) + c.normalize().abs() * depth
+        } else {
+            (a * a + b * b + c * c).map(f32::sqrt)
+        };
         (self.p - e, self.p + e)
     }
 
-    /// alpha^2 + beta^2 + gamma^2 of x.
-    pub fn distance2(&self, x: Vec3) -> f32 {
+    /// The squared distance in the footprint of x (unit normal nq):
+    /// alpha^2 + beta^2 + gamma^2 in the ellipsoid; in the curved footprint
+    /// alpha^2 + beta^2, where nq is within COVERAGE_NORMAL_COS of the
+    /// footprint's normal (tilted by phi) and x within |c| + rho tan(phi / 2)
+    /// of its plane; above 1 outside either.
+    pub fn distance2(&self, x: Vec3, nq: Vec3) -> f32 {
+        let (u2, depth, tilt) = self.tests(x, nq);
+        if depth >= 0.0 && tilt >= 0.0 {
+            u2
+        } else {
+            2.0
+        }
+    }
+
+    /// How near x is to being decided the other way: the least of
+    /// |u^2 - 1| and, for the curved footprint, the depth and tilt tests'
+    /// margins (relative).
+    pub fn margin(&self, x: Vec3, nq: Vec3) -> f32 {
+        let (u2, depth, tilt) = self.tests(x, nq);
+        (u2 - 1.0).abs().min(depth.abs()).min(tilt.abs())
+    }
+
+    /// u^2 of x, and the curved footprint's depth and tilt tests as margins
+    /// (>= 0: passed; relative to the thickness and to 1); the ellipsoid
+    /// passes both by far.
+    fn tests(&self, x: Vec3, nq: Vec3) -> (f32, f32, f32) {
         let (a, b, c) = (self.a, self.b, self.c());
         let e = x - self.p;
         let (bc, ca, ab) = (b.cross(c), c.cross(a), a.cross(b));
         let det = a.dot(bc);
         let u = Vec3::new(bc.dot(e), ca.dot(e), ab.dot(e)) / det;
-        u.dot(u)
+        if !self.curved {
+            return (u.dot(u), f32::INFINITY, f32::INFINITY);
+        }
+        let thickness = c.length();
+        let cos_phi = c.dot(nq) / thickness;
+        let tan_half = (1.0 - cos_phi * cos_phi).max(0.0).sqrt() / (1.0 + cos_phi);
+        let rho = (u.x * a + u.y * b).length();
+        let depth = (thickness + rho * tan_half - u.z.abs() * thickness) / thickness;
+        (u.x * u.x + u.y * u.y, depth, cos_phi - COVERAGE_NORMAL_COS)
     }
 }
 
@@ -286,6 +326,7 @@ pub fn footprint(
         b,
         thickness: FOOTPRINT_THICKNESS * a.length().max(b.length()),
         power: record.power.truncate() * power_scale,
+        curved: options.shape.curved(),
     }
 }
 
@@ -390,7 +431,7 @@ pub fn estimate(footprints: &[Footprint], x: Vec3, nq: Vec3, epanechnikov: bool)
         if f.c().dot(nq) <= 0.0 {
             continue;
         }
-        let u2 = f.distance2(x);
+        let u2 = f.distance2(x, nq);
         if u2.is_nan() || u2 > 1.0 {
             continue;
         }

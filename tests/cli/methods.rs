@@ -130,6 +130,25 @@ fn igi_says_it_skips_vpls_that_would_light_nothing() {
     );
 }
 
+/// `--explain` says which footprint photon differentials sum, as
+/// `--footprint-shape` asks.
+#[test]
+fn differentials_explain_which_footprint_they_sum() {
+    let d = TempDir::new("explain-differentials");
+    let explain = |args: &[&str]| {
+        Run::new(["render", "--quiet", "--explain", "--width", "32"])
+            .args(["--height", "24", "--method", "differentials"])
+            .args(["--set", "photon_map.photons_stored=2000"])
+            .args(args)
+            .output_to(d.join("x.png"))
+            .scene("cornell_box_obj")
+            .stderr()
+    };
+    assert!(explain(&[]).contains("so a curved surface stays in it"));
+    let err = explain(&["--footprint-shape", "ellipsoid"]);
+    assert!(err.contains("the paper's thin ellipsoid"), "{err}");
+}
+
 /// IGI as a user runs it: the JSON reports the VPLs, the gather and the
 /// bias compensation; IGI's
 /// switches without `--method igi`, the one-shot estimate's accelerations

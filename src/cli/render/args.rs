@@ -474,7 +474,7 @@ impl RenderArgs {
             || self.caustic_k.is_some()
             || self.caustic_scene_grid
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --footprint-shape) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
         }
         Ok(())
     }
@@ -498,7 +498,7 @@ impl RenderArgs {
             (
                 Method::Differentials,
                 self.differentials.any_given(),
-                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --caustic-photons and --footprint-bounces are photon differentials': add --method differentials",
+                "--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --footprint-shape, --caustic-photons and --footprint-bounces are photon differentials': add --method differentials",
                 "--method differentials replaces the kNN estimate with footprints",
             ),
             (

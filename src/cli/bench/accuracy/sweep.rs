@@ -1,6 +1,7 @@
 //! `bench accuracy`'s sweep: one parameter at a time around the scene's
 //! defaults, and every other method at its defaults and a few variants.
 
+use photonmap::photon::differentials::FootprintShape;
 use photonmap::photon::{BuildMethod, GridKind};
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::{CausticPaths, DifferentialsOptions, IgiOptions, Kernel, RadiosityOptions};
@@ -250,9 +251,9 @@ fn igi_rows(base: &Config, quick: bool) -> Vec<Config> {
 }
 
 /// Photon differentials: automatic smoothing (k_PD = the scene's k), no
-/// coverage probes, the paper's one map (no caustic footprint map), the
-/// paper scenes' 8 bounces, four times the photons, the Epanechnikov kernel,
-/// and 4 spp.
+/// coverage probes, the paper's ellipsoid footprints, the paper's one map
+/// (no caustic footprint map), the paper scenes' 8 bounces, four times the
+/// photons, the Epanechnikov kernel, and 4 spp.
 fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
     let pd = |label: &str, spp: u32, f: &dyn Fn(&mut DifferentialsOptions)| {
         base.by_tweaked(label, RunMethod::Differentials, spp, f)
@@ -265,6 +266,9 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
         out.push(more);
         out.push(pd("differentials, no coverage probes", 1, &|o| {
             o.coverage_samples = 0
+        }));
+        out.push(pd("differentials, ellipsoid footprints", 1, &|o| {
+            o.footprint_shape = FootprintShape::Ellipsoid
         }));
         out.push(pd("differentials, one map", 1, &|o| {
             o.caustic_photons = Some(0)
