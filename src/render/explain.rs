@@ -274,7 +274,7 @@ impl RenderOutput {
                     if r.converged { "converged" } else { "stopped at --max-shots" },
                     100.0 * r.unshot_fraction,
                     caustic_map(o.caustic_paths),
-                    caustic_shots(r.caustic_shot_fraction)
+                    caustic_shots(r.caustic_shot_fraction, o.shoot_caustics)
                 ),
             ));
         }
@@ -471,12 +471,13 @@ impl RenderOutput {
 }
 
 /// Whether radiosity's shots carry the caustic map's light on (L S+ D D+).
-fn caustic_shots(fraction: Option<f64>) -> String {
+fn caustic_shots(fraction: Option<f64>, shoot_caustics: bool) -> String {
     match fraction {
         Some(f) => format!(
             "the caustic map's photons were deposited into the elements first ({:.2}% of the emitted power), so that light bounces on from the diffuse surface it reached (L S+ D D+)",
             100.0 * f
         ),
+        None if shoot_caustics => "no caustic map's light was there to deposit into the elements (L S+ D D+ has none)".into(),
         None => "light that leaves a mirror or glass onto a diffuse surface never bounces on from there (L S+ D D+ is missing; --shoot-caustics true carries it)".into(),
     }
 }

@@ -130,6 +130,30 @@ fn igi_says_it_skips_vpls_that_would_light_nothing() {
     );
 }
 
+/// `--explain` on a scene with no mirror or glass (the closed box) says that radiosity's
+/// caustic deposit had nothing to deposit, not that light is missing, and
+/// says it is missing where `--shoot-caustics false` leaves it out.
+#[test]
+fn radiosity_explains_a_deposit_with_nothing_to_deposit() {
+    let d = TempDir::new("explain-radiosity");
+    let explain = |args: &[&str]| {
+        Run::new(["render", "--quiet", "--explain", "--width", "32"])
+            .args(["--height", "24", "--method", "radiosity", "--elements", "4"])
+            .args(["--convergence", "0.01"])
+            .args(args)
+            .output_to(d.join("x.png"))
+            .scene("tests/closed_box")
+            .stderr()
+    };
+    let err = explain(&[]);
+    assert!(
+        err.contains("no caustic map's light was there to deposit") && !err.contains("is missing"),
+        "{err}"
+    );
+    let err = explain(&["--shoot-caustics", "false"]);
+    assert!(err.contains("L S+ D D+ is missing"), "{err}");
+}
+
 /// `--explain` says which footprint photon differentials sum, as
 /// `--footprint-shape` asks.
 #[test]
