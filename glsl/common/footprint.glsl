@@ -31,8 +31,8 @@ vec3 footprint_normal_axis(vec3 a, vec3 b, float thickness) {
 // sqrt(a_i^2 + b_i^2) plus its deepest reach along the normal (below).
 vec3 footprint_half_extent(vec3 a, vec3 b, vec3 c, bool curved) {
     if (!curved) return sqrt(a * a + b * b + c * c);
-    float tilted = sqrt((1.0 - COVERAGE_NORMAL_COS) / (1.0 + COVERAGE_NORMAL_COS));
-    float depth = length(c) + tilted * sqrt(dot(a, a) + dot(b, b));
+    float tan_half_max = sqrt((1.0 - COVERAGE_NORMAL_COS) / (1.0 + COVERAGE_NORMAL_COS));
+    float depth = length(c) + tan_half_max * sqrt(dot(a, a) + dot(b, b));
     return sqrt(a * a + b * b) + abs(normalize(c)) * depth;
 }
 
@@ -41,11 +41,13 @@ vec3 footprint_half_extent(vec3 a, vec3 b, vec3 c, bool curved) {
 // alpha^2 + beta^2 of x's projection onto the ellipse's plane, where nq
 // tilts from the footprint's normal n by an angle phi of cosine at least
 // COVERAGE_NORMAL_COS and x lies no farther from the plane than |c| +
-// rho tan(phi / 2), rho its distance from p along the plane: a point of
-// any surface through p tangent to the plane, of curvature radius R >= rho,
-// lies at most there (a sphere's exactly: rho = R sin phi, depth
-// R (1 - cos phi)), while the other wall at a corner, tilted by a right
-// angle, does not count. Above 1 outside either.
+// rho tan(phi / 2), rho its distance from p along the plane: a sphere
+// tangent to the plane at p lies exactly there (rho = R sin phi, depth
+// R (1 - cos phi)), a cylinder within it, while the other wall at a
+// corner, tilted by a right angle, does not count; across a crease that
+// turns by less than 60 degrees (a bevel, a faceted mesh) the face beyond
+// counts near the crease, as a curved surface's would. Above 1 outside
+// either.
 float footprint_distance2(vec3 x, vec3 nq, vec3 p, vec3 a, vec3 b, vec3 c, bool curved) {
     vec3 e = x - p;
     vec3 bc = cross(b, c), ca = cross(c, a), ab = cross(a, b);

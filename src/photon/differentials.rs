@@ -6,8 +6,8 @@
 //!    a photon (in units of the spacing Delta = 2 sqrt(pi / n)).
 //! 2. **Morton codes** (`footprint_keys.frag`) of the stored records, after
 //!    the HistoPyramid compaction, sorted by the bitonic passes.
-//! 3. **Footprints** (`footprints.frag`) in Morton order: the ellipsoids,
-//!    their areas and powers.
+//! 3. **Footprints** (`footprints.frag`) in Morton order: the ellipses,
+//!    their areas and powers (which points each holds: `FootprintShape`).
 //! 4. **The BVH**: leaves of T consecutive footprints (`footprint_leaves`)
 //!    and their boxes, then the inner boxes one level a pass
 //!    (`footprint_reduce`). The tree is the complete binary tree over the
@@ -156,6 +156,14 @@ impl FootprintShape {
     /// The shaders' `u_curved`.
     pub fn curved(self) -> bool {
         self == FootprintShape::Curved
+    }
+
+    /// Its `--footprint-shape` value.
+    pub fn name(self) -> &'static str {
+        match self {
+            FootprintShape::Curved => "curved",
+            FootprintShape::Ellipsoid => "ellipsoid",
+        }
     }
 }
 

@@ -443,6 +443,7 @@ pub struct DifferentialsReport {
     pub leaves: u32,
     /// Coverage probes a footprint (0: the whole ellipse counts).
     pub coverage_samples: u32,
+    /// Which query points a footprint held.
     pub footprint_shape: FootprintShape,
     pub total_footprint_area: f64,
     pub surface_area: f64,

@@ -320,43 +320,61 @@ fn the_walk_finds_exactly_the_footprints_brute_force_finds() {
         ..DifferentialsOptions::default()
     };
     let out = run(&scene, 32, 32, o);
-    let run = state(&out);
+    let walk = walk_against_brute_force(&out, true);
+    println!(
+        "{} pixels, {:.1} footprints each on average: {} apart from brute force, {} more on a footprint's boundary",
+        walk.hits, walk.mean_found, walk.apart, walk.borderline
+    );
+    assert!(walk.mean_found > 5.0, "the walk has footprints to find");
+    assert_eq!(walk.apart, 0);
+}
+
+/// The walk's sums at the first hits against the twin's brute force over
+/// the same footprints.
+struct WalkCheck {
+    hits: usize,
+    /// Hits whose count or sum is apart, off every footprint's boundary.
+    apart: usize,
+    /// Hits apart but within 1e-4 of some footprint's boundary, where f32
+    /// may decide either way.
+    borderline: usize,
+    mean_found: f64,
+}
+
+fn walk_against_brute_force(out: &RenderOutput, epanechnikov: bool) -> WalkCheck {
+    let run = state(out);
     let fps = footprints(run);
     let sum = common::texels(&run.estimate.sum);
     let x = common::texels(&out.state.direct.diffuse_position);
     let n = common::texels(&out.state.direct.diffuse_normal);
-    let (mut pixels, mut apart, mut borderline, mut found) = (0, 0, 0, 0u64);
+    let (mut hits, mut apart, mut borderline, mut found) = (0, 0, 0, 0u64);
     for i in 0..sum.len() {
         if x[i][3] <= 0.0 {
             continue;
         }
-        pixels += 1;
+        hits += 1;
         let (p, nq) = (common::v3(x[i]), common::v3(n[i]));
-        let (s, c) = twin::estimate(&fps, p, nq, true);
+        let (s, c) = twin::estimate(&fps, p, nq, epanechnikov);
         found += c as u64;
         let same =
             sum[i][3] as u32 == c && close(common::v3(sum[i]), s, 1e-3 * s.max_element() + 1e-9);
-        // A pixel on some footprint's boundary may round either way.
-        let on_a_surface = fps
-            .iter()
-            .any(|f| f.area > 0.0 && f.c().dot(nq) > 0.0 && f.margin(p, nq) < 1e-4);
         if !same {
-            *(if on_a_surface {
+            let on_a_boundary = fps
+                .iter()
+                .any(|f| f.area > 0.0 && f.c().dot(nq) > 0.0 && f.on_boundary(p, nq, 1e-4));
+            *(if on_a_boundary {
                 &mut borderline
             } else {
                 &mut apart
             }) += 1;
         }
     }
-    println!(
-        "{pixels} pixels, {:.1} footprints each on average: {apart} apart from brute force, {borderline} more on a footprint's boundary",
-        found as f64 / pixels as f64
-    );
-    assert!(
-        found as f64 / pixels as f64 > 5.0,
-        "the walk has footprints to find"
-    );
-    assert_eq!(apart, 0);
+    WalkCheck {
+        hits,
+        apart,
+        borderline,
+        mean_found: found as f64 / hits.max(1) as f64,
+    }
 }
 
 #[test]
@@ -395,38 +413,21 @@ fn a_plane_under_a_point_light_gets_its_analytic_irradiance() {
     assert!((ratio - 1.0).abs() <= tolerance);
 }
 
-/// The footprint estimate over the ball's first hits lit at cos >= 0.5,
+/// The ball under the point light rendered with `o`: the footprint
+/// estimate over the first hits lit at cos >= 0.5 (the cap above y = 0.729)
 /// over the analytic E(x) = I cos / d^2 (I = 1, light at (0, 3, 0), the
-/// unit ball at the origin), with the footprints' mean radius, how many
-/// reach those hits, and at how many of the ball's hits the walk's sum is
-/// apart from the twin's brute force over the same footprints (off their
-/// boundaries, where either may round the other way).
-fn ball_estimate(shape: FootprintShape) -> (f64, f32, usize, usize) {
+/// unit ball at the origin), the footprints' mean radius, how many of them
+/// reach the cap, and the walk against brute force.
+fn ball_estimate(o: DifferentialsOptions) -> (f64, f32, usize, WalkCheck) {
     let scene = common::fixture("ball_under_point_light");
-    let o = DifferentialsOptions {
-        footprint_shape: shape,
-        ..DifferentialsOptions::default()
-    };
     let out = run(&scene, 48, 48, o);
     let run = state(&out);
     let sum = common::texels(&run.estimate.sum);
     let x = common::texels(&out.state.direct.diffuse_position);
-    let n = common::texels(&out.state.direct.diffuse_normal);
-    let fps = footprints(run);
     let light = Vec3::new(0.0, 3.0, 0.0);
-    let (mut ratio, mut pixels, mut apart) = (0.0f64, 0usize, 0usize);
+    let (mut ratio, mut pixels) = (0.0f64, 0usize);
     for i in 0..sum.len() {
         let p = common::v3(x[i]);
-        if x[i][3] > 0.0 {
-            let nq = common::v3(n[i]);
-            let (s, c) = twin::estimate(&fps, p, nq, false);
-            let same = sum[i][3] as u32 == c
-                && close(common::v3(sum[i]), s, 1e-3 * s.max_element() + 1e-9);
-            let borderline = fps
-                .iter()
-                .any(|f| f.area > 0.0 && f.c().dot(nq) > 0.0 && f.margin(p, nq) < 1e-4);
-            apart += usize::from(!same && !borderline);
-        }
         let v = light - p;
         let cos = p.normalize().dot(v.normalize());
         if x[i][3] <= 0.0 || cos < 0.5 {
@@ -435,14 +436,16 @@ fn ball_estimate(shape: FootprintShape) -> (f64, f32, usize, usize) {
         ratio += f64::from(sum[i][0] / (cos / v.length_squared()));
         pixels += 1;
     }
-    let r = fps
-        .iter()
-        .map(|f| f.a.length().max(f.b.length()))
-        .sum::<f32>()
-        / fps.len() as f32;
-    // The lit cap cos >= 0.5 reaches y = 0.6 or so; the footprints near it.
-    let near = fps.iter().filter(|f| f.p.y > 0.6 - f.a.length()).count();
-    (ratio / pixels as f64, r, near, apart)
+    let fps = footprints(run);
+    let radius = |f: &Footprint| f.a.length().max(f.b.length());
+    let r = fps.iter().map(radius).sum::<f32>() / fps.len() as f32;
+    let near = fps.iter().filter(|f| f.p.y > 0.729 - radius(f)).count();
+    (
+        ratio / pixels as f64,
+        r,
+        near,
+        walk_against_brute_force(&out, false),
+    )
 }
 
 /// On a ball, the paper's thin ellipsoid lets the surface's points near its
@@ -450,19 +453,41 @@ fn ball_estimate(shape: FootprintShape) -> (f64, f32, usize, usize) {
 /// loses their share of the power; the curved footprint keeps them, so the
 /// estimate meets the analytic irradiance within its noise and its kernel's
 /// bias: the plane's, plus the ball's area under an ellipse of radius r
-/// exceeding the ellipse's by (r / R)^2 / 4 at most.
+/// exceeding the ellipse's by (r / R)^2 / 4 at most. At these footprints
+/// the ball falls away by less than their thickness, so a third run with
+/// footprints five times as wide (the caustic factor 25), which the ball
+/// leaves by several thicknesses, checks the walk and the boxes where the
+/// depth allowance decides.
 #[test]
 fn on_a_ball_the_curved_footprint_keeps_the_light_the_ellipsoid_loses() {
-    let (curved, r, near, curved_apart) = ball_estimate(FootprintShape::Curved);
-    let (ellipsoid, _, _, ellipsoid_apart) = ball_estimate(FootprintShape::Ellipsoid);
+    let with = |footprint_shape, caustic_smoothing| DifferentialsOptions {
+        footprint_shape,
+        caustic_smoothing,
+        ..DifferentialsOptions::default()
+    };
+    let (curved, r, near, curved_walk) = ball_estimate(with(FootprintShape::Curved, 5.0));
+    let (ellipsoid, _, _, ellipsoid_walk) = ball_estimate(with(FootprintShape::Ellipsoid, 5.0));
+    let (_, wide_r, _, wide_walk) = ball_estimate(with(FootprintShape::Curved, 25.0));
     // Noise, the plane's kernel bias 0.75 (r / R)^2 with the ball's radius
     // for the height, and the ball's excess area (r / R)^2 / 4.
     let r = f64::from(r);
     let tolerance = 3.0 / (near as f64).sqrt() + r * r;
     println!(
-        "estimate / analytic: curved {curved:.4}, ellipsoid {ellipsoid:.4} (allowed 1 +- {tolerance:.4}: {near} photons reach the cap, footprint radius {r:.3}); the walk apart from brute force at {curved_apart} and {ellipsoid_apart} hits"
+        "estimate / analytic: curved {curved:.4}, ellipsoid {ellipsoid:.4} (allowed 1 +- {tolerance:.4}: {near} photons reach the cap, footprint radius {r:.3})"
     );
-    assert_eq!((curved_apart, ellipsoid_apart), (0, 0));
+    for (name, w) in [
+        ("curved".to_string(), &curved_walk),
+        ("ellipsoid".to_string(), &ellipsoid_walk),
+        (format!("curved, footprint radius {wide_r:.3}"), &wide_walk),
+    ] {
+        println!(
+            "{name}: {} hits, {:.1} footprints each, {} apart from brute force, {} more on a footprint's boundary",
+            w.hits, w.mean_found, w.apart, w.borderline
+        );
+        assert_eq!(w.apart, 0, "{name}");
+        assert!(w.borderline * 100 <= w.hits, "{name}");
+    }
+    assert!(wide_r > 0.3, "{wide_r}");
     assert!((curved - 1.0).abs() <= tolerance);
     assert!(ellipsoid < 1.0 - tolerance);
 }

@@ -171,7 +171,7 @@ pub(super) fn print_summary(
             format!(" (auto: {m:.4} diffuse footprints a hit at s = 1 in the pilot)")
         });
         eprintln!(
-            "photon differentials: {} footprints ({} diffuse, {} caustic, {} degenerate); s = {:.2}{pilot}, caustics {}, r_max {}, {} coverage probes a footprint; BVH of {} leaves of {} (auto {}); {:.1} footprints hold a first hit on average (k_PD), {:.1} nodes and {:.1} footprints examined, {} passes",
+            "photon differentials: {} footprints ({} diffuse, {} caustic, {} degenerate); s = {:.2}{pilot}, caustics {}, r_max {}, {} coverage probes a footprint, {} footprints; BVH of {} leaves of {} (auto {}); {:.1} footprints hold a first hit on average (k_PD), {:.1} nodes and {:.1} footprints examined, {} passes",
             d.footprints,
             d.diffuse_footprints,
             d.footprints - d.diffuse_footprints,
@@ -180,6 +180,7 @@ pub(super) fn print_summary(
             d.caustic_smoothing,
             d.max_radius,
             d.coverage_samples,
+            d.footprint_shape.name(),
             d.leaves,
             d.leaf_size,
             d.auto_leaf_size,
