@@ -157,14 +157,6 @@ impl FootprintShape {
     pub fn curved(self) -> bool {
         self == FootprintShape::Curved
     }
-
-    /// Its `--footprint-shape` value.
-    pub fn name(self) -> &'static str {
-        match self {
-            FootprintShape::Curved => "curved",
-            FootprintShape::Ellipsoid => "ellipsoid",
-        }
-    }
 }
 
 /// How footprints are made from differentials.

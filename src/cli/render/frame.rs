@@ -180,7 +180,8 @@ pub(super) fn print_summary(
             d.caustic_smoothing,
             d.max_radius,
             d.coverage_samples,
-            d.footprint_shape.name(),
+            clap::ValueEnum::to_possible_value(&d.footprint_shape)
+                .map_or_else(String::new, |v| v.get_name().to_string()),
             d.leaves,
             d.leaf_size,
             d.auto_leaf_size,
