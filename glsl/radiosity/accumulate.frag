@@ -9,6 +9,7 @@ uniform int u_lights;
 layout(location = 0) out vec4 o_radiosity;
 layout(location = 1) out vec4 o_residual;
 layout(location = 2) out vec4 o_direct;
+layout(location = 3) out vec4 o_deposited;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -17,4 +18,5 @@ void main() {
     o_radiosity = db;
     o_residual = db;
     o_direct = u_lights != 0 ? db : vec4(0.0);
+    o_deposited = vec4(0.0);
 }

@@ -36,7 +36,7 @@ uniform float u_fade_distance;          // IGI's bound m: gather only what it le
 
 layout(location = 0) out vec4 o_position;   // the gather hit, w = 1 where it is a query
 layout(location = 1) out vec4 o_normal;     // facing the gather ray, w = material + 1
-layout(location = 2) out vec4 o_throughput; // of the specular chain (1 without one)
+layout(location = 2) out vec4 o_throughput; // of the specular chain (1 without one), w = the primitive hit
 
 void main() {
     ivec2 texel = ivec2(gl_FragCoord.xy);
@@ -77,7 +77,7 @@ void main() {
         if (kind == MAT_DIFFUSE) {
             o_position = vec4(p, 1.0);
             o_normal = vec4(nf, float(mat + 1));
-            o_throughput = vec4(throughput, 0.0);
+            o_throughput = vec4(throughput, float(prim));
             return;
         }
         float ior = 0.0;

@@ -444,6 +444,13 @@ pub struct RadiosityArgs {
     /// the emitters alone.
     #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
     pub shoot_caustics: bool,
+    /// Radiosity: final gather over the solution. N cosine-distributed rays
+    /// a pixel read the solution where they land, so a pixel near a
+    /// contact or a shadow's edge takes the light of the surfaces around it
+    /// rather than its own element's (0: off, the solution read at the
+    /// pixel; 0..=4096).
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = in_range(0, photonmap::render::radiosity::MAX_GATHER_RAYS))]
+    pub gather_rays: u32,
 }
 
 fn open_fraction(s: &str) -> Result<f32, String> {
@@ -465,6 +472,7 @@ impl RadiosityArgs {
             || self.gradient != d.gradient
             || self.form_factor != d.form_factor
             || self.shoot_caustics != d.shoot_caustics
+            || self.gather_rays != d.gather_rays
     }
 }
 
@@ -480,6 +488,7 @@ impl From<&RadiosityArgs> for RadiosityOptions {
             gradient: a.gradient,
             form_factor: a.form_factor,
             shoot_caustics: a.shoot_caustics,
+            gather_rays: a.gather_rays,
             ..RadiosityOptions::default()
         }
     }

@@ -261,7 +261,7 @@ impl RenderOutput {
                 0,
                 true,
                 format!(
-                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side, the widest {:.3} across: a receiver nearer a shooter than its width, as a face is where it meets the floor, gets the shooter's mean radiosity, not the light beside it (each doubling of --substructure halves the width); {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; {}",
+                    "{} patches (each side of a diffuse primitive, and each emitter's emitting side), {} elements ({} x {} a patch, in an atlas); {} shots of {} x {} sub-element shooters, each with a hemispherical item buffer of {} texels a side, the widest {:.3} across: a receiver nearer a shooter than its width, as a face is where it meets the floor, gets the shooter's mean radiosity, not the light beside it (each doubling of --substructure halves the width); {}: {:.3}% of the emitted power unshot; shots stop at mirrors and glass, so {}; {}; {}",
                     r.patches,
                     r.elements,
                     r.element_resolution,
@@ -274,7 +274,8 @@ impl RenderOutput {
                     if r.converged { "converged" } else { "stopped at --max-shots" },
                     100.0 * r.unshot_fraction,
                     caustic_map(o.caustic_paths),
-                    caustic_shots(r.caustic_shot_fraction, o.shoot_caustics)
+                    caustic_shots(r.caustic_shot_fraction, o.shoot_caustics),
+                    solution_read(o.gather_rays)
                 ),
             ));
         }
@@ -479,6 +480,14 @@ fn caustic_shots(fraction: Option<f64>, shoot_caustics: bool) -> String {
         ),
         None if shoot_caustics => "no caustic map's light was there to deposit into the elements (L S+ D D+ has none)".into(),
         None => "light that leaves a mirror or glass onto a diffuse surface never bounces on from there (L S+ D D+ is missing; --shoot-caustics true carries it)".into(),
+    }
+}
+
+/// Where the image reads the radiosity solution.
+fn solution_read(gather_rays: u32) -> String {
+    match gather_rays {
+        0 => "the image reads the solution at each pixel's own element, whose mean misses how the light changes across it near a contact or a shadow's edge (--gather-rays N reads it where rays from the pixel land)".to_string(),
+        n => format!("final gather: {n} rays a pixel read the solution where they land, with the direct light there from a shadow ray a light, so an element's error enters a pixel only as the share of its hemisphere that element covers"),
     }
 }
 

@@ -59,24 +59,37 @@ pub struct GatherStats {
     pub estimate_passes: u32,
 }
 
+/// The gather rays of one batch at one image size: each pixel's rays from
+/// its first diffuse hit, traced to the diffuse hit each ends at
+/// (`gather_rays.frag`). Final gather, IGI's bias compensation and
+/// radiosity's gather read what lies at those hits.
+pub struct GatherRays {
+    height: u32,
+    /// Gather rays per pixel in one batch.
+    pub batch: u32,
+    /// The hits, width x (height x batch): w = 1 where a ray ended on a
+    /// diffuse surface.
+    pub position: Texture,
+    /// Facing the gather ray, w = material + 1.
+    pub normal: Texture,
+    /// The specular chain's throughput, w = the primitive hit.
+    pub throughput: Texture,
+    target: Target,
+    program: Program,
+    /// Bound as u_pixel when the first hits are in place (never read).
+    no_pixels: Texture,
+}
+
 /// The textures and programs of final gather at one image size.
 pub struct FinalGather {
     gpu: Gpu,
     width: u32,
     height: u32,
-    /// Gather rays per pixel in one batch.
-    pub batch: u32,
-    pub position: Texture,
-    pub normal: Texture,
-    pub throughput: Texture,
-    rays_target: Target,
+    pub rays: GatherRays,
     pub estimate: RadianceEstimate,
     pub indirect: Texture,
     indirect_target: Target,
-    rays: Program,
     accumulate: Program,
-    /// Bound as u_pixel when the first hits are in place (never read).
-    no_pixels: Texture,
 }
 
 /// Rays per batch for an image of width x height: as many of `rays` as fit
@@ -87,33 +100,26 @@ pub fn batch_size(width: u32, height: u32, rays: u32, max_texture: u32) -> u32 {
     rays.min(by_texels).min(by_height).max(1)
 }
 
-impl FinalGather {
+impl GatherRays {
+    /// Room for `rays` a pixel of a width x height image, in batches of
+    /// `batch_size` rays.
     pub fn new(gpu: &Gpu, width: u32, height: u32, rays: u32) -> Result<Self> {
         let batch = batch_size(width, height, rays, gpu.max_texture_size());
         let t = || Texture::new(gpu, width, height * batch, TexFormat::Rgba32F);
         let (position, normal, throughput) = (t()?, t()?, t()?);
-        let rays_target = Target::new(gpu, &[&position, &normal, &throughput])?;
-        let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
-        let indirect_target = Target::new(gpu, &[&indirect])?;
         Ok(Self {
-            gpu: gpu.clone(),
-            width,
             height,
             batch,
-            rays_target,
+            target: Target::new(gpu, &[&position, &normal, &throughput])?,
             position,
             normal,
             throughput,
-            estimate: RadianceEstimate::new(gpu, width, height * batch)?,
-            indirect,
-            indirect_target,
-            rays: Program::fullscreen(gpu, "render/gather_rays.frag")?,
-            accumulate: Program::fullscreen(gpu, "render/gather_accumulate.frag")?,
+            program: Program::fullscreen(gpu, "render/gather_rays.frag")?,
             no_pixels: Texture::new(gpu, 1, 1, TexFormat::R32I)?,
         })
     }
 
-    /// The gather hits of the last batch, as the estimate's queries.
+    /// The hits of the last batch, as queries.
     pub fn queries(&self) -> QueryPoints<'_> {
         QueryPoints {
             position: &self.position,
@@ -123,9 +129,10 @@ impl FinalGather {
     }
 
     /// Traces gather rays `rays` (at most `batch` of them) of every pixel from
-    /// its first diffuse hit; the batch's unused slots hold no query. With
-    /// `fade` = IGI's bound m > 0, only what that bound leaves out is
-    /// gathered (`gather_rays.frag`).
+    /// its first diffuse hit; the batch's unused slots hold no query. Each
+    /// ray follows at most `max_depth` mirrors and glass. With `fade` = IGI's
+    /// bound m > 0, only what that bound leaves out is gathered
+    /// (`gather_rays.frag`).
     pub fn trace_batch(
         &self,
         scene: &SceneTextures,
@@ -134,7 +141,7 @@ impl FinalGather {
         (max_depth, fade): (u32, f32),
         seed: u32,
     ) -> Result<()> {
-        let mut b = self.rays.bind();
+        let mut b = self.program.bind();
         scene.bind(&mut b);
         b.texture("u_diffuse_position", first.position)
             .texture("u_diffuse_normal", first.normal)
@@ -146,7 +153,25 @@ impl FinalGather {
             .int("u_image_height", self.height as i32)
             .int("u_max_depth", max_depth as i32)
             .float("u_fade_distance", fade)
-            .draw_fullscreen(&self.rays_target, &DrawState::PLAIN)
+            .draw_fullscreen(&self.target, &DrawState::PLAIN)
+    }
+}
+
+impl FinalGather {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, rays: u32) -> Result<Self> {
+        let rays = GatherRays::new(gpu, width, height, rays)?;
+        let indirect = Texture::new(gpu, width, height, TexFormat::Rgba32F)?;
+        let indirect_target = Target::new(gpu, &[&indirect])?;
+        Ok(Self {
+            gpu: gpu.clone(),
+            width,
+            height,
+            estimate: RadianceEstimate::new(gpu, width, height * rays.batch)?,
+            rays,
+            indirect,
+            indirect_target,
+            accumulate: Program::fullscreen(gpu, "render/gather_accumulate.frag")?,
+        })
     }
 
     /// Adds the finished batch (`rays` of them) to each pixel's indirect light.
@@ -162,8 +187,8 @@ impl FinalGather {
         let mut b = self
             .estimate
             .bind_result(&self.accumulate, scene, direct, k, max_radius);
-        b.texture("u_gather_normal", &self.normal)
-            .texture("u_gather_throughput", &self.throughput)
+        b.texture("u_gather_normal", &self.rays.normal)
+            .texture("u_gather_throughput", &self.rays.throughput)
             .int("u_batch", rays as i32)
             .int("u_image_height", self.height as i32)
             .float("u_total_rays", total_rays as f32)
@@ -198,18 +223,19 @@ impl FinalGather {
         let mut done = 0;
         while done < options.rays {
             crate::interrupt::check()?;
-            let rays = self.batch.min(options.rays - done);
+            let rays = self.rays.batch.min(options.rays - done);
             self.gpu.finish();
             let t0 = std::time::Instant::now();
             timer.around(|| {
-                self.trace_batch(scene, first, done..done + rays, depth_and_fade, seed)
+                self.rays
+                    .trace_batch(scene, first, done..done + rays, depth_and_fade, seed)
             })?;
             self.gpu.finish();
             timings.add_since("gather rays", timer.seconds(), t0, 1);
             let run = self.estimate.run(
                 scene,
                 global,
-                self.queries(),
+                self.rays.queries(),
                 options.k,
                 max_radius,
                 estimate,

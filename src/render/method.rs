@@ -20,6 +20,8 @@ use super::radiosity::RadiosityRun;
 use super::sample::{FrameMethod, Prepare, SampleFrame};
 
 /// A frame method's state: its maps, textures and per-sample reports.
+// One a render, moved rarely: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum MethodRun {
     DirectOnly,
     PhotonMap(PhotonMapRun),

@@ -38,7 +38,7 @@ pub use differentials::{
 pub use direct::DirectLight;
 pub use explain::ExplainLine;
 pub use eye_paths::{trace_eye_paths, EyeSample};
-pub use final_gather::{FinalGather, FinalGatherOptions, GatherStats};
+pub use final_gather::{FinalGather, FinalGatherOptions, GatherRays, GatherStats};
 pub use frame::{render, render_views};
 pub use igi::{Igi, IgiOptions, IgiRun, IgiStats, VplGather, VplReport, Vpls};
 pub use method::MethodRun;

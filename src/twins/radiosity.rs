@@ -165,3 +165,12 @@ pub fn discontinuities(values: &[Option<f32>], res: u32, gradient: f32, floor: f
     }
     (count, close)
 }
+
+/// The twin of glsl/radiosity/gather_sum.frag: a pixel's indirect light from
+/// the radiance `brought` back by each of its gather rays (batches summed),
+/// over `rays` cosine-distributed rays from a first hit of `throughput` and
+/// `albedo`.
+pub fn gathered_sum(throughput: Vec3, albedo: Vec3, brought: &[Vec3], rays: u32) -> Vec3 {
+    let sum: Vec3 = brought.iter().copied().sum();
+    throughput * albedo * sum / rays as f32
+}

@@ -38,7 +38,7 @@ fn the_compensation_rays_equal_their_cpu_twin() {
     };
     let out = render(&gpu, &scene, &options(&scene, size, seed, igi), &mut ()).unwrap();
     let c = out.igi_run().unwrap().compensation.as_ref().unwrap();
-    assert_eq!(c.gather.batch, rays, "one batch holds every ray");
+    assert_eq!(c.gather.rays.batch, rays, "one batch holds every ray");
     let map = CpuPhotonMap::from_gpu(&c.map);
     let check = compare_with_twin(
         &scene,

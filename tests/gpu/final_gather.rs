@@ -52,7 +52,7 @@ fn final_gather_equals_its_cpu_twin() {
     )
     .unwrap();
     let fg = out.gather().unwrap();
-    assert_eq!(fg.batch, rays, "one batch holds every ray");
+    assert_eq!(fg.rays.batch, rays, "one batch holds every ray");
     let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
     let depth_and_fade = (scene.render.max_specular_depth, 0.0);
     let c = compare_with_twin(
@@ -107,9 +107,9 @@ pub fn compare_with_twin(
     let first_normal = common::texels(&direct.diffuse_normal);
     let first_throughput = common::texels(&direct.diffuse_throughput);
     let (gp, gn, gt) = (
-        common::texels(&fg.position),
-        common::texels(&fg.normal),
-        common::texels(&fg.throughput),
+        common::texels(&fg.rays.position),
+        common::texels(&fg.rays.normal),
+        common::texels(&fg.rays.throughput),
     );
     let indirect = common::texels(&fg.indirect);
     let max_radius = scene.photon_map.max_radius;

@@ -26,6 +26,7 @@ mod platforms;
 mod radiance_estimate;
 mod radiosity;
 mod radiosity_caustics;
+mod radiosity_gather;
 mod ray_tracer;
 mod reference_images;
 mod sppm;

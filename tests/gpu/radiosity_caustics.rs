@@ -1,7 +1,8 @@
 //! Radiosity's caustic deposit (`--shoot-caustics`) against the caustic map
 //! it comes from: every caustic photon's reflected power enters the
-//! elements, as radiosity, as unshot residual and as the direct part that
-//! the image leaves to the caustic map.
+//! elements, as radiosity, as unshot residual, as the direct part that
+//! the image leaves to the caustic map, and as the deposit that a gather
+//! hit keeps, which splits and shots leave as it was.
 
 use photonmap::photon::PhotonMap;
 use photonmap::render::photon_options::CAUSTIC_K;
@@ -30,21 +31,14 @@ fn the_caustic_deposit_adds_the_reflected_power_of_every_caustic_photon() {
         )
     };
     let (with, without) = (run(true), run(false));
+    assert_eq!(
+        deposit_sum(&without),
+        0.0,
+        "nothing deposited when not shot"
+    );
     let (direct_on, b_on, residual_on) = box_sums(&with);
     let (direct_off, b_off, residual_off) = box_sums(&without);
-    // The caustic map's records (position w = 1), power scaled to the
-    // photons in use, reflected at albedo 0.5.
-    let caustics = with.radiosity_run().unwrap().caustics.as_ref().unwrap();
-    let PhotonMap::Sorted(map) = &caustics.map else {
-        panic!("the default build sorts");
-    };
-    let (position, power) = (common::texels(&map.position), common::texels(&map.power));
-    let reflected: f64 = position
-        .iter()
-        .zip(&power)
-        .filter(|(p, _)| p[3] == 1.0)
-        .map(|(_, w)| 0.5 * f64::from(w[0]))
-        .sum();
+    let reflected = reflected_caustic_power(&with);
     let report = with.radiosity_run().unwrap().report.caustic_shot_fraction;
     println!(
         "reflected caustic power {reflected:.6}; deposited: radiosity {:.6}, direct {:.6}, residual {:.6}; reported {report:?}",
@@ -57,6 +51,7 @@ fn the_caustic_deposit_adds_the_reflected_power_of_every_caustic_photon() {
         b_on - b_off,
         direct_on - direct_off,
         residual_on - residual_off,
+        deposit_sum(&with),
     ] {
         assert!(
             (deposited - reflected).abs() <= 1e-3 * reflected,
@@ -72,6 +67,55 @@ fn the_caustic_deposit_adds_the_reflected_power_of_every_caustic_photon() {
                 .caustic_shot_fraction
                 .is_none()
     );
+}
+
+/// The same box solved to convergence with adaptive subdivision: tiles
+/// split after the deposit, and their children must inherit it, while the
+/// shots add none to it.
+#[test]
+fn splits_and_shots_keep_the_caustic_deposit() {
+    let out = solve(&mirror_ball_box(""), RadiosityOptions::default());
+    let report = &out.radiosity_run().unwrap().report;
+    let (reflected, deposit) = (reflected_caustic_power(&out), deposit_sum(&out));
+    println!(
+        "{} splits, {} shots: deposit {deposit:.6}, reflected caustic power {reflected:.6}",
+        report.splits, report.shots
+    );
+    assert!(report.splits > 0 && report.shots > 1);
+    assert!(
+        (deposit - reflected).abs() <= 1e-3 * reflected,
+        "deposit {deposit}, reflected {reflected}"
+    );
+}
+
+/// The caustic map's records (position w = 1), power scaled to the photons
+/// in use, reflected at the box's albedo 0.5 (red channel).
+fn reflected_caustic_power(out: &photonmap::render::RenderOutput) -> f64 {
+    let caustics = out.radiosity_run().unwrap().caustics.as_ref().unwrap();
+    let PhotonMap::Sorted(map) = &caustics.map else {
+        panic!("the default build sorts");
+    };
+    let (position, power) = (common::texels(&map.position), common::texels(&map.power));
+    position
+        .iter()
+        .zip(&power)
+        .filter(|(p, _)| p[3] == 1.0)
+        .map(|(_, w)| 0.5 * f64::from(w[0]))
+        .sum()
+}
+
+/// The deposit texture's power over the live elements of diffuse patches
+/// (red channel).
+fn deposit_sum(out: &photonmap::render::RenderOutput) -> f64 {
+    let r = &out.radiosity_run().unwrap().radiosity;
+    let e = &r.elements;
+    let deposit = common::texels(&r.deposit);
+    e.position
+        .iter()
+        .enumerate()
+        .filter(|(t, pos)| pos[3] > 0.0 && !e.patches[e.normal[*t][3] as usize].emitter)
+        .map(|(t, pos)| f64::from(deposit[t][0]) * f64::from(pos[3]))
+        .sum()
 }
 
 /// The closed box of albedo 0.5 (scenes/tests/closed_box.toml) lit by a

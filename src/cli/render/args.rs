@@ -474,7 +474,7 @@ impl RenderArgs {
             || self.caustic_k.is_some()
             || self.caustic_scene_grid
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --footprint-shape) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics)");
+            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --footprint-shape) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics, --gather-rays)");
         }
         Ok(())
     }
@@ -504,8 +504,8 @@ impl RenderArgs {
             (
                 Method::Radiosity,
                 self.radiosity.any_given(),
-                "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor and --shoot-caustics are radiosity's: add --method radiosity",
-                "--method radiosity computes the diffuse interreflection itself",
+                "--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics and --gather-rays are radiosity's: add --method radiosity",
+                "--method radiosity computes the diffuse interreflection itself (--gather-rays N gathers over its solution)",
             ),
         ];
         if (self.caustic_paths.is_some() || self.caustic_k.is_some() || self.caustic_scene_grid)

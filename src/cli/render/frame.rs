@@ -147,7 +147,7 @@ pub(super) fn print_summary(
     }
     if let Some(r) = out.radiosity() {
         eprintln!(
-            "radiosity: {} patches in {} tiles of {} x {} ({} splits{}), {} elements; {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}",
+            "radiosity: {} patches in {} tiles of {} x {} ({} splits{}), {} elements; {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}; {}",
             r.patches,
             r.tiles,
             r.element_resolution,
@@ -163,6 +163,13 @@ pub(super) fn print_summary(
                 "from the caustic photon map"
             } else {
                 "none (nothing specular in the scene)"
+            },
+            match out.radiosity_run().and_then(|run| run.gather.as_ref()) {
+                Some(g) => format!(
+                    "final gather of {} rays a pixel, direct light at their hits by shadow rays",
+                    g.rays_per_pixel()
+                ),
+                None => "the solution read at each pixel".to_string(),
             }
         );
     }

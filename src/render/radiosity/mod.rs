@@ -40,8 +40,11 @@
 //!    that light also bounces on: before the first shot each caustic
 //!    record's reflected power is deposited into its element (`deposit`),
 //!    and the lookup leaves that first reflection to the caustic map.
+//!    With `gather_rays`, final gather (`gather`): rays from each first hit
+//!    read the solution where they land, in place of the lookup at the hit.
 
 mod elements;
+mod gather;
 mod options;
 pub mod run;
 mod subdivide;
@@ -50,9 +53,10 @@ pub use elements::{
     block_outline, element_point, full_tree, is_curved, onto_surface, tessellate, Elements, Node,
     Patch, Tile, CURVED_SEGMENTS, MAX_ATLAS_TEXELS,
 };
+pub use gather::SolutionGather;
 pub use options::{
-    ConvergencePoint, FormFactor, RadiosityOptions, RadiosityReport, MAX_SUBDIVIDE, SPLIT_FLOOR,
-    SPLIT_SHARE,
+    ConvergencePoint, FormFactor, RadiosityOptions, RadiosityReport, MAX_GATHER_RAYS,
+    MAX_SUBDIVIDE, SPLIT_FLOOR, SPLIT_SHARE,
 };
 pub use run::RadiosityRun;
 
@@ -108,6 +112,8 @@ pub struct Radiosity {
     pub radiosity: Texture,
     pub residual: Texture,
     pub direct: Texture,
+    /// What the caustic deposit put into each element (also in `direct`).
+    pub deposit: Texture,
     atlas_target: Target,
     residual_target: Target,
     /// The last shot's energy at each element (before `accumulate`).
@@ -147,6 +153,7 @@ struct Programs {
     inherit: Program,
     zero: Program,
     lookup: Program,
+    gather_sum: Program,
     deposit: Program,
 }
 
@@ -170,6 +177,7 @@ impl Programs {
             inherit: p("radiosity/inherit.frag")?,
             zero: p("radiosity/zero.frag")?,
             lookup: p("radiosity/lookup.frag")?,
+            gather_sum: p("radiosity/gather_sum.frag")?,
             deposit: Program::new(gpu, "radiosity/deposit.vert", "radiosity/deposit.frag", &[])?,
         })
     }
@@ -214,8 +222,9 @@ impl Radiosity {
         let radiosity = upload(&elements.emission)?;
         let residual = upload(&elements.emission)?;
         let direct = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
-        Target::new(gpu, &[&direct])?.clear([0.0; 4]);
-        let atlas_target = Target::new(gpu, &[&radiosity, &residual, &direct])?;
+        let deposit = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
+        Target::new(gpu, &[&direct, &deposit])?.clear([0.0; 4]);
+        let atlas_target = Target::new(gpu, &[&radiosity, &residual, &direct, &deposit])?;
         let residual_target = Target::new(gpu, &[&residual])?;
         let shot = Texture::new(gpu, w, h, TexFormat::Rgba32F)?;
         let shot_target = Target::new(gpu, &[&shot])?;
@@ -252,6 +261,7 @@ impl Radiosity {
             radiosity,
             residual,
             direct,
+            deposit,
             atlas_target,
             residual_target,
             shot,
@@ -641,30 +651,69 @@ impl Radiosity {
             .draw_region(&self.shot_target, &DrawState::PLAIN, region)
     }
 
-    /// The indirect light at `direct`'s first hits, left in `indirect`.
+    /// The indirect light at `direct`'s first hits, left in `indirect`: the
+    /// solution read at each hit, or with `gather` the solution read where
+    /// its rays land. `seed` draws the gather rays.
     pub fn run(
         &self,
         textures: &SceneTextures,
         direct: &DirectLight,
+        gather: Option<&SolutionGather>,
+        seed: u32,
         timings: &mut Timings,
+        on_batch: &mut dyn FnMut(u32, u32),
     ) -> Result<()> {
+        if let Some(g) = gather {
+            return g.run(self, textures, direct, seed, timings, on_batch);
+        }
         self.gpu.finish();
         let t0 = std::time::Instant::now();
-        let mut b = self.programs.lookup.bind();
-        textures.bind(&mut b);
-        direct.bind_weights(&mut b);
-        self.bind_atlas(&mut b);
-        b.texture("u_diffuse_position", &direct.diffuse_position)
-            .texture("u_radiosity", &self.radiosity)
-            .texture("u_direct", &self.direct)
-            .texture("u_patch_of", &self.patch_of)
-            .int("u_patch_of_width", self.patch_of_width as i32)
-            .texture("u_nodes", &self.nodes)
-            .draw_fullscreen(&self.indirect_target, &DrawState::PLAIN)?;
-        drop(b);
+        self.lookup(
+            textures,
+            LookupAt {
+                position: &direct.diffuse_position,
+                normal: &direct.diffuse_normal,
+                throughput: &direct.diffuse_throughput,
+            },
+            None,
+            &self.indirect_target,
+        )?;
         self.gpu.finish();
         timings.add_since("radiosity lookup", 0.0, t0, 1);
         self.gpu.check("radiosity lookup")
+    }
+
+    /// `lookup.frag` at the points `at` into `target` (their size): at the
+    /// first hits (`gather` None) each one's radiance from the solution less
+    /// its direct part; at a batch of gather hits, the radiance each sends
+    /// back, its direct part from a shadow ray a light.
+    fn lookup(
+        &self,
+        textures: &SceneTextures,
+        at: LookupAt<'_>,
+        gather: Option<GatherBatch>,
+        target: &Target,
+    ) -> Result<()> {
+        let mut b = self.programs.lookup.bind();
+        textures.bind(&mut b);
+        self.bind_atlas(&mut b);
+        b.texture("u_diffuse_position", at.position)
+            .texture("u_diffuse_normal", at.normal)
+            .texture("u_diffuse_throughput", at.throughput)
+            .int("u_gather", gather.is_some() as i32)
+            .uint("u_seed", gather.map_or(0, |g| g.seed))
+            .int("u_first_ray", gather.map_or(0, |g| g.first_ray) as i32)
+            .int(
+                "u_image_height",
+                gather.map_or(0, |g| g.image_height) as i32,
+            )
+            .texture("u_radiosity", &self.radiosity)
+            .texture("u_direct", &self.direct)
+            .texture("u_deposited", &self.deposit)
+            .texture("u_patch_of", &self.patch_of)
+            .int("u_patch_of_width", self.patch_of_width as i32)
+            .texture("u_nodes", &self.nodes)
+            .draw_fullscreen(target, &DrawState::PLAIN)
     }
 
     /// Deposits the caustic trace's stored records into the elements they
@@ -701,6 +750,26 @@ impl Radiosity {
     pub fn read_indirect(&self) -> Image {
         Image::from_gl_rgba(self.width, self.height, &self.indirect.read_f32())
     }
+}
+
+/// Points where the solution is read: a hit each texel (w of `position` > 0),
+/// its normal facing the ray that found it and its throughput, w = the
+/// primitive hit.
+#[derive(Clone, Copy)]
+struct LookupAt<'a> {
+    position: &'a Texture,
+    normal: &'a Texture,
+    throughput: &'a Texture,
+}
+
+/// A batch of gather hits: the eye sample's seed, the index of the batch's
+/// first ray among each pixel's, and the image's height (ray j of the batch
+/// is row y + j x height).
+#[derive(Clone, Copy)]
+struct GatherBatch {
+    seed: u32,
+    first_ray: u32,
+    image_height: u32,
 }
 
 /// The power of the scene's point lights, 4 pi I (luminance).

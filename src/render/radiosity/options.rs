@@ -36,6 +36,10 @@ pub struct RadiosityOptions {
     /// before the first shot, so that light from a mirror or glass bounces
     /// on from the diffuse surface it reached (L S+ D D+).
     pub shoot_caustics: bool,
+    /// Final gather over the solution: cosine-distributed rays a pixel that
+    /// read the solution where they land, in place of reading it at the
+    /// pixel (0: off).
+    pub gather_rays: u32,
 }
 
 /// A shooter's form factor to a receiving element's centre.
@@ -73,6 +77,7 @@ impl Default for RadiosityOptions {
             caustic_k: None,
             caustic_scene_grid: false,
             shoot_caustics: true,
+            gather_rays: 0,
         }
     }
 }
@@ -118,6 +123,11 @@ impl RadiosityOptions {
             ));
         }
         Error::check_range("radiosity.subdivide", self.subdivide, 0..=MAX_SUBDIVIDE)?;
+        Error::check_range(
+            "radiosity.gather_rays",
+            self.gather_rays,
+            0..=MAX_GATHER_RAYS,
+        )?;
         Error::check_positive(
             "radiosity.gradient",
             self.gradient,
@@ -125,6 +135,9 @@ impl RadiosityOptions {
         )
     }
 }
+
+/// Gather rays a pixel at most, as final gather's.
+pub const MAX_GATHER_RAYS: u32 = 4096;
 
 /// Quadtree depth at most (a tile at depth 6 is 1/64 of its patch a side).
 pub const MAX_SUBDIVIDE: u32 = 6;

@@ -1,21 +1,23 @@
 //! Radiosity through a render: the caustic map and the solution, made once,
-//! then each eye sample's lookup at its first hits.
+//! then each eye sample's lookup at its first hits, or its final gather.
 
 use crate::gpu::Result;
 use crate::image::Image;
 use crate::timing::Timings;
 
-use super::{Radiosity, RadiosityOptions, RadiosityReport};
+use super::{Radiosity, RadiosityOptions, RadiosityReport, SolutionGather};
 use crate::render::observer::{Progress, RenderObserver};
 use crate::render::photon_map::MapEstimate;
 use crate::render::photon_options::WithCausticMap;
 use crate::render::sample::{FrameMethod, Prepare, SampleFrame};
 
-/// The caustic map, the solution's atlas and passes, and its report.
+/// The caustic map, the solution's atlas and passes, its report, and the
+/// final gather's rays where it gathers.
 pub struct RadiosityRun {
     pub caustics: Option<MapEstimate>,
     pub radiosity: Radiosity,
     pub report: RadiosityReport,
+    pub gather: Option<SolutionGather>,
 }
 
 impl RadiosityRun {
@@ -43,10 +45,15 @@ impl RadiosityRun {
                 1000,
             ));
         })?;
+        let gather = match o.gather_rays {
+            0 => None,
+            rays => Some(SolutionGather::new(p.gpu, p.width, p.height, rays)?),
+        };
         Ok(Self {
             caustics,
             radiosity,
             report,
+            gather,
         })
     }
 }
@@ -60,7 +67,22 @@ impl FrameMethod for RadiosityRun {
         observer: &mut dyn RenderObserver,
     ) -> Result<Image> {
         let mut image = MapEstimate::image_or_direct(self.caustics.as_mut(), f, timings, observer)?;
-        self.radiosity.run(f.textures, f.direct, timings)?;
+        let at = f.at;
+        self.radiosity.run(
+            f.textures,
+            f.direct,
+            self.gather.as_ref(),
+            f.seed,
+            timings,
+            &mut |done, total| {
+                observer.progress(&Progress::at(
+                    "radiosity gather",
+                    done as u64,
+                    total as u64,
+                    at,
+                ))
+            },
+        )?;
         image.add(&self.radiosity.read_indirect());
         Ok(image)
     }

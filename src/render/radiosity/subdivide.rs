@@ -101,7 +101,8 @@ impl Radiosity {
     }
 
     /// A split's records on the GPU: the children's elements and their
-    /// inherited radiosity, residual and direct part; the parent retired.
+    /// inherited radiosity, residual, direct part and deposit; the parent
+    /// retired.
     pub(super) fn adopt(&self, parent: usize, children: &[usize]) -> Result<()> {
         let e = &self.elements;
         let upload = |t: usize| -> Result<()> {
@@ -131,6 +132,7 @@ impl Radiosity {
                 .texture("u_radiosity", &self.radiosity)
                 .texture("u_residual", &self.residual)
                 .texture("u_direct", &self.direct)
+                .texture("u_deposited", &self.deposit)
                 .ivec2("u_child_base", [cx as i32, cy as i32])
                 .ivec2("u_parent_base", [px as i32, py as i32])
                 .ivec2("u_quadrant", [quadrant[0] as i32, quadrant[1] as i32])

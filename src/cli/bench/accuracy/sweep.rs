@@ -285,7 +285,8 @@ fn differentials_rows(base: &Config, quick: bool) -> Vec<Config> {
 /// Progressive radiosity: its defaults, its caustic map from lights only,
 /// not shot on, at the scene's k, at k = 32 and on the scene's grid, the chapter's ~10,000 elements of
 /// CORNELL BOX (32 x 32 a patch side), shooters of 2 x 2 elements, a finer
-/// item buffer, and 4 spp.
+/// item buffer, final gather over the solution at 16, 64 and 256 rays a
+/// pixel, and 4 spp.
 fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
     let rad = |label: &str, spp: u32, f: &dyn Fn(&mut RadiosityOptions)| {
         base.by_tweaked(label, RunMethod::Radiosity, spp, f)
@@ -313,6 +314,11 @@ fn radiosity_rows(base: &Config, quick: bool) -> Vec<Config> {
         out.push(rad("radiosity, item buffer 1024", 1, &|o| {
             o.item_buffer = 1024
         }));
+        for rays in [16, 64, 256] {
+            out.push(rad(&format!("radiosity, final gather {rays}"), 1, &|o| {
+                o.gather_rays = rays
+            }));
+        }
         out.push(rad("radiosity, 4 spp", 4, &|_| {}));
     }
     out
