@@ -39,7 +39,6 @@ const MAX_FUNCTION_LINES: usize = 120;
 const LONG_TEST_FUNCTIONS: &[&str] = &[
     "tests/gpu/adaptive.rs: adaptive_sppm_computes_what_full_sppm_does_and_fills_as_its_twin",
     "tests/gpu/igi.rs: interleaving_and_upsampling_equal_their_cpu_twins",
-    "tests/gpu/radiosity.rs: a_diffuse_sphere_around_a_point_light_reaches_its_steady_state",
 ];
 
 /// The library module a file belongs to (`src/photon/trace.rs` -> `photon`).

@@ -130,11 +130,13 @@ fn igi_says_it_skips_vpls_that_would_light_nothing() {
     );
 }
 
-/// `--explain` on a scene with no mirror or glass (the closed box) says that radiosity's
-/// caustic deposit had nothing to deposit, not that light is missing, and
-/// says it is missing where `--shoot-caustics false` leaves it out.
+/// `--explain` on a scene with no mirror or glass (the closed box) says that
+/// radiosity's caustic deposit had nothing to deposit, not that light is
+/// missing, and says it is missing where `--shoot-caustics false` leaves it
+/// out. It says where the image reads the solution: at each pixel, naming
+/// the gather that reads it elsewhere, or where `--gather-rays` rays land.
 #[test]
-fn radiosity_explains_a_deposit_with_nothing_to_deposit() {
+fn radiosity_explains_its_deposit_and_where_it_reads_the_solution() {
     let d = TempDir::new("explain-radiosity");
     let explain = |args: &[&str]| {
         Run::new(["render", "--quiet", "--explain", "--width", "32"])
@@ -147,11 +149,18 @@ fn radiosity_explains_a_deposit_with_nothing_to_deposit() {
     };
     let err = explain(&[]);
     assert!(
-        err.contains("no caustic map's light was there to deposit") && !err.contains("is missing"),
+        err.contains("no caustic map's light was there to deposit")
+            && !err.contains("is missing")
+            && err.contains("(--gather-rays N reads it where rays from the pixel land)"),
         "{err}"
     );
     let err = explain(&["--shoot-caustics", "false"]);
     assert!(err.contains("L S+ D D+ is missing"), "{err}");
+    let err = explain(&["--gather-rays", "4"]);
+    assert!(
+        err.contains("final gather: 4 rays a pixel read the solution where they land"),
+        "{err}"
+    );
 }
 
 /// `--explain` says which footprint photon differentials sum, as
@@ -366,8 +375,17 @@ fn radiosity_runs_and_refuses_what_it_cannot_do() {
             .any(|w| (widest - w).abs() < 1e-4),
         "{widest}"
     );
-    let refused: [(&[&str], &str); 14] = [
+    let refused: [(&[&str], &str); 17] = [
         (&["--elements", "8"], "--method radiosity"),
+        (&["--gather-rays", "4"], "--method radiosity"),
+        (
+            &["--method", "radiosity", "--gather-rays", "5000"],
+            "0..=4096",
+        ),
+        (
+            &["--method", "radiosity", "--final-gather", "4"],
+            "--gather-rays N gathers over its solution",
+        ),
         (
             &["--caustic-scene-grid"],
             "add --method igi or --method radiosity",

@@ -276,3 +276,24 @@ pub fn blocks_against_path_tracer(
     }
     (n, chi2 / n as f64, worst)
 }
+
+/// A frame's first diffuse hits read back: the image's size, and each
+/// pixel's position (w > 0 where a hit), normal (w = material + 1) and
+/// throughput (w = the primitive).
+pub struct FirstHits {
+    pub width: u32,
+    pub height: u32,
+    pub position: Vec<[f32; 4]>,
+    pub normal: Vec<[f32; 4]>,
+    pub throughput: Vec<[f32; 4]>,
+}
+
+pub fn first_hits(direct: &photonmap::render::DirectLight) -> FirstHits {
+    FirstHits {
+        width: direct.diffuse_position.width,
+        height: direct.diffuse_position.height,
+        position: texels(&direct.diffuse_position),
+        normal: texels(&direct.diffuse_normal),
+        throughput: texels(&direct.diffuse_throughput),
+    }
+}

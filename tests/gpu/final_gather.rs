@@ -99,13 +99,13 @@ pub fn compare_with_twin(
     (seed, rays, k): (u32, u32, u32),
     (max_depth, fade): (u32, f32),
 ) -> TwinCheck {
-    let (w, h) = (
-        direct.diffuse_position.width,
-        direct.diffuse_position.height,
-    );
-    let first = common::texels(&direct.diffuse_position);
-    let first_normal = common::texels(&direct.diffuse_normal);
-    let first_throughput = common::texels(&direct.diffuse_throughput);
+    let common::FirstHits {
+        width: w,
+        height: h,
+        position: first,
+        normal: first_normal,
+        throughput: first_throughput,
+    } = common::first_hits(direct);
     let (gp, gn, gt) = (
         common::texels(&fg.rays.position),
         common::texels(&fg.rays.normal),

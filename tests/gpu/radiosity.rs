@@ -224,6 +224,19 @@ fn the_item_buffer_sees_what_shadow_rays_see() {
     assert_eq!(unexplained, 0);
 }
 
+/// The sphere around a point light's solution: 16 x 16 elements a tile in 8 x
+/// 8 shooters, 128^2 item buffers, 0.1% left unshot, no splits.
+pub(crate) fn sphere_options() -> RadiosityOptions {
+    RadiosityOptions {
+        resolution: 16,
+        substructure: 8,
+        item_buffer: 128,
+        convergence: 1e-3,
+        subdivide: 0,
+        ..RadiosityOptions::default()
+    }
+}
+
 /// A point light at the centre of a diffuse sphere of radius R = 1: every
 /// element of the inside receives I / R^2 = 1 directly, and at steady state
 /// B = rho / (1 - rho) everywhere, since every point of a sphere's inside
@@ -239,13 +252,8 @@ fn a_diffuse_sphere_around_a_point_light_reaches_its_steady_state() {
     let exact = 0.5 / (1.0 - 0.5);
     for form_factor in [FormFactor::Polygon, FormFactor::Disc] {
         let o = RadiosityOptions {
-            resolution: 16,
-            substructure: 8,
-            item_buffer: 128,
-            convergence: 1e-3,
-            subdivide: 0,
             form_factor,
-            ..RadiosityOptions::default()
+            ..sphere_options()
         };
         let out = solve(&s, o.clone());
         let report = out.radiosity().unwrap();

@@ -11,7 +11,7 @@ use photonmap::scene::Material;
 use photonmap::twins::final_gather::gather_ray;
 use photonmap::twins::radiosity::gathered_sum;
 
-use crate::radiosity::solve;
+use crate::radiosity::{solve, sphere_options};
 
 /// A point light at the centre of a closed diffuse sphere (radius 1, albedo
 /// rho = 1/2, I = 1): direct irradiance 1 everywhere, B = rho / (1 - rho) =
@@ -26,26 +26,21 @@ fn gathered_from_the_sphere_around_a_point_light_is_its_steady_state() {
     let scene = common::fixture("sphere_around_point_light");
     let rays = 8;
     let o = RadiosityOptions {
-        resolution: 16,
-        substructure: 8,
-        item_buffer: 128,
-        convergence: 1e-3,
-        subdivide: 0,
         gather_rays: rays,
-        ..RadiosityOptions::default()
+        ..sphere_options()
     };
     let out = solve(&scene, o);
     let run = out.radiosity_run().unwrap();
     let gather = run.gather.as_ref().expect("gather_rays > 0 gathers");
     assert_eq!(gather.rays.batch, rays, "one batch holds every ray");
     let direct = &out.state.direct;
-    let (w, h) = (
-        direct.diffuse_position.width,
-        direct.diffuse_position.height,
-    );
-    let first = common::texels(&direct.diffuse_position);
-    let first_normal = common::texels(&direct.diffuse_normal);
-    let first_throughput = common::texels(&direct.diffuse_throughput);
+    let common::FirstHits {
+        width: w,
+        height: h,
+        position: first,
+        normal: first_normal,
+        throughput: first_throughput,
+    } = common::first_hits(direct);
     let hits = common::texels(&gather.rays.position);
     let gathered = common::texels(&gather.gathered);
     let indirect = common::texels(&run.radiosity.indirect);

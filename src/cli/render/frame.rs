@@ -145,33 +145,8 @@ pub(super) fn print_summary(
             c.k()
         );
     }
-    if let Some(r) = out.radiosity() {
-        eprintln!(
-            "radiosity: {} patches in {} tiles of {} x {} ({} splits{}), {} elements; {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}; {}",
-            r.patches,
-            r.tiles,
-            r.element_resolution,
-            r.element_resolution,
-            r.splits,
-            if r.atlas_full { ", the atlas full" } else { "" },
-            r.elements,
-            r.shots,
-            r.seconds,
-            if r.converged { "converged" } else { "stopped at --max-shots" },
-            100.0 * r.unshot_fraction,
-            if out.photons().is_some() {
-                "from the caustic photon map"
-            } else {
-                "none (nothing specular in the scene)"
-            },
-            match out.radiosity_run().and_then(|run| run.gather.as_ref()) {
-                Some(g) => format!(
-                    "final gather of {} rays a pixel, direct light at their hits by shadow rays",
-                    g.rays_per_pixel()
-                ),
-                None => "the solution read at each pixel".to_string(),
-            }
-        );
+    if let Some(line) = radiosity_summary(out) {
+        eprintln!("{line}");
     }
     if let (Some(d), Some(s)) = (out.differentials(), out.footprint_estimates().first()) {
         let pilot = d.pilot_mean_diffuse_footprints.map_or(String::new(), |m| {
@@ -215,4 +190,35 @@ pub(super) fn print_summary(
     for (p, _) in written {
         eprintln!("wrote {p}");
     }
+}
+
+/// The stderr line on a radiosity solution, where the method made one.
+fn radiosity_summary(out: &render::RenderOutput) -> Option<String> {
+    let r = out.radiosity()?;
+    Some(format!(
+        "radiosity: {} patches in {} tiles of {} x {} ({} splits{}), {} elements; {} shots in {:.2} s, {}: {:.2}% of the power unshot; caustics {}; {}",
+        r.patches,
+        r.tiles,
+        r.element_resolution,
+        r.element_resolution,
+        r.splits,
+        if r.atlas_full { ", the atlas full" } else { "" },
+        r.elements,
+        r.shots,
+        r.seconds,
+        if r.converged { "converged" } else { "stopped at --max-shots" },
+        100.0 * r.unshot_fraction,
+        if out.photons().is_some() {
+            "from the caustic photon map"
+        } else {
+            "none (nothing specular in the scene)"
+        },
+        match out.radiosity_run().and_then(|run| run.gather.as_ref()) {
+            Some(g) => format!(
+                "final gather of {} rays a pixel, direct light at their hits by shadow rays",
+                g.rays_per_pixel()
+            ),
+            None => "the solution read at each pixel".to_string(),
+        }
+    ))
 }
