@@ -35,16 +35,12 @@ uniform int u_image_height;             // gather hits: ray j of the batch is ro
 
 layout(location = 0) out vec4 o_radiance;
 
-void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    o_radiance = vec4(0.0);
-    vec4 x = texelFetch(u_diffuse_position, px, 0);
-    if (x.w <= 0.0) return;
-    vec3 nf = texelFetch(u_diffuse_normal, px, 0).xyz;
-    vec4 throughput = texelFetch(u_diffuse_throughput, px, 0);
-    int prim = int(throughput.w);
-    Leaf leaf = leaf_at(prim, x.xyz, nf);
-    if (leaf.tile < 0) return;
+// The bilinear mean of B - B_direct (+ the deposit where `keep_deposit`)
+// over the elements around the point's (u, v) in its leaf, or 0 where its
+// side has no patch or no tile there.
+vec3 solution_at(int prim, vec3 x, vec3 nf, bool keep_deposit) {
+    Leaf leaf = leaf_at(prim, x, nf);
+    if (leaf.tile < 0) return vec3(0.0);
     int tile = leaf.tile, depth = leaf.depth;
     vec2 uv = leaf.uv * float(u_res) - 0.5;
     // Longitude wraps around a sphere and a cylinder (a whole patch's tile).
@@ -63,13 +59,24 @@ void main() {
             ivec2 t = base + e;
             if (texelFetch(u_element_position, t, 0).w <= 0.0) continue;
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
-            vec3 kept = u_gather != 0 ? texelFetch(u_deposited, t, 0).rgb : vec3(0.0);
+            vec3 kept = keep_deposit ? texelFetch(u_deposited, t, 0).rgb : vec3(0.0);
             b += w * (texelFetch(u_radiosity, t, 0).rgb - texelFetch(u_direct, t, 0).rgb + kept);
             wsum += w;
         }
     }
     if (wsum > 0.0) b /= wsum;
-    b = max(b, vec3(0.0));
+    return max(b, vec3(0.0));
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    o_radiance = vec4(0.0);
+    vec4 x = texelFetch(u_diffuse_position, px, 0);
+    if (x.w <= 0.0) return;
+    vec3 nf = texelFetch(u_diffuse_normal, px, 0).xyz;
+    vec4 throughput = texelFetch(u_diffuse_throughput, px, 0);
+    int prim = int(throughput.w);
+    vec3 b = solution_at(prim, x.xyz, nf, u_gather != 0);
     if (u_gather != 0) {
         // The gather ray's own stream: its pixel and its index among them.
         int j = px.y / u_image_height;

@@ -8,10 +8,13 @@
 //!
 //! A batch of rays a pixel is traced as final gather's are
 //! (`gather_rays.frag`, straight to the first surface: light that reaches
-//! the pixel through a mirror or glass is the caustic map's), the solution
-//! is read at each ray's hit by the same lookup as at the first hits
-//! (`lookup.frag`, whole radiosity: the hit's direct light is part of what
-//! it sends), and `gather_sum.frag` adds the batch to each pixel.
+//! the pixel through a mirror or glass is the caustic map's, with
+//! `--caustic-paths all`; `from-lights` leaves light a diffuse surface sends
+//! through them out, as the lookup at the pixel does), the solution is
+//! read at each ray's hit by the same lookup as at the first hits
+//! (`lookup.frag`: all the hit sends back, its direct light from a shadow
+//! ray a light instead of its element's), and `gather_sum.frag` adds the
+//! batch to each pixel.
 
 use crate::gpu::{DrawState, Gpu, Result, Target, TexFormat, Texture};
 use crate::render::final_gather::GatherRays;
@@ -69,7 +72,8 @@ impl SolutionGather {
             let rays = self.rays.batch.min(self.rays_per_pixel - done);
             gpu.finish();
             let t0 = std::time::Instant::now();
-            // No mirror or glass on the way: that light is the caustic map's.
+            // No mirror or glass on the way: that light is the caustic map's
+            // (with --caustic-paths all).
             self.rays.trace_batch(
                 textures,
                 direct.queries(),

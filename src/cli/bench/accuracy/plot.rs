@@ -53,6 +53,7 @@ pub fn csv(r: &AccuracyReport) -> String {
         let (sppm_iterations, gather_rays) = match x.method {
             RunMethod::Sppm { sppm_iterations } => (sppm_iterations, 0),
             RunMethod::FinalGather { gather_rays } => (0, gather_rays),
+            RunMethod::Radiosity(ref o) => (0, o.gather_rays),
             _ => (0, 0),
         };
         s += &format!(
