@@ -39,6 +39,11 @@ pub(super) fn bias_map(mean: &Image, reference: &Image) -> (Image, f64) {
     (out, scale as f64)
 }
 
+/// A CSV field in quotes, its quotes doubled: run labels hold commas.
+pub fn csv_quoted(t: &str) -> String {
+    format!("\"{}\"", t.replace('"', "\"\""))
+}
+
 pub fn csv(r: &AccuracyReport) -> String {
     let mut s = String::from("label,method,photons_stored,k,max_radius,leak,shadow_rays,build,grid,tile,spp,sppm_iterations,gather_rays,adaptive,vpl_paths,imperfect_visibility,interleave,downsample,seconds,rmse,bias_rmse,noise_rmse,rel_mse,ssim,pareto\n");
     for x in &r.runs {
@@ -58,7 +63,7 @@ pub fn csv(r: &AccuracyReport) -> String {
         };
         s += &format!(
             "{},{},{},{},{},{:?},{},{:?},{:?},{},{},{},{},{},{},{},{},{},{:.4},{:.6},{:.6},{:.6},{:.6},{:.6},{}\n",
-            x.label,
+            csv_quoted(&x.label),
             x.method.name(),
             x.photons_stored,
             x.k,

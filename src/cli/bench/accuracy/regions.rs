@@ -166,7 +166,7 @@ pub fn slug(label: &str) -> String {
 /// `regions.csv`: a row a run and region.
 pub fn csv(report: &AccuracyReport) -> String {
     let mut s = String::from("label,method,region,pixels,energy,energy_noise,rel_rmse,seconds\n");
-    let quote = |t: &str| format!("\"{}\"", t.replace('"', "\"\""));
+    let quote = super::plot::csv_quoted;
     for run in &report.runs {
         for (score, size) in run.regions.iter().zip(&report.regions) {
             s += &format!(
