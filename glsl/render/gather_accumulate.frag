@@ -6,29 +6,25 @@
 // indirect light is throughput_1 * albedo_1 * mean(L) over all its rays, so
 // each adds throughput_1 * albedo_1 * L / u_total_rays.
 #include "common/scene.glsl"
+#include "common/gather_pixel.glsl"
 
-uniform sampler2D u_diffuse_normal;      // the pixel's first diffuse hit, w = material + 1
-uniform sampler2D u_diffuse_throughput;
 uniform sampler2D u_gather_normal;       // the gather hits, w = material + 1
 uniform sampler2D u_gather_throughput;
 uniform sampler2D u_state_flux;          // the global map's estimate at each gather hit
 uniform isampler2D u_state_cursor;
 uniform int u_k;
 uniform float u_max_radius;
-uniform int u_batch;
-uniform int u_image_height;
-uniform float u_total_rays;
 
 layout(location = 0) out vec4 o_radiance;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     o_radiance = vec4(0.0);
-    int mat1 = int(texelFetch(u_diffuse_normal, px, 0).w) - 1;
-    if (mat1 < 0) return;
+    vec3 weight;
+    if (!gather_weight(px, weight)) return;
     vec3 sum = vec3(0.0);
     for (int j = 0; j < u_batch; ++j) {
-        ivec2 g = ivec2(px.x, px.y + j * u_image_height);
+        ivec2 g = gather_texel(px, j);
         int mat = int(texelFetch(u_gather_normal, g, 0).w) - 1;
         if (mat < 0) continue;
         vec4 flux = texelFetch(u_state_flux, g, 0);
@@ -39,7 +35,5 @@ void main() {
         vec3 throughput = texelFetch(u_gather_throughput, g, 0).rgb;
         sum += throughput * albedo / PI * flux.rgb / (PI * r2);
     }
-    vec3 albedo1 = material_texel(mat1, 1).rgb;
-    vec3 throughput1 = texelFetch(u_diffuse_throughput, px, 0).rgb;
-    o_radiance = vec4(throughput1 * albedo1 * sum / u_total_rays, 0.0);
+    o_radiance = vec4(weight * sum / u_total_rays, 0.0);
 }

@@ -119,6 +119,12 @@ impl GatherRays {
         })
     }
 
+    /// The height of the image whose rays these are (ray j of a batch is
+    /// row y + j x height).
+    pub fn image_height(&self) -> u32 {
+        self.height
+    }
+
     /// The hits of the last batch, as queries.
     pub fn queries(&self) -> QueryPoints<'_> {
         QueryPoints {

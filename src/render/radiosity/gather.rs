@@ -31,7 +31,6 @@ pub struct SolutionGather {
     pub gathered: Texture,
     gathered_target: Target,
     rays_per_pixel: u32,
-    height: u32,
 }
 
 impl SolutionGather {
@@ -44,7 +43,6 @@ impl SolutionGather {
             gathered,
             rays: rays_textures,
             rays_per_pixel: rays,
-            height,
         })
     }
 
@@ -94,7 +92,7 @@ impl SolutionGather {
                 Some(GatherBatch {
                     seed,
                     first_ray: done,
-                    image_height: self.height,
+                    image_height: self.rays.image_height(),
                 }),
                 &self.gathered_target,
             )?;
@@ -106,7 +104,7 @@ impl SolutionGather {
             direct.bind_weights(&mut b);
             b.texture("u_gathered", &self.gathered)
                 .int("u_batch", rays as i32)
-                .int("u_image_height", self.height as i32)
+                .int("u_image_height", self.rays.image_height() as i32)
                 .float("u_total_rays", self.rays_per_pixel as f32)
                 .draw_fullscreen(&radiosity.indirect_target, &DrawState::ADDITIVE)?;
             drop(b);
