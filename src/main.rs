@@ -33,7 +33,7 @@ enum Command {
     Reference(cli::reference::ReferenceArgs),
     Regress(cli::regress::RegressArgs),
     Tables(cli::tables::TablesArgs),
-    #[command(subcommand)]
+    #[command(subcommand, about = cli::bench::ABOUT)]
     Bench(cli::bench::BenchCommand),
     Info(cli::info::InfoArgs),
     Scenes(cli::scenes::ScenesArgs),

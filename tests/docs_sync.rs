@@ -90,6 +90,29 @@ fn cli_page() -> String {
     page
 }
 
+/// Every command that a `Commands:` list names, at every level, says what
+/// it does on its line (clap prints a bare name for a command without one).
+#[test]
+fn every_command_is_described_where_its_parent_lists_it() {
+    let mut all = Vec::new();
+    commands(&mut Vec::new(), &mut all);
+    let mut bare = Vec::new();
+    for (path, text) in &all {
+        let listed = text
+            .lines()
+            .skip_while(|l| *l != "Commands:")
+            .skip(1)
+            .take_while(|l| !l.trim().is_empty())
+            .filter(|l| l.starts_with("  ") && !l[2..].starts_with(' '));
+        for line in listed {
+            if line.split_whitespace().nth(1).is_none() {
+                bare.push(format!("photonmap {} {}", path.join(" "), line.trim()));
+            }
+        }
+    }
+    assert!(bare.is_empty(), "listed with no description: {bare:?}");
+}
+
 #[test]
 fn the_command_reference_is_the_programs_own_help() {
     let want = cli_page();

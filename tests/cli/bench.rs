@@ -42,7 +42,10 @@ fn bench_meshes_reports_every_size_with_rates_renders_and_a_plot() {
     let report = Run::new(["bench", "meshes", "--triangles", "8,2000", "--width", "48"])
         .args(["--height", "32", "--photons", "4096", "--json"])
         .writing("--out", &d)
+        .umask(0o077)
         .json();
+    // Its JSON, SVG and renders are 0600, as new files are under umask 077.
+    assert!(common::assert_output_modes(&d, 0o077) >= 4);
     let rows = report["rows"].as_array().unwrap();
     // The analytic ball, then the meshes as generated (the UV sphere rounds the count).
     let triangles: Vec<u64> = rows

@@ -1,10 +1,11 @@
 //! `render`'s output files: by extension, several at once, with provenance;
 //! written all or nothing, so an output that cannot be written, or a full
-//! disk, leaves no partial file and the previous output intact.
+//! disk, leaves no partial file and the previous output intact; and every
+//! command's outputs take the mode the umask gives a new file.
 
 use std::process::Command;
 
-use crate::common::{Printed, Run, TempDir};
+use crate::common::{assert_output_modes, root, Printed, Run, TempDir};
 
 use photonmap::render::Image;
 
@@ -134,4 +135,63 @@ fn a_full_disk_leaves_no_partial_file_and_keeps_the_previous_output() {
     assert!(err.contains("No space left"), "{err}");
     assert_eq!(left.len(), 1, "{left:?}");
     assert_eq!(kept, previous);
+}
+
+/// Under umask 022 every output is 0644, under 077 it is 0600, as
+/// `File::create` makes them, though each is written through a temporary
+/// file (made 0600) and renamed: `render` (PNG, EXR, PFM, a replaced output
+/// made 0600 before), `convert`, `compare` (difference image, JUnit, HTML),
+/// `merge --passes` and `convert-scene`. The other commands' tests check
+/// theirs (`tables`, `bench`, `reference`, `regress`).
+#[test]
+fn outputs_take_the_mode_the_umask_gives() {
+    for umask in [0o022, 0o077] {
+        let d = TempDir::new(&format!("umask{umask:03o}"));
+        let out = |name: &str| d.join(format!("out/{name}"));
+        std::fs::create_dir_all(d.join("out")).unwrap();
+        // An output there before, private: the new one takes the umask's mode.
+        std::fs::write(out("a.png"), b"before").unwrap();
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let private = std::fs::Permissions::from_mode(0o600);
+            std::fs::set_permissions(out("a.png"), private).unwrap();
+        }
+        for (seed, name) in [("1", "a"), ("2", "b")] {
+            Run::new([
+                "render", "ring", "--quiet", "--width", "16", "--height", "12",
+            ])
+            .args(["--seed", seed])
+            .output_to(out(&format!("{name}.png")))
+            .output_to(out(&format!("{name}.exr")))
+            .output_to(out(&format!("{name}.pfm")))
+            .umask(umask)
+            .succeeds();
+        }
+        Run::new(["convert"])
+            .arg(out("a.exr"))
+            .writing_arg(out("converted.png"))
+            .umask(umask)
+            .succeeds();
+        Run::new(["compare"])
+            .arg(out("a.exr"))
+            .arg(out("b.exr"))
+            .writing("--diff", out("diff.png"))
+            .writing("--junit", out("compare.xml"))
+            .writing("--html", out("compare.html"))
+            .umask(umask)
+            .succeeds();
+        Run::new(["merge", "--passes"])
+            .writing_arg(out("merged.exr"))
+            .arg(out("a.exr"))
+            .arg(out("b.exr"))
+            .umask(umask)
+            .succeeds();
+        Run::new(["convert-scene"])
+            .arg(root().join("scenes/tests/import/cornell_box.pbrt"))
+            .writing_arg(out("cornell.toml"))
+            .umask(umask)
+            .succeeds();
+        let files = assert_output_modes(&d.join("out"), umask);
+        assert!(files >= 12, "{files} files checked");
+    }
 }

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::common::{Run, TempDir};
+use crate::common::{assert_output_modes, Run, TempDir};
 
 #[test]
 fn reference_and_accuracy_bench_write_their_results() {
@@ -15,7 +15,10 @@ fn reference_and_accuracy_bench_write_their_results() {
         .args(["--photons-per-iteration", "4096", "--quiet"])
         .writing("--out", &reference)
         .scene("glass_ball")
+        .umask(0o077)
         .succeeds();
+    // The EXR and its JSON are 0600, as a new file is under umask 077.
+    assert!(assert_output_modes(&d, 0o077) >= 2);
     let info: serde_json::Value =
         serde_json::from_slice(&std::fs::read(reference.with_extension("json")).unwrap()).unwrap();
     assert_eq!(
@@ -44,7 +47,10 @@ fn reference_and_accuracy_bench_write_their_results() {
     .arg("--reference")
     .arg(&reference)
     .writing("--out", &results)
+    .umask(0o022)
     .json();
+    // Its CSV, JSON, SVG and PNGs are 0644, as new files are under umask 022.
+    assert!(assert_output_modes(&results, 0o022) >= 4);
     let runs = v["runs"].as_array().unwrap();
     assert!(runs.len() >= 10, "{} runs", runs.len());
     let num = |r: &serde_json::Value, f: &str| r[f].as_f64().unwrap();

@@ -23,6 +23,7 @@ fn regress_catches_a_brighter_light_a_shifted_camera_and_a_missing_caustic() {
         .writing("--junit", &junit)
         .writing("--out", d.join(label))
         .in_dir(common::root())
+        .umask(0o077)
         .run();
         let v: serde_json::Value = serde_json::from_slice(&out.stdout)
             .unwrap_or_else(|_| panic!("{label}: {}", out.stderr_text()));
@@ -58,4 +59,6 @@ fn regress_catches_a_brighter_light_a_shifted_camera_and_a_missing_caustic() {
             assert!(d.join(label).join(f).is_file(), "{label}: {f}");
         }
     }
+    // Its JUnit XML and images are 0600, as new files are under umask 077.
+    assert!(common::assert_output_modes(&d, 0o077) >= 12);
 }

@@ -1,14 +1,17 @@
 //! `photonmap tables --quick`: every table and figure of the paper, with sane
 //! values, beside the paper's own figures.
 
-use crate::common::{Run, TempDir};
+use crate::common::{assert_output_modes, Run, TempDir};
 
 #[test]
 fn tables_quick_produces_every_table_with_sane_values() {
     let d = TempDir::new("tables");
     let v = Run::new(["tables", "--quick", "--json", "--quiet"])
         .writing("--out", &d)
+        .umask(0o022)
         .json();
+    // Every file it wrote is 0644, as a new file is under umask 022.
+    assert!(assert_output_modes(&d, 0o022) > 0);
     // Table 1: 3 scenes x 2 builds x 4 stages, positive times, the paper's figures beside them.
     let t1 = v["table1"].as_array().unwrap();
     assert_eq!(t1.len(), 24);

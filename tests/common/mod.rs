@@ -297,3 +297,23 @@ pub fn first_hits(direct: &photonmap::render::DirectLight) -> FirstHits {
         throughput: texels(&direct.diffuse_throughput),
     }
 }
+
+/// Every file under `path` (a file, or a folder walked whole) has the mode
+/// that `File::create` gives under `umask`: 0666 less the mask. Returns how
+/// many files it checked.
+pub fn assert_output_modes(path: &Path, umask: u32) -> usize {
+    use std::os::unix::fs::PermissionsExt;
+    let meta = std::fs::metadata(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    if meta.is_dir() {
+        let entries = std::fs::read_dir(path).unwrap().flatten();
+        return entries.map(|e| assert_output_modes(&e.path(), umask)).sum();
+    }
+    let mode = meta.permissions().mode() & 0o777;
+    assert_eq!(
+        mode,
+        0o666 & !umask,
+        "{} is {mode:03o} under umask {umask:03o}",
+        path.display()
+    );
+    1
+}

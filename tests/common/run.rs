@@ -77,6 +77,30 @@ impl Run {
         self
     }
 
+    /// Runs it under this umask (octal, as the shell's `umask` takes it):
+    /// through `sh -c 'umask M && exec ...'`, the same program, arguments,
+    /// folder and environment.
+    pub fn umask(mut self, mask: u32) -> Self {
+        let mut wrapped = Command::new("sh");
+        wrapped
+            .arg("-c")
+            .arg(format!("umask {mask:03o} && exec \"$0\" \"$@\""))
+            .arg(self.command.get_program())
+            .args(self.command.get_args());
+        if let Some(dir) = self.command.get_current_dir() {
+            wrapped.current_dir(dir);
+        }
+        for (key, value) in self.command.get_envs() {
+            match value {
+                Some(v) => wrapped.env(key, v),
+                None => wrapped.env_remove(key),
+            };
+        }
+        self.command = wrapped;
+        self.shown = format!("(umask {mask:03o}) {}", self.shown);
+        self
+    }
+
     pub fn env(mut self, key: &str, value: impl AsRef<OsStr>) -> Self {
         self.command.env(key, value);
         self

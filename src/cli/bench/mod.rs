@@ -25,6 +25,11 @@ use clap::Subcommand;
 
 use photonmap::gpu::Platform;
 
+/// `bench`'s line in `photonmap --help`.
+pub const ABOUT: &str = "Benchmarks with results to commit: stress, accuracy against a reference, \
+    meshes, IGI, differentials, against Mitsuba 3, the computation mask, builds and the \
+    estimate (`bench <name> --help`)";
+
 #[derive(Subcommand)]
 pub enum BenchCommand {
     /// The stress suite: scale and place, sizes, crowding, grids, search edges,
