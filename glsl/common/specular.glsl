@@ -15,6 +15,20 @@ vec3 specular_about(vec3 d, vec3 m, float ior, bool entering, float u) {
     return u < f ? reflect(d, m) : eta * d + (eta * cos_i - cos_t) * m;
 }
 
+// What a path that carries radiance (an eye path, a gather ray) multiplies
+// its throughput by as it leaves d for next at the surface whose geometric
+// normal nf faces d: (eta_i / eta_t)^2 where it refracts, 1 otherwise.
+// Radiance crossing from index eta_t into eta_i scales so (Veach's thesis,
+// 5.2: the solid angle is compressed on the denser side); a path that enters
+// glass and leaves it again takes eta and 1 / eta, so through a closed ball
+// the two cancel. Photons and VPLs carry flux, which refraction does not
+// scale: light paths never call this.
+float radiance_refraction_scale(vec3 next, vec3 nf, float ior, bool entering) {
+    if (ior == 0.0 || dot(next, nf) >= 0.0) return 1.0;
+    float eta = entering ? 1.0 / ior : ior;
+    return eta * eta;
+}
+
 // The same about the shading normal ms (on the side of the geometric normal
 // nf, both facing d), unless d arrives from behind ms, or the new direction
 // leaves on the wrong side of the geometric surface (a reflection below it,

@@ -1,7 +1,10 @@
 // The next ray of an eye path at a mirror or glass hit. Glass chooses
 // reflection with probability F (exact Fresnel) and refraction otherwise, so the
-// throughput needs no weight (F / F = (1 - F) / (1 - F) = 1): one path per
-// pixel whose expectation equals the split tree (ARCHITECTURE.md). On a
+// Fresnel weight cancels (F / F = (1 - F) / (1 - F) = 1): one path per
+// pixel whose expectation equals the split tree (ARCHITECTURE.md). Where it
+// refracts, the path's throughput takes radiance's (eta_i / eta_t)^2
+// (common/specular.glsl): a surface seen inside glass or water is that much
+// dimmer from outside. On a
 // triangle with vertex normals the direction is taken about the shading
 // normal (common/specular.glsl); the geometric normal still moves the origin.
 // render/specular.frag (a pass per depth) and render/eye_path.frag (fused)
@@ -12,7 +15,8 @@
 
 // At hit p (geometric normal n, primitive prim, material mat of kind kind,
 // mirror or glass) of a ray along d: the next ray's origin and direction, and
-// the throughput times the mirror's colour.
+// the throughput times the mirror's colour or, where it refracts, radiance's
+// scale.
 void specular_step(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int prim, int mat,
                    int kind, inout vec3 throughput, out vec3 origin, out vec3 next) {
     bool entering = dot(n, d) < 0.0;
@@ -35,6 +39,7 @@ void specular_step(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int p
     } else {
         next = specular_about(d, nf, ior, entering, u);
     }
+    throughput *= radiance_refraction_scale(next, nf, ior, entering);
     next = normalize(next);
     origin = offset_origin(p, nf, next);
 }

@@ -4,7 +4,8 @@
 // ray j of pixel (x, y). Each ray leaves the pixel's first diffuse hit
 // cosine-distributed about its viewer-facing normal, follows mirrors and glass
 // as eye paths do (glass chooses by Fresnel, so no weight), and ends at the
-// first diffuse hit, which becomes a query of the global photon map. A ray that
+// first diffuse hit, which becomes a query of the global photon map; where it
+// refracts it takes radiance's (eta_i / eta_t)^2, as eye paths do. A ray that
 // leaves the scene or meets an emitter gathers nothing: direct light is the
 // shadow rays', and light reaching the pixel by specular paths alone is the
 // caustic map's. Rays are cosine-distributed about the geometric normal, as
@@ -96,6 +97,8 @@ void main() {
         } else {
             next = specular_about(d, nf, ior, entering, u);
         }
+        // A gather ray carries radiance back to the pixel, as an eye path does.
+        throughput *= radiance_refraction_scale(next, nf, ior, entering);
         d = normalize(next);
         o = offset_origin(p, nf, d);
     }

@@ -10,7 +10,9 @@ use crate::scene::{Material, Scene};
 use super::knn::{knn_grid, CpuPhotonMap};
 use super::random::{rng_init, rng_next};
 use super::ray_trace::{closest_hit, offset_scale};
-use super::shading::{facing_shading_normal, specular_about, specular_shaded};
+use super::shading::{
+    facing_shading_normal, radiance_refraction_scale, specular_about, specular_shaded,
+};
 
 /// Where a gather ray ends: the diffuse hit that queries the global map.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -86,8 +88,9 @@ pub fn gather_ray(
             specular_shaded(d, nf, ms, ior, entering, u).0
         } else {
             specular_about(d, nf, ior, entering, u)
-        }
-        .normalize();
+        };
+        throughput *= radiance_refraction_scale(next, nf, ior, entering);
+        let next = next.normalize();
         d = next;
         o = offset_origin(p, nf, d, floor);
     }

@@ -12,7 +12,9 @@ use crate::scene::pack::PackedScene;
 use super::intersect::intersect_geometry;
 use super::light::{area_light_point, sample_light_triangle};
 use super::random::{rng_init, rng_next};
-use super::shading::{facing_shading_normal, fresnel_dielectric, specular_about};
+use super::shading::{
+    facing_shading_normal, fresnel_dielectric, radiance_refraction_scale, specular_about,
+};
 
 /// Closest hit: (shape index, t, point, geometric normal).
 pub fn closest_hit(scene: &Scene, o: Vec3, d: Vec3) -> Option<(usize, f32, Vec3, Vec3)> {
@@ -214,11 +216,13 @@ fn specular_moments(
     let s = offset_scale(p, 1e-6 * scene.size());
     let (mut m1, mut m2) = (Vec3::ZERO, Vec3::ZERO);
     for (w, next) in taken {
+        // Radiance's (eta_i / eta_t)^2 where the branch refracts.
+        let scale = radiance_refraction_scale(next, nf, ior, entering);
         let next = next.normalize();
         let origin = p + if next.dot(nf) >= 0.0 { s } else { -s } * nf;
         let (b1, b2) = expected_moments(scene, origin, next, depth_left - 1, grid);
-        m1 += w * b1;
-        m2 += w * b2;
+        m1 += w * scale * b1;
+        m2 += w * scale * scale * b2;
     }
     (m1, m2)
 }

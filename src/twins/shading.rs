@@ -76,6 +76,18 @@ pub fn specular_about(d: Vec3, m: Vec3, ior: f32, entering: bool, u: f32) -> Vec
     }
 }
 
+/// What a radiance-carrying path's throughput takes leaving for `next` at a
+/// surface whose geometric normal nf faces the incoming ray: (eta_i /
+/// eta_t)^2 where it refracts, else 1 (`radiance_refraction_scale` in
+/// common/specular.glsl).
+pub fn radiance_refraction_scale(next: Vec3, nf: Vec3, ior: f32, entering: bool) -> f32 {
+    if ior == 0.0 || next.dot(nf) >= 0.0 {
+        return 1.0;
+    }
+    let eta = if entering { 1.0 / ior } else { ior };
+    eta * eta
+}
+
 /// About the shading normal ms unless d comes from behind it or the result
 /// leaves on the wrong side of the geometric surface (then about nf); and
 /// whether ms was used.

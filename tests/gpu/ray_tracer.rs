@@ -131,6 +131,31 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
     );
 }
 
+/// A surface seen only through glass (a diffuse square and a point light
+/// sealed in a glass ball) is dimmer by radiance's 1 / ior^2 where the eye
+/// path enters: the GPU's mean over seeds meets the twin's split tree with
+/// the factor, and is told apart from the same tree without it (the square's
+/// albedo times ior^2 stands for it, as every path to the square enters the
+/// ball once and leaves it never).
+#[test]
+fn a_surface_inside_glass_is_seen_dimmer_by_radiance_eta_squared() {
+    let scene = common::fixture("glass_inside");
+    let images = direct_renders(&scene, 1..129);
+    let mut unscaled = scene.clone();
+    let ior: f32 = 1.5;
+    for m in unscaled.materials.iter_mut() {
+        if let photonmap::scene::Material::Diffuse { albedo } = m {
+            *albedo *= ior * ior;
+        }
+    }
+    assert_converges_to_split_tree(
+        &images,
+        (&scene, "the split tree with (eta_i / eta_t)^2"),
+        (&unscaled, "the tree without it"),
+        0.8,
+    );
+}
+
 #[test]
 fn an_emitter_seen_directly_shows_its_radiance() {
     let gpu = common::gpu();

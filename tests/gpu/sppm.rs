@@ -8,7 +8,7 @@ use glam::Vec3;
 use photonmap::photon::{BuildMethod, PhotonConfig};
 use photonmap::render::software::CpuPhotonMap;
 use photonmap::render::sppm::{render_sppm, Sppm, SppmOptions};
-use photonmap::render::{Image, Method, PhotonMapOptions, RenderOptions};
+use photonmap::render::{render, Image, Method, PhotonMapOptions, RenderOptions};
 use photonmap::scene::{load_scene_str, Material, Scene};
 use photonmap::timing::Timings;
 use photonmap::twins::sppm::{update, PixelState, VisiblePoint};
@@ -263,6 +263,54 @@ fn sppm_agrees_with_an_independent_path_tracer() {
         100.0 * worst
     );
     assert!(chi2_n < 3.0, "chi^2/n = {chi2_n}");
+}
+
+/// The furnace seen from inside glass (`scenes/tests/furnace_in_glass.toml`):
+/// the camera and the point light at the centre of a glass ball in the
+/// closed diffuse sphere. The ball is lossless, so the walls' radiance stays
+/// the furnace's uniform L = rho I / (pi R^2 (1 - rho)), and a camera in the
+/// glass sees it ior^2 = 2.25 times as bright (radiance's (eta_i / eta_t)^2
+/// where the eye path leaves the glass). The field is uniform, so SPPM and
+/// the paper's kNN estimate are unbiased here (hat-box theorem, as in the
+/// furnace) and their error is noise: each method's mean over 8 seeds must
+/// lie within 4 of its standard errors (from the seeds' spread) of the
+/// closed form, and that error must be small enough to tell ior^2 from ior.
+#[test]
+fn the_furnace_seen_from_inside_glass_is_ior_squared_as_bright() {
+    let scene = common::fixture("furnace_in_glass");
+    let expected = 1.5f64.powi(2) * 0.5 / (std::f64::consts::PI * 0.5);
+    let sppm = SppmOptions {
+        iterations: 32,
+        photons_per_iteration: 1 << 14,
+        initial_radius: Some(0.1),
+        ..SppmOptions::default()
+    };
+    let gpu = common::gpu();
+    let methods: [(&str, &dyn Fn(u32) -> Image); 2] = [
+        ("SPPM", &|seed| sppm_image(&scene, 32, 32, seed, &sppm)),
+        ("the paper's method", &|seed| {
+            let mut o = RenderOptions::for_scene(&scene);
+            (o.width, o.height, o.seed) = (32, 32, seed);
+            render(&gpu, &scene, &o, &mut ()).unwrap().image
+        }),
+    ];
+    for (name, image) in methods {
+        let ratios: Vec<f64> = (1..=8)
+            .map(|seed| mean_of(&image(seed)) / expected)
+            .collect();
+        let mean = ratios.iter().sum::<f64>() / 8.0;
+        let sd = (ratios.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / 7.0).sqrt();
+        let se = sd / 8f64.sqrt();
+        eprintln!("furnace in glass, {name}: {mean:.4} +- {se:.4} of ior^2 L (seeds {ratios:.4?})");
+        assert!(
+            se < 0.01,
+            "{name}: the test lost its power (standard error {se})"
+        );
+        assert!(
+            (mean - 1.0).abs() < 4.0 * se,
+            "{name}: {mean} +- {se} of ior^2 L"
+        );
+    }
 }
 
 /// Energy: inside a closed diffuse sphere (radius 1, albedo rho) with a point
