@@ -1,7 +1,8 @@
 //! Regions of the image that an error can be split by: the diffuse surfaces
 //! the pixels see first, read back from the ray tracer's own first-hit
-//! record, and rectangles the user names. `bench accuracy --regions` reports
-//! each method's energy and error in each.
+//! record, and rectangles the user names (`NAME=X0:X1:Y0:Y1`). `bench
+//! accuracy --regions` reports each method's energy and error in each, and
+//! `bench mitsuba --region` each image's energy in the rectangles.
 
 use crate::gpu::{Gpu, Result};
 use crate::render::{render, RenderOptions};
@@ -28,6 +29,33 @@ pub struct Rectangle {
     pub x1: u32,
     pub y0: u32,
     pub y1: u32,
+}
+
+/// `NAME=X0:X1:Y0:Y1`: whole pixels, X0 < X1, Y0 < Y1, ends excluded (the
+/// form `--region` takes).
+impl std::str::FromStr for Rectangle {
+    type Err = String;
+
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        let usage =
+            || format!("{text:?}: expected NAME=X0:X1:Y0:Y1 (whole pixels, X0 < X1, Y0 < Y1)");
+        let (name, bounds) = text.rsplit_once('=').ok_or_else(usage)?;
+        let numbers: Vec<u32> = bounds
+            .split(':')
+            .map(str::parse)
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|_| usage())?;
+        match numbers[..] {
+            [x0, x1, y0, y1] if !name.is_empty() && x0 < x1 && y0 < y1 => Ok(Rectangle {
+                name: name.to_string(),
+                x0,
+                x1,
+                y0,
+                y1,
+            }),
+            _ => Err(usage()),
+        }
+    }
 }
 
 impl Rectangle {
@@ -153,5 +181,29 @@ fn surface_name(scene: &Scene, shape: usize, plane: Option<(glam::Vec3, glam::Ve
         (None, Geometry::Sphere { center, .. }) => format!("sphere {shape} at {}", at(center)),
         (None, Geometry::Cylinder { base, .. }) => format!("cylinder {shape} at {}", at(base)),
         (None, _) => format!("shape {shape}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Rectangle;
+
+    #[test]
+    fn rectangles_parse_and_refuse() {
+        let r: Rectangle = "under the balls=0:256:190:215".parse().unwrap();
+        assert_eq!(
+            (r.name.as_str(), r.x0, r.x1, r.y0, r.y1),
+            ("under the balls", 0, 256, 190, 215)
+        );
+        for bad in [
+            "ceiling",
+            "=0:1:0:1",
+            "a=0:1:0",
+            "a=1:1:0:1",
+            "a=0:1:x:1",
+            "a=0:1:0:-1",
+        ] {
+            assert!(bad.parse::<Rectangle>().is_err(), "{bad}");
+        }
     }
 }

@@ -154,13 +154,18 @@ fn bench_mitsuba_and_tables_refuse_what_they_cannot_do() {
 
 /// `bench mitsuba` refuses a budget that is not a positive number of
 /// seconds, a --reference or --mask that is not there, a mask of another
-/// size, and a --mitsuba-reference that cannot be made, before it runs
-/// Mitsuba or writes anything.
+/// size, a --mitsuba-reference that cannot be made, and a --region that is
+/// malformed, outside the reference or all masked, before it runs Mitsuba
+/// or writes anything.
 #[test]
 fn bench_mitsuba_refuses_bad_budgets_references_and_masks() {
     let d = TempDir::new("bench-mitsuba");
     let out_dir = d.join("out");
-    let refused: [(&[&str], &str); 10] = [
+    let refused: [(&[&str], &str); 13] = [
+        (&["--region", "floor=0:10:5"], "NAME=X0:X1:Y0:Y1"),
+        (&["--region", "floor=0:257:0:10"], "outside the reference's 256 x 192"),
+        // The truth's mask of GLASS BALL leaves out its top-left corner (the black sky).
+        (&["--region", "corner=0:1:0:1"], "the mask leaves none"),
         (&["--seconds", "0"], "--seconds"),
         (&["--mitsuba-reference", "0"], "--mitsuba-reference"),
         (&["--mitsuba-reference", "10", "--scale", "3"], "--scale 3"),

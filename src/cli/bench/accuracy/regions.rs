@@ -39,29 +39,13 @@ impl RegionArgs {
     }
 
     fn rectangles(&self) -> Result<Vec<Rectangle>> {
-        self.region.iter().map(|r| parse_rectangle(r)).collect()
-    }
-}
-
-/// `NAME=X0:X1:Y0:Y1`.
-fn parse_rectangle(text: &str) -> Result<Rectangle> {
-    let usage = "NAME=X0:X1:Y0:Y1 (whole pixels, X0 < X1, Y0 < Y1)";
-    let Some((name, bounds)) = text.rsplit_once('=') else {
-        bail!("--region {text:?}: expected {usage}");
-    };
-    let numbers: Vec<u32> = match bounds.split(':').map(str::parse).collect() {
-        Ok(n) => n,
-        Err(_) => bail!("--region {text:?}: expected {usage}"),
-    };
-    match numbers[..] {
-        [x0, x1, y0, y1] if !name.is_empty() && x0 < x1 && y0 < y1 => Ok(Rectangle {
-            name: name.to_string(),
-            x0,
-            x1,
-            y0,
-            y1,
-        }),
-        _ => bail!("--region {text:?}: expected {usage}"),
+        self.region
+            .iter()
+            .map(|r| {
+                r.parse()
+                    .map_err(|e: String| anyhow::anyhow!("--region {e}"))
+            })
+            .collect()
     }
 }
 
@@ -245,25 +229,6 @@ pub fn print_table(report: &AccuracyReport) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn rectangles_parse_and_refuse() {
-        let r = parse_rectangle("under the balls=0:256:190:215").unwrap();
-        assert_eq!(
-            (r.name.as_str(), r.x0, r.x1, r.y0, r.y1),
-            ("under the balls", 0, 256, 190, 215)
-        );
-        for bad in [
-            "ceiling",
-            "=0:1:0:1",
-            "a=0:1:0",
-            "a=1:1:0:1",
-            "a=0:1:x:1",
-            "a=0:1:0:-1",
-        ] {
-            assert!(parse_rectangle(bad).is_err(), "{bad}");
-        }
-    }
 
     #[test]
     fn slugs_are_file_names() {

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use photonmap::bench::regions::Rectangle;
+
 use crate::cli::args::in_range;
 use crate::cli::bench::output::BenchOutput;
 
@@ -36,6 +38,12 @@ pub struct MitsubaBenchArgs {
     /// pixel).
     #[arg(long, value_name = "PNG")]
     pub mask: Option<PathBuf>,
+    /// A rectangle in which every image's energy is reported against the
+    /// reference's: NAME=X0:X1:Y0:Y1, columns X0..X1 and rows Y0..Y1 of the
+    /// reference's pixels, row 0 at the top, ends excluded, less what the
+    /// mask leaves out. The table goes to regions.md. Repeat it for more.
+    #[arg(long, value_name = "NAME=X0:X1:Y0:Y1", value_parser = rectangle)]
+    pub region: Vec<Rectangle>,
     /// Wall-time budgets in seconds (e.g. 30,60,120): photonmap's SPPM at
     /// its defaults and each Mitsuba integrator render for each; the longest
     /// also records the convergence curves.
@@ -74,6 +82,11 @@ fn max_depth(s: &str) -> Result<i32, String> {
         Ok(v) if v == -1 || (1..=1024).contains(&v) => Ok(v),
         _ => Err(format!("{s}: give -1 (no limit) or a depth in 1..=1024")),
     }
+}
+
+/// `--region`'s NAME=X0:X1:Y0:Y1.
+fn rectangle(s: &str) -> Result<Rectangle, String> {
+    s.parse()
 }
 
 /// A budget: a positive number of seconds, at most a day.

@@ -25,6 +25,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 
+use photonmap::bench::regions::Region;
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::render::sppm::{render_sppm, SppmOptions};
 use photonmap::render::{render, EstimatePass, RenderObserver};
@@ -148,8 +149,13 @@ fn race(
 
 /// Everything before the races: the reference (checked, or made by
 /// Mitsuba with --mitsuba-reference), the output folder, and the export and
-/// script Mitsuba runs from. Returns the reference, its scale and the folder.
-fn prepare(a: &MitsubaBenchArgs, scene: &Scene, name: &str) -> Result<(Target, u32, PathBuf)> {
+/// script Mitsuba runs from. Returns the reference, its scale, the folder
+/// and the `--region`s.
+fn prepare(
+    a: &MitsubaBenchArgs,
+    scene: &Scene,
+    name: &str,
+) -> Result<(Target, u32, PathBuf, Vec<Region>)> {
     let given = match a.mitsuba_reference {
         None => Some(score::target(a, scene, name)?),
         Some(_) => None,
@@ -162,6 +168,11 @@ fn prepare(a: &MitsubaBenchArgs, scene: &Scene, name: &str) -> Result<(Target, u
         Some(_) => None,
         None => score::mask_of_size(a, width, height)?,
     };
+    let mask = match &given {
+        Some((t, _)) => t.mask.as_ref(),
+        None => mitsuba_mask.as_ref(),
+    };
+    let regions = score::regions(a, (width, height), mask.map(|m| m.1.as_slice()))?;
     runner::check_mitsuba(a)?;
     let dir = folder(a.out.as_deref(), "mitsuba", Some(name))?;
     runner::write_inputs(&dir, scene, (width, height), a.max_depth)?;
@@ -169,19 +180,20 @@ fn prepare(a: &MitsubaBenchArgs, scene: &Scene, name: &str) -> Result<(Target, u
         Some(t) => t,
         None => score::mitsuba_target(a, &dir, mitsuba_mask, &a.output.progress())?,
     };
-    Ok((target, scale, dir))
+    Ok((target, scale, dir, regions))
 }
 
 pub fn run(a: &MitsubaBenchArgs, platform: Platform) -> Result<()> {
     let scene = embedded::load_path_or_name(&a.scene)?;
     let name = stem(&a.scene);
-    let (target, scale, dir) = prepare(a, &scene, &name)?;
+    let (target, scale, dir, regions) = prepare(a, &scene, &name)?;
     let (width, height) = (target.image.width, target.image.height);
     let progress = a.output.progress();
     let gpu = crate::cli::gpu(platform)?;
     let bench = Bench {
         dir: &dir,
         target: &target,
+        regions: &regions,
         width,
         height,
     };

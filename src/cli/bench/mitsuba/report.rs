@@ -34,8 +34,20 @@ pub struct Row {
     /// Mean of (a - b)^2 / (b^2 + 0.01).
     pub rel_mse: f64,
     pub rmse: f64,
+    /// The image's energy in each `--region`, against the reference's.
+    pub regions: Vec<RegionEnergy>,
     /// PNG in the out folder (the EXR beside it has the same stem).
     pub image: String,
+}
+
+/// An image's mean over the reference's in one `--region` (channels
+/// averaged, within the mask).
+#[derive(Serialize, Clone, Debug)]
+pub struct RegionEnergy {
+    pub name: String,
+    /// Its compared pixels.
+    pub pixels: usize,
+    pub energy: f64,
 }
 
 /// One image along a method's longest run.
@@ -82,6 +94,7 @@ pub struct MitsubaBench {
 
 pub(super) const PLOT_FILE: &str = "convergence.svg";
 const TABLE_FILE: &str = "table.md";
+const REGIONS_FILE: &str = "regions.md";
 
 /// The report's files beside the images: the convergence plot, mitsuba.json
 /// and the table.
@@ -91,6 +104,9 @@ pub(super) fn write(dir: &Path, report: &MitsubaBench) -> Result<()> {
     write_json(&dir.join("mitsuba.json"), report)?;
     let table = markdown_table(report, &command_line());
     write_atomically(&dir.join(TABLE_FILE), table.as_bytes())?;
+    if let Some(regions) = regions_table(report, &command_line()) {
+        write_atomically(&dir.join(REGIONS_FILE), regions.as_bytes())?;
+    }
     Ok(())
 }
 
@@ -114,6 +130,30 @@ fn markdown_table(b: &MitsubaBench, command: &str) -> String {
         );
     }
     s
+}
+
+/// Each row's energy in each `--region` (none without them), headed by the
+/// command.
+fn regions_table(b: &MitsubaBench, command: &str) -> Option<String> {
+    let first = b.rows.first().filter(|r| !r.regions.is_empty())?;
+    let mut s = format!(
+        "`{command}`\n\n{}; {}. Each region's energy: the image's mean there over the reference's.\n\n",
+        heading(b),
+        b.gl_renderer
+    );
+    s += "| renderer | budget (s) |";
+    for r in &first.regions {
+        s += &format!(" {} ({} px) |", r.name, r.pixels);
+    }
+    s += &format!("\n|---|---|{}\n", "---|".repeat(first.regions.len()));
+    for row in &b.rows {
+        s += &format!("| {} | {} |", row.renderer, budget(row, 0));
+        for r in &row.regions {
+            s += &format!(" {:.3} |", r.energy);
+        }
+        s += "\n";
+    }
+    Some(s)
 }
 
 /// A row's budget with `decimals` decimals, or "-" for the one-map render.
