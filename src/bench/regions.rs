@@ -5,7 +5,7 @@
 //! `bench mitsuba --region` each image's energy in the rectangles.
 
 use crate::gpu::{Gpu, Result};
-use crate::render::{render, RenderOptions};
+use crate::render::{render, Image, RenderOptions};
 use crate::scene::{Geometry, Scene};
 
 /// A named set of pixels (top row first, as [`crate::render::Image`]).
@@ -29,6 +29,61 @@ pub struct Rectangle {
     pub x1: u32,
     pub y0: u32,
     pub y1: u32,
+}
+
+/// An image's mean over a reference's in one region (channels together).
+#[derive(serde::Serialize, Clone, Debug)]
+pub struct RegionEnergy {
+    pub name: String,
+    /// Its pixels.
+    pub pixels: usize,
+    pub energy: f64,
+}
+
+/// Each region's energy: `image`'s sum over `reference`'s on its pixels.
+pub fn region_energies(regions: &[Region], image: &Image, reference: &Image) -> Vec<RegionEnergy> {
+    let sum = |img: &Image, r: &Region| -> f64 {
+        img.pixels
+            .iter()
+            .zip(&r.pixels)
+            .filter(|(_, &inside)| inside)
+            .map(|(p, _)| p.iter().map(|&v| f64::from(v)).sum::<f64>())
+            .sum()
+    };
+    regions
+        .iter()
+        .map(|r| RegionEnergy {
+            name: r.name.clone(),
+            pixels: r.count(),
+            energy: sum(image, r) / sum(reference, r),
+        })
+        .collect()
+}
+
+/// `rectangles` as regions of a `width` x `height` image, each less what
+/// `mask` leaves out; refused (naming the option, `--region`) when one lies
+/// outside the image or keeps no pixel.
+pub fn masked_rectangles(
+    rectangles: &[Rectangle],
+    (width, height): (u32, u32),
+    mask: Option<&[bool]>,
+) -> std::result::Result<Vec<Region>, String> {
+    let mut out = Vec::new();
+    for r in rectangles {
+        let shown = format!("--region {}={}:{}:{}:{}", r.name, r.x0, r.x1, r.y0, r.y1);
+        if r.x1 > width || r.y1 > height {
+            return Err(format!("{shown}: outside the {width} x {height} pixels"));
+        }
+        let mut region = r.region(width, height);
+        if let Some(m) = mask {
+            region.pixels.iter_mut().zip(m).for_each(|(p, &k)| *p &= k);
+        }
+        if region.count() == 0 {
+            return Err(format!("{shown}: the mask leaves none of its pixels"));
+        }
+        out.push(region);
+    }
+    Ok(out)
 }
 
 /// `NAME=X0:X1:Y0:Y1`: whole pixels, X0 < X1, Y0 < Y1, ends excluded (the
@@ -186,7 +241,29 @@ fn surface_name(scene: &Scene, shape: usize, plane: Option<(glam::Vec3, glam::Ve
 
 #[cfg(test)]
 mod tests {
-    use super::Rectangle;
+    use super::*;
+
+    /// A region's energy is the image's sum over the reference's on its
+    /// pixels alone, channels together; a masked-out or outside rectangle is
+    /// refused.
+    #[test]
+    fn region_energy_is_the_ratio_of_the_region_sums() {
+        let mut image = Image::new(2, 2);
+        let mut reference = Image::new(2, 2);
+        image.pixels = vec![[1.0, 2.0, 3.0], [9.0; 3], [4.0; 3], [0.0; 3]];
+        reference.pixels = vec![[2.0; 3], [1.0; 3], [2.0; 3], [5.0; 3]];
+        let left: Rectangle = "left=0:1:0:2".parse().unwrap();
+        let regions = masked_rectangles(std::slice::from_ref(&left), (2, 2), None).unwrap();
+        let e = region_energies(&regions, &image, &reference);
+        assert_eq!((e[0].name.as_str(), e[0].pixels), ("left", 2));
+        assert!((e[0].energy - (6.0 + 12.0) / (6.0 + 6.0)).abs() < 1e-12);
+        let mask = [false, true, false, true];
+        let err = masked_rectangles(&[left], (2, 2), Some(&mask)).unwrap_err();
+        assert!(err.contains("the mask leaves none"), "{err}");
+        let wide: Rectangle = "wide=0:3:0:1".parse().unwrap();
+        let err = masked_rectangles(&[wide], (2, 2), None).unwrap_err();
+        assert!(err.contains("outside the 2 x 2 pixels"), "{err}");
+    }
 
     #[test]
     fn rectangles_parse_and_refuse() {

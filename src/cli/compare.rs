@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 
+use photonmap::bench::regions::{masked_rectangles, region_energies, Rectangle, RegionEnergy};
 use photonmap::image::write_all_atomically;
 use photonmap::metrics::{compare, false_colour, flip_map, fraction_beyond, FLIP_PERCENTILES};
 use photonmap::render::Image;
@@ -25,6 +26,11 @@ pub struct CompareArgs {
     /// Only pixels where this PNG (same size) is bright (> 50%) count (not FLIP).
     #[arg(long)]
     pub mask: Option<PathBuf>,
+    /// Also report the energy (the image's mean over the reference's) in a
+    /// rectangle: NAME=X0:X1:Y0:Y1, columns X0..X1 and rows Y0..Y1, row 0 at
+    /// the top, ends excluded, less what --mask leaves out. Repeat it for more.
+    #[arg(long, value_name = "NAME=X0:X1:Y0:Y1", value_parser = rectangle)]
+    pub region: Vec<Rectangle>,
     /// Write the difference image as a PNG: FLIP's error map in its magma
     /// colour map when a FLIP threshold is given, else |a - b| / (|b| + 0.01)
     /// in false colour (black 0 .. red >= 1); --diff-map chooses.
@@ -47,6 +53,11 @@ pub struct CompareArgs {
     pub html: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--region`'s NAME=X0:X1:Y0:Y1.
+fn rectangle(s: &str) -> std::result::Result<Rectangle, String> {
+    s.parse()
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -157,6 +168,9 @@ struct Report {
     /// A warn-tier threshold did not hold.
     warned: bool,
     diff: Option<String>,
+    /// The energy in each --region.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    regions: Vec<RegionEnergy>,
 }
 
 #[derive(serde::Serialize)]
@@ -230,6 +244,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let a = Image::read_exr(&args.image)?;
     let b = Image::read_exr(&args.reference)?;
     let mask = args.mask.as_ref().map(|p| read_mask(p, &a)).transpose()?;
+    let regions = masked_rectangles(&args.region, (a.width, a.height), mask.as_deref())
+        .map_err(|e| anyhow!("{e} of {}", args.image.display()))?;
     let measured = Measured {
         m: compare(&a, &b, mask.as_deref())?,
         flip: flip_map(&a, &b)?,
@@ -284,6 +300,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         warned: !warned.is_empty(),
         checks,
         diff: diff.as_ref().map(|d| d.display().to_string()),
+        regions: region_energies(&regions, &a, &b),
     };
     let case = case(&report, &measured, &a, &b, wall.elapsed().as_secs_f64())?;
     write_outputs(args, &report, &measured, &a, &b, &case)?;
@@ -447,6 +464,9 @@ fn print(args: &CompareArgs, report: &Report) -> Result<()> {
     }
     if let Some(p) = report.percent_beyond_warn {
         println!("beyond --warn    {p:.4}% of pixels");
+    }
+    for r in &report.regions {
+        println!("energy in {} ({} pixels) {:.6}", r.name, r.pixels, r.energy);
     }
     for c in &report.checks {
         let verdict = match (c.passed, c.tier) {

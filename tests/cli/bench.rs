@@ -163,7 +163,10 @@ fn bench_mitsuba_refuses_bad_budgets_references_and_masks() {
     let out_dir = d.join("out");
     let refused: [(&[&str], &str); 13] = [
         (&["--region", "floor=0:10:5"], "NAME=X0:X1:Y0:Y1"),
-        (&["--region", "floor=0:257:0:10"], "outside the reference's 256 x 192"),
+        (
+            &["--region", "floor=0:257:0:10"],
+            "outside the 256 x 192 pixels of the reference",
+        ),
         // The truth's mask of GLASS BALL leaves out its top-left corner (the black sky).
         (&["--region", "corner=0:1:0:1"], "the mask leaves none"),
         (&["--seconds", "0"], "--seconds"),

@@ -53,6 +53,33 @@ fn compare_prints_metrics_writes_a_difference_image_and_checks_its_inputs() {
         .arg(d.join("nope.exr"))
         .arg(&b)
         .refused_with("nope.exr");
+    // --region: the energy in a rectangle is the sum of a's pixels there over
+    // b's; one outside the image is refused.
+    let v = metrics(&a, &b, &["--region", "left half=0:20:0:30"]);
+    let (ia, ib) = (
+        photonmap::render::Image::read_exr(&a).unwrap(),
+        photonmap::render::Image::read_exr(&b).unwrap(),
+    );
+    let sum = |img: &photonmap::render::Image| -> f64 {
+        (0..30)
+            .flat_map(|y| (0..20).map(move |x| y * 40 + x))
+            .map(|i| img.pixels[i].iter().map(|&c| f64::from(c)).sum::<f64>())
+            .sum()
+    };
+    let region = &v["regions"][0];
+    assert_eq!(
+        (&region["name"], &region["pixels"]),
+        (&"left half".into(), &600.into()),
+        "{v}"
+    );
+    let energy = region["energy"].as_f64().unwrap();
+    assert!((energy - sum(&ia) / sum(&ib)).abs() < 1e-9, "{energy}");
+    assert!(same.get("regions").is_none(), "{same}");
+    Run::new(["compare"])
+        .arg(&a)
+        .arg(&b)
+        .args(["--region", "wide=0:41:0:30"])
+        .refused_with("outside the 40 x 30 pixels");
 }
 
 /// compare as a CI gate: an identical image passes, a perturbed one fails

@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::Result;
 use serde::Serialize;
 
+use photonmap::bench::regions::RegionEnergy;
 use photonmap::image::write_atomically;
 
 use crate::cli::bench::output::{command_line, write_json};
@@ -38,16 +39,6 @@ pub struct Row {
     pub regions: Vec<RegionEnergy>,
     /// PNG in the out folder (the EXR beside it has the same stem).
     pub image: String,
-}
-
-/// An image's mean over the reference's in one `--region` (channels
-/// averaged, within the mask).
-#[derive(Serialize, Clone, Debug)]
-pub struct RegionEnergy {
-    pub name: String,
-    /// Its compared pixels.
-    pub pixels: usize,
-    pub energy: f64,
 }
 
 /// One image along a method's longest run.

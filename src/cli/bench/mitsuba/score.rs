@@ -7,14 +7,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use photonmap::bench::regions::Region;
+use photonmap::bench::regions::{masked_rectangles, region_energies, Region};
 use photonmap::image::{write_all_atomically, write_atomically};
 use photonmap::metrics::{compare, Metrics};
 use photonmap::render::Image;
 use photonmap::scene::Scene;
 
 use super::args::MitsubaBenchArgs;
-use super::report::{Curve, CurvePoint, RegionEnergy, Row};
+use super::report::{Curve, CurvePoint, Row};
 use super::runner::{render_mitsuba, Taken};
 use crate::cli::bench::scene::default_reference;
 use crate::cli::compare::read_mask;
@@ -197,45 +197,10 @@ pub(super) fn mitsuba_target(
 /// keeps no pixel.
 pub(super) fn regions(
     a: &MitsubaBenchArgs,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     mask: Option<&[bool]>,
 ) -> Result<Vec<Region>> {
-    let mut out = Vec::new();
-    for r in &a.region {
-        let shown = format!("--region {}={}:{}:{}:{}", r.name, r.x0, r.x1, r.y0, r.y1);
-        if r.x1 > width || r.y1 > height {
-            bail!("{shown}: outside the reference's {width} x {height} pixels");
-        }
-        let mut region = r.region(width, height);
-        if let Some(m) = mask {
-            region.pixels.iter_mut().zip(m).for_each(|(p, &k)| *p &= k);
-        }
-        if region.count() == 0 {
-            bail!("{shown}: the mask leaves none of its pixels");
-        }
-        out.push(region);
-    }
-    Ok(out)
-}
-
-/// Each region's mean over the reference's, channels averaged.
-fn region_energies(regions: &[Region], image: &Image, reference: &Image) -> Vec<RegionEnergy> {
-    let sum = |img: &Image, r: &Region| -> f64 {
-        img.pixels
-            .iter()
-            .zip(&r.pixels)
-            .filter(|(_, &inside)| inside)
-            .map(|(p, _)| p.iter().map(|&v| f64::from(v)).sum::<f64>())
-            .sum()
-    };
-    regions
-        .iter()
-        .map(|r| RegionEnergy {
-            name: r.name.clone(),
-            pixels: r.count(),
-            energy: sum(image, r) / sum(reference, r),
-        })
-        .collect()
+    masked_rectangles(&a.region, size, mask).map_err(|e| anyhow::anyhow!("{e} of the reference"))
 }
 
 /// The reference runs' first seeds: far from the benchmark's own (0..).
@@ -329,27 +294,5 @@ impl Bench<'_> {
             renderer: renderer.into(),
             points,
         })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A region's energy is the image's sum over the reference's on its
-    /// pixels alone, channels together.
-    #[test]
-    fn region_energy_is_the_ratio_of_the_region_sums() {
-        let mut image = Image::new(2, 2);
-        let mut reference = Image::new(2, 2);
-        image.pixels = vec![[1.0, 2.0, 3.0], [9.0; 3], [4.0; 3], [0.0; 3]];
-        reference.pixels = vec![[2.0; 3], [1.0; 3], [2.0; 3], [5.0; 3]];
-        let left = Region {
-            name: "left".into(),
-            pixels: vec![true, false, true, false],
-        };
-        let e = region_energies(&[left], &image, &reference);
-        assert_eq!((e[0].name.as_str(), e[0].pixels), ("left", 2));
-        assert!((e[0].energy - (6.0 + 12.0) / (6.0 + 6.0)).abs() < 1e-12);
     }
 }
