@@ -66,6 +66,19 @@ pub const CULL_SLACK: f32 = 1e-3;
 /// (glsl/render/gather_rays.frag; the eye side's other streams use other top bits).
 pub const GATHER_STREAM: u32 = 0x5000_0000;
 
+/// The random stream of a VCM camera path's vertex s (segments from the
+/// camera) is VCM_CAMERA_STREAM | s (glsl/vcm/camera_path.frag).
+pub const VCM_CAMERA_STREAM: u32 = 0x8000_0000;
+
+/// VCM's techniques (`--vcm-mode`): path tracing with next-event estimation,
+/// light tracing, progressive photon mapping (merging at the first diffuse
+/// vertex), bidirectional path tracing, and all of them.
+pub const VCM_MODE_PT: u32 = 0;
+pub const VCM_MODE_LT: u32 = 1;
+pub const VCM_MODE_PPM: u32 = 2;
+pub const VCM_MODE_BPT: u32 = 3;
+pub const VCM_MODE_VCM: u32 = 4;
+
 /// Adaptive sampling interpolates a pixel only from corners whose first-hit
 /// normal is within this cosine of its own (about 18 degrees) and whose
 /// material is the same (glsl/render/adaptive_plan.glsl).
@@ -173,6 +186,12 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("SHOOTER_OUTLINE", u(SHOOTER_OUTLINE)),
         ("SHOOTER_TEXELS", u(SHOOTER_TEXELS)),
         ("GATHER_STREAM", format!("0x{GATHER_STREAM:x}u")),
+        ("VCM_CAMERA_STREAM", format!("0x{VCM_CAMERA_STREAM:x}u")),
+        ("VCM_MODE_PT", u(VCM_MODE_PT)),
+        ("VCM_MODE_LT", u(VCM_MODE_LT)),
+        ("VCM_MODE_PPM", u(VCM_MODE_PPM)),
+        ("VCM_MODE_BPT", u(VCM_MODE_BPT)),
+        ("VCM_MODE_VCM", u(VCM_MODE_VCM)),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
         ("PRIMITIVE_BOX_ROW", u(PRIMITIVE_BOX_ROW)),
         ("VPL_NORMAL_COS", format!("{VPL_NORMAL_COS:?}")),

@@ -85,6 +85,9 @@ vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
 
 int primitive_material(int prim) { return int(primitive_texel(prim, 0).y); }
 
+// The light whose emitting primitive this is (head .w = light + 1), or -1.
+int primitive_light(int prim) { return int(primitive_texel(prim, 0).w) - 1; }
+
 // ---- shading normals: a triangle's vertex normals, interpolated.
 
 // Whether the primitive has vertex normals (head .z = record + 1, 0: none).

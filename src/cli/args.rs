@@ -11,6 +11,7 @@ use photonmap::render::differentials::{COVERAGE_SAMPLES, MAX_BOUNCES as DIFFEREN
 use photonmap::render::radiance_estimate::LeakTest;
 use photonmap::render::radiosity::FormFactor;
 use photonmap::render::sppm::{DirectLighting, SppmOptions, SppmStart};
+use photonmap::render::vcm::{VcmMode, VcmOptions};
 use photonmap::render::{
     DifferentialsOptions, EstimateMode, EstimateOptions, IgiOptions, Kernel, RadiosityOptions,
 };
@@ -172,6 +173,11 @@ pub enum Method {
     /// Progressive refinement radiosity: texels of an element atlas shoot
     /// and gather through item buffers; caustics from a caustic photon map.
     Radiosity,
+    /// Vertex connection and merging: light and camera paths each
+    /// iteration, each path taken by every technique that can make it (light
+    /// tracing, path tracing, connections, photon merging) and weighted by
+    /// multiple importance sampling; converges to the exact image.
+    Vcm,
 }
 
 /// A positive finite number.
@@ -288,6 +294,59 @@ impl From<&SppmArgs> for SppmOptions {
             shadow_rays: a.sppm_shadow_rays,
             adaptive: None,
             adaptive_pilot: a.adaptive_pilot,
+        }
+    }
+}
+
+/// Vertex connection and merging (`--method vcm`; its iterations and time
+/// are --iterations and --time).
+#[derive(Args, Clone, Debug, Default)]
+pub struct VcmArgs {
+    /// VCM: its techniques: pt (path tracing with next-event estimation),
+    /// lt (light tracing), ppm (merging at the first diffuse vertex), bpt
+    /// (every connection), vcm (every connection and merge; the default).
+    #[arg(long, value_enum, value_name = "MODE")]
+    pub vcm_mode: Option<VcmMode>,
+    /// VCM: light paths traced an iteration (1..=4194304; default 16384).
+    /// Camera path i connects to light path i mod N.
+    #[arg(long, value_name = "N", value_parser = in_range(1, 1 << 22))]
+    pub light_paths: Option<u32>,
+    /// VCM: the longest path, in segments (2..=64; default 32); Russian
+    /// roulette ends most far sooner.
+    #[arg(long, value_name = "N", value_parser = in_range(2, 64))]
+    pub max_path_length: Option<u32>,
+    /// VCM: the merging radius at the first iteration (default: 4 pixel
+    /// footprints at the camera's look-at distance).
+    #[arg(long, value_name = "R", value_parser = positive)]
+    pub merge_radius: Option<f64>,
+    /// VCM: the merging radius shrinks as i^((alpha - 1) / 2); alpha in
+    /// (0, 1) (default 0.75).
+    #[arg(long, value_name = "ALPHA", value_parser = fraction)]
+    pub merge_alpha: Option<f32>,
+}
+
+impl VcmArgs {
+    pub fn any_given(&self) -> bool {
+        self.vcm_mode.is_some()
+            || self.light_paths.is_some()
+            || self.max_path_length.is_some()
+            || self.merge_radius.is_some()
+            || self.merge_alpha.is_some()
+    }
+
+    /// The options, with the iterations and time of `sppm`'s --iterations
+    /// and --time (which progressive methods share).
+    pub fn options(&self, iterations: &SppmArgs) -> VcmOptions {
+        let d = VcmOptions::default();
+        VcmOptions {
+            mode: self.vcm_mode.unwrap_or(d.mode),
+            iterations: iterations.iteration_limit(),
+            seconds: iterations.time,
+            light_paths: self.light_paths.unwrap_or(d.light_paths),
+            max_segments: self.max_path_length.unwrap_or(d.max_segments),
+            initial_radius: self.merge_radius.map(|r| r as f32),
+            alpha: self.merge_alpha.unwrap_or(d.alpha),
+            ..d
         }
     }
 }

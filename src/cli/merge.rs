@@ -94,8 +94,9 @@ fn read_pass(path: &Path) -> Result<Pass> {
             path.display()
         );
     }
-    if provenance["method"] == "sppm" && provenance["iterations"].is_null() {
-        bail!("{}: an SPPM render whose header does not record its iterations (a --write-partial file?): passes of different lengths cannot be told apart", path.display());
+    let progressive = provenance["method"] == "sppm" || provenance["method"] == "vcm";
+    if progressive && provenance["iterations"].is_null() {
+        bail!("{}: a progressive (SPPM or VCM) render whose header does not record its iterations (a --write-partial file?): passes of different lengths cannot be told apart", path.display());
     }
     let weight = provenance["spp"]
         .as_f64()

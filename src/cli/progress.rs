@@ -78,20 +78,22 @@ impl ProgressReport {
     pub fn update(&mut self, p: &Progress<'_>) {
         let per_run = self.passes_per_sample + self.estimate_units;
         let (position, what) = match p.at {
-            None if p.stage == "SPPM iterations" => match self.seconds {
-                // Whichever of the clock and the iterations is further on.
-                Some(s) => {
-                    let elapsed = self.clock.elapsed().as_secs_f64();
-                    let by_time = (elapsed / s * self.total as f64) as u64;
-                    let what = if p.total >= super::args::MAX_SPPM_ITERATIONS as u64 {
-                        format!("iteration {}, {elapsed:.0} of {s} s", p.done)
-                    } else {
-                        format!("iteration {}/{}, {elapsed:.0} of {s} s", p.done, p.total)
-                    };
-                    (p.done.max(by_time), what)
+            None if p.stage == photonmap::render::progressive::ITERATIONS_STAGE => {
+                match self.seconds {
+                    // Whichever of the clock and the iterations is further on.
+                    Some(s) => {
+                        let elapsed = self.clock.elapsed().as_secs_f64();
+                        let by_time = (elapsed / s * self.total as f64) as u64;
+                        let what = if p.total >= super::args::MAX_SPPM_ITERATIONS as u64 {
+                            format!("iteration {}, {elapsed:.0} of {s} s", p.done)
+                        } else {
+                            format!("iteration {}/{}, {elapsed:.0} of {s} s", p.done, p.total)
+                        };
+                        (p.done.max(by_time), what)
+                    }
+                    None => (p.done, format!("iteration {}/{}", p.done, p.total)),
                 }
-                None => (p.done, format!("iteration {}/{}", p.done, p.total)),
-            },
+            }
             None => (0, p.stage.to_string()),
             Some(at) => {
                 let run = (at.view as u64) * at.samples as u64 + at.sample as u64;

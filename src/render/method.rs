@@ -62,6 +62,10 @@ impl MethodRun {
                 "SPPM is progressive, not a frame method: render it with render::sppm::render_sppm"
                     .into(),
             )),
+            Method::Vcm(_) => return Err(Error::InvalidOption(
+                "VCM is progressive, not a frame method: render it with render::vcm::render_vcm"
+                    .into(),
+            )),
         })
     }
 

@@ -19,6 +19,7 @@ pub mod output;
 pub mod photon_map;
 pub mod photon_options;
 pub mod plan;
+pub mod progressive;
 pub mod radiance_estimate;
 pub mod radiosity;
 pub mod ray_trace;
@@ -27,6 +28,7 @@ pub mod search_work;
 pub mod software;
 pub mod sppm;
 pub mod sppm_adaptive;
+pub mod vcm;
 
 pub use crate::image::Image;
 pub use crate::timing::{StageTiming, Timings};

@@ -12,6 +12,7 @@ use super::plan::FrameSize;
 use super::radiance_estimate::EstimateOptions;
 use super::radiosity::RadiosityOptions;
 use super::sppm::options::SppmOptions;
+use super::vcm::options::VcmOptions;
 
 /// How one render runs (what the scene file does not fix).
 #[derive(Clone, Debug)]
@@ -113,6 +114,11 @@ pub enum Method {
     /// Stochastic progressive photon mapping: iterations of eye paths and
     /// photons, each pixel's radius shrinking; converges to the exact image.
     Sppm(WithPhotons<SppmOptions>),
+    /// Vertex connection and merging: light and camera subpaths each
+    /// iteration, every path taken by every technique that can make it
+    /// (light tracing, path tracing, connections, merging), weighted by
+    /// multiple importance sampling; progressive, as SPPM.
+    Vcm(VcmOptions),
 }
 
 impl Method {
@@ -126,6 +132,7 @@ impl Method {
             Method::Differentials(_) => "differentials",
             Method::Radiosity(_) => "radiosity",
             Method::Sppm(_) => "sppm",
+            Method::Vcm(_) => "vcm",
         }
     }
 
@@ -138,13 +145,16 @@ impl Method {
             Method::Differentials(o) => Some(&o.photons),
             Method::Radiosity(o) => Some(&o.photons),
             Method::Sppm(o) => Some(&o.photons),
+            Method::Vcm(_) => None,
         }
     }
 
     /// The kNN-grid estimate's options, where the method runs one.
     pub fn estimate(&self) -> Option<&EstimateOptions> {
         match self {
-            Method::DirectOnly | Method::Differentials(_) | Method::Sppm(_) => None,
+            Method::DirectOnly | Method::Differentials(_) | Method::Sppm(_) | Method::Vcm(_) => {
+                None
+            }
             Method::PhotonMap(o) => Some(&o.estimate),
             Method::Igi(o) => Some(&o.estimate),
             Method::Radiosity(o) => Some(&o.estimate),

@@ -49,7 +49,7 @@ pub struct RayTracer {
 }
 
 /// The uniforms of `common/camera.glsl` for eye sample `sample`.
-fn bind_camera(b: &mut Bindings<'_>, camera: &Camera, plan: &PassPlan, sample: u32) {
+pub(crate) fn bind_camera(b: &mut Bindings<'_>, camera: &Camera, plan: &PassPlan, sample: u32) {
     let (strata_x, strata_y) = crate::sampling::strata(plan.spp);
     let (u, v, w) = camera.basis();
     let tan_v = (camera.vfov_degrees.to_radians() * 0.5).tan();

@@ -17,6 +17,8 @@ use super::{triangle_area, Geometry, Light, Material, Scene};
 /// per triangle with vertex normals; one per emissive triangle of a
 /// `Light::Triangles`.
 pub struct PackedScene {
+    /// Each primitive's head texel (kind, material, normals record + 1,
+    /// light + 1 for a light's emitting primitive, else 0), then its geometry.
     pub primitives: Vec<[f32; 4]>,
     pub materials: Vec<[f32; 4]>,
     pub lights: Vec<[f32; 4]>,
@@ -123,7 +125,8 @@ impl PackedScene {
             .map(|(i, _)| i as f32);
         let mut lights = Vec::new();
         let mut light_triangles = Vec::new();
-        for (l, &probability) in scene.lights.iter().zip(&probabilities) {
+        let mut emitting = Vec::new();
+        for (index, (l, &probability)) in scene.lights.iter().zip(&probabilities).enumerate() {
             let v = |a: glam::Vec3| [a.x, a.y, a.z, 0.0];
             cdf += probability;
             let primitive = match *l {
@@ -175,6 +178,18 @@ impl PackedScene {
                 }
             };
             lights.push([cdf, probability, primitive, 0.0]);
+            match *l {
+                Light::Triangles { first, count, .. } => {
+                    emitting.extend((first..first + count).map(|p| (p, index)))
+                }
+                _ if primitive >= 0.0 => emitting.push((primitive as usize, index)),
+                _ => {}
+            }
+        }
+        // Each emitting primitive names its light (head .w = light + 1), for
+        // the pdfs of a path that hits it (VCM's MIS weights).
+        for (prim, light) in emitting {
+            primitives[prim * PRIMITIVE_TEXELS as usize][3] = (light + 1) as f32;
         }
         Self {
             primitives,

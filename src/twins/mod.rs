@@ -16,3 +16,4 @@ pub mod random;
 pub mod ray_trace;
 pub mod shading;
 pub mod sppm;
+pub mod vcm;

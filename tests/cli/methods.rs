@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use crate::common::{Run, TempDir};
+use photonmap::render::Image;
 
 /// Final gather and adaptive sampling as a user runs them: the JSON reports
 /// the gather and the pyramid's levels (adaptive SPPM: its pilot and plan); a
@@ -459,4 +460,80 @@ fn assert_render_refused(dir: &Path, name: &str, args: &[&str], says: &str) {
         .scene(name)
         .output_to(dir.join("bad.png"))
         .refused_with(says);
+}
+
+/// `--method vcm` renders with its iterations and its report, each
+/// `--vcm-mode` runs, two passes of other seeds merge (`merge --passes`) to
+/// their average, and its switches are refused without it, as is what it
+/// cannot take.
+#[test]
+fn vcm_runs_merges_and_refuses_what_it_cannot_do() {
+    let d = TempDir::new("vcm");
+    for mode in ["pt", "lt", "ppm", "bpt", "vcm"] {
+        let v = render_cornell_box_json(
+            &d,
+            ["24", "24"],
+            &["--method", "vcm", "--vcm-mode", mode, "--iterations", "2"],
+        );
+        assert_eq!(v["method"], "vcm", "{v}");
+        assert_eq!(v["vcm_mode"], mode, "{v}");
+        assert_eq!(v["iterations"], 2, "{v}");
+        assert_eq!(v["provenance"]["method"], "vcm", "{v}");
+    }
+    // merge --passes of two seeds is their average (equal iterations).
+    let pass = |seed: &str| {
+        let exr = d.join(format!("pass{seed}.exr"));
+        Run::new(["render", "--quiet", "--width", "24", "--height", "24"])
+            .args([
+                "--method",
+                "vcm",
+                "--iterations",
+                "2",
+                "--light-paths",
+                "1024",
+            ])
+            .args(["--seed", seed])
+            .scene("cornell_box")
+            .writing("--exr", &exr)
+            .succeeds();
+        exr
+    };
+    let (a, b) = (pass("1"), pass("2"));
+    let merged = d.join("merged.exr");
+    Run::new(["merge", "--passes"])
+        .writing_arg(&merged)
+        .arg(&a)
+        .arg(&b)
+        .succeeds();
+    let (ia, ib) = (Image::read_exr(&a).unwrap(), Image::read_exr(&b).unwrap());
+    let m = Image::read_exr(&merged).unwrap();
+    for (i, p) in m.pixels.iter().enumerate() {
+        for (c, &v) in p.iter().enumerate() {
+            let mean = 0.5 * (ia.pixels[i][c] + ib.pixels[i][c]);
+            assert!(
+                (v - mean).abs() <= 1e-5 * mean.abs() + 1e-7,
+                "pixel {i}: {v} against {mean}"
+            );
+        }
+    }
+    for (args, says) in [
+        (&["--vcm-mode", "bpt"][..], "add --method vcm"),
+        (
+            &["--method", "sppm", "--light-paths", "64"][..],
+            "add --method vcm",
+        ),
+        (
+            &["--method", "vcm", "--adaptive"][..],
+            "no adaptive sampling",
+        ),
+        (
+            &["--method", "vcm", "--spp", "2"][..],
+            "--method vcm renders one view",
+        ),
+        (&["--method", "vcm", "--max-path-length", "1"][..], "2..=64"),
+        (&["--method", "vcm", "--merge-alpha", "1"][..], "(0, 1)"),
+        (&["--method", "vcm", "--light-paths", "0"][..], "1..="),
+    ] {
+        assert_render_refused(&d, "cornell_box", args, says);
+    }
 }

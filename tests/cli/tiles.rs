@@ -27,7 +27,7 @@ fn render(out: &Path, scene: &str, args: &[&str]) -> Image {
 #[test]
 fn a_crop_holds_the_frames_own_pixels_under_every_method() {
     let d = TempDir::new("crop-methods");
-    let methods: [(&str, &[&str]); 9] = [
+    let methods: [(&str, &[&str]); 10] = [
         ("paper", &[]),
         ("final-gather", &["--final-gather", "8"]),
         ("adaptive", &["--final-gather", "8", "--adaptive"]),
@@ -37,6 +37,17 @@ fn a_crop_holds_the_frames_own_pixels_under_every_method() {
         ("radiosity", &["--method", "radiosity"]),
         ("direct", &["--direct-only"]),
         ("sppm", &["--method", "sppm", "--iterations", "2"]),
+        (
+            "vcm",
+            &[
+                "--method",
+                "vcm",
+                "--iterations",
+                "2",
+                "--light-paths",
+                "2048",
+            ],
+        ),
     ];
     for (name, args) in methods {
         let full = render(&d.join(format!("{name}.exr")), "cornell_box", args);

@@ -32,3 +32,4 @@ mod reference_images;
 mod sppm;
 mod stress;
 mod truth;
+mod vcm;

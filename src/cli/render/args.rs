@@ -18,7 +18,7 @@ use photonmap::scene::Scene;
 
 use crate::cli::args::{
     in_range, DifferentialsArgs, EstimateArgs, IgiArgs, LoadedScene, Method, PhotonMapArgs,
-    RadiosityArgs, SceneArgs, SppmArgs,
+    RadiosityArgs, SceneArgs, SppmArgs, VcmArgs,
 };
 
 /// Render a scene to images: PNG (sRGB), EXR (linear float RGB, with the
@@ -71,8 +71,9 @@ pub struct RenderArgs {
     /// Direct light and specular paths only: no photons, no radiance estimate.
     #[arg(long)]
     pub direct_only: bool,
-    /// Global illumination: the paper's one-shot photon map, or stochastic
-    /// progressive photon mapping (which converges to the exact image).
+    /// Global illumination: the paper's one-shot photon map, one of the
+    /// other methods, or a progressive one (SPPM, VCM), which converges to
+    /// the exact image.
     #[arg(long, value_enum, default_value_t = Method::Paper)]
     pub method: Method,
     /// Final gather (section 4.5): N cosine-distributed gather rays per pixel
@@ -101,6 +102,8 @@ pub struct RenderArgs {
     pub adaptive_threshold: f32,
     #[command(flatten)]
     pub sppm: SppmArgs,
+    #[command(flatten)]
+    pub vcm: VcmArgs,
     #[command(flatten)]
     pub igi: IgiArgs,
     /// IGI and radiosity: the light their caustic map carries. all: every
@@ -402,7 +405,10 @@ impl RenderArgs {
     /// The method with its options: the one place where switches that do
     /// not go together are refused.
     pub(super) fn method(&self) -> Result<render::Method> {
-        if self.method == Method::Sppm {
+        if self.vcm.any_given() && self.method != Method::Vcm {
+            bail!("--vcm-mode, --light-paths, --max-path-length, --merge-radius and --merge-alpha are VCM's: add --method vcm");
+        }
+        if matches!(self.method, Method::Sppm | Method::Vcm) {
             self.check_sppm_switches()?;
         } else {
             self.check_method_switches()?;
@@ -448,6 +454,7 @@ impl RenderArgs {
                     ..(&self.radiosity).into()
                 },
             }),
+            Method::Vcm => render::Method::Vcm(self.vcm.options(&self.sppm)),
             Method::Sppm => render::Method::Sppm(WithPhotons {
                 photons,
                 method: SppmOptions {
@@ -460,8 +467,17 @@ impl RenderArgs {
         })
     }
 
-    /// `--method sppm` renders one view with its own eye samples and photons.
+    /// `--method sppm` and `--method vcm` render one view with their own eye
+    /// samples and photons; VCM takes no adaptive sampling.
     fn check_sppm_switches(&self) -> Result<()> {
+        let name = if self.method == Method::Vcm {
+            "vcm"
+        } else {
+            "sppm"
+        };
+        if self.method == Method::Vcm && (self.adaptive || self.sppm.adaptive_pilot.is_some()) {
+            bail!("--method vcm has no adaptive sampling: drop --adaptive and --adaptive-pilot");
+        }
         if self.camera_path.is_some()
             || self.direct_only
             || self.reference_software.is_some()
@@ -474,7 +490,7 @@ impl RenderArgs {
             || self.caustic_k.is_some()
             || self.caustic_scene_grid
         {
-            bail!("--method sppm renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --footprint-shape) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics, --gather-rays)");
+            bail!("--method {name} renders one view with its own eye samples and photons: drop --camera-path, --direct-only, --reference-software, --spp, --final-gather, --caustic-paths, --caustic-k, --caustic-scene-grid, IGI's switches (--vpl-paths, --vpl-min-distance, --imperfect-visibility, --interleave, --downsample), photon differentials' (--smoothing, --caustic-smoothing, --footprint-max-radius, --leaf-size, --kernel, --footprint-coverage, --footprint-shape) and radiosity's (--elements, --substructure, --item-buffer, --max-shots, --convergence, --subdivide, --gradient, --form-factor, --shoot-caustics, --gather-rays)");
         }
         Ok(())
     }

@@ -8,6 +8,7 @@ mod frame;
 mod observer;
 mod output;
 mod sppm;
+mod vcm;
 
 pub use args::{RenderArgs, SnapshotEvery};
 pub use observer::SnapshotWriter;
@@ -18,6 +19,8 @@ use photonmap::gpu::Platform;
 pub fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     if args.method == crate::cli::args::Method::Sppm {
         sppm::run(args, platform)
+    } else if args.method == crate::cli::args::Method::Vcm {
+        vcm::run(args, platform)
     } else {
         frame::run(args, platform)
     }

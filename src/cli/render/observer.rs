@@ -293,7 +293,7 @@ fn write_done_on_signal(
     };
     let what = if sppm {
         provenance.iterations = Some(done.count);
-        "SPPM iterations"
+        "iterations"
     } else {
         provenance.spp = done.count;
         "eye samples"

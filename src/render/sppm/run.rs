@@ -5,8 +5,9 @@ use crate::gpu::{Gpu, Result};
 use crate::image::Image;
 use crate::render::adaptive::AdaptiveStats;
 use crate::render::explain::ExplainLine;
-use crate::render::observer::{At, EstimatePass, Progress, RenderObserver, StopReason};
+use crate::render::observer::{RenderObserver, StopReason};
 use crate::render::options::RenderOptions;
+use crate::render::progressive::{run_progressive, Progressed, Progressive};
 use crate::scene::Scene;
 use crate::timing::Timings;
 
@@ -44,61 +45,11 @@ pub fn render_sppm(
     // grid follows the largest radius over every pixel.
     options.check_pixel_bounds()?;
     let mut run = Sppm::new(gpu, scene, options, sppm)?;
-    let mut timings = Timings::default();
-    let wall = std::time::Instant::now();
-    let mut observed = 0.0;
-    let mut stopped_by = StopReason::Iterations;
-    while run.iteration < sppm.iterations {
-        crate::interrupt::check()?;
-        if sppm
-            .seconds
-            .is_some_and(|s| run.iteration > 0 && wall.elapsed().as_secs_f64() - observed >= s)
-        {
-            stopped_by = StopReason::Time;
-            break;
-        }
-        run.iterate(&mut timings, observer)?;
-        let t0 = std::time::Instant::now();
-        observer.progress(&Progress::stage(
-            "SPPM iterations",
-            run.iteration as u64,
-            sppm.iterations as u64,
-        ));
-        observer.estimate_pass(&EstimatePass {
-            stopped_by: None,
-            at: At {
-                view: 0,
-                views: 1,
-                sample: 0,
-                samples: 1,
-            },
-            pass: run.iteration - 1,
-            searching: 0,
-            query_pixels: 0,
-            seconds: wall.elapsed().as_secs_f64() - observed,
-            finished: false,
-            image: &|| Ok(options.cut(run.image()?)),
-        })?;
-        observed += t0.elapsed().as_secs_f64();
-    }
-    let image = options.cut(run.image()?);
-    timings.wall_seconds = wall.elapsed().as_secs_f64();
-    observer.estimate_pass(&EstimatePass {
-        at: At {
-            view: 0,
-            views: 1,
-            sample: 0,
-            samples: 1,
-        },
-        pass: run.iteration,
-        searching: 0,
-        query_pixels: 0,
-        seconds: timings.wall_seconds - observed,
-        finished: true,
-        stopped_by: Some(stopped_by),
-        image: &|| Ok(image.clone()),
-    })?;
-    observer.frame(0, &image)?;
+    let Progressed {
+        image,
+        stopped_by,
+        timings,
+    } = run_progressive(&mut run, options, (sppm.iterations, sppm.seconds), observer)?;
     let final_largest_radius = run.largest_radius()?;
     let mut explain = explain(&run, sppm);
     if let Some(b) = options.pixel_bounds {
@@ -216,4 +167,18 @@ fn explain(run: &Sppm, o: &SppmOptions) -> Vec<ExplainLine> {
         ),
     ));
     lines
+}
+
+impl Progressive for Sppm {
+    fn iterations_done(&self) -> u32 {
+        self.iteration
+    }
+
+    fn iterate(&mut self, timings: &mut Timings, observer: &mut dyn RenderObserver) -> Result<()> {
+        Sppm::iterate(self, timings, observer)
+    }
+
+    fn image(&self) -> Result<Image> {
+        Sppm::image(self)
+    }
 }
