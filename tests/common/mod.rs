@@ -111,43 +111,79 @@ pub fn write_sphere_obj(path: &Path, triangles: usize, normals: bool) {
 /// standard deviations (sd / sqrt(B), blocks taken as independent).
 pub fn block_chi2(a: &[Image], b: &[Image], block: u32) -> (f64, usize, f64) {
     let n = a.len().min(b.len());
+    let (bw, bh) = (a[0].width / block, a[0].height / block);
+    let blocks = (0..bh).flat_map(|by| (0..bw).map(move |bx| (bx, by)));
+    chi2_over_blocks(
+        blocks.map(|(bx, by)| (seed_stats(a, block, bx, by), seed_stats(b, block, bx, by))),
+        n,
+    )
+}
+
+/// `block_chi2` of A's seeds against a reference made of two independent
+/// runs (Mitsuba's, `bench mitsuba --mitsuba-reference`): per block, the
+/// runs' mean, and the variance of that mean from their difference,
+/// (r1 - r2)^2 / 4. The bound is block_chi2's from A's seeds alone; it holds
+/// where the reference's noise is small beside A's, and adding the
+/// reference's variance to each block's only loosens the test.
+pub fn block_chi2_against_runs(a: &[Image], runs: [&Image; 2], block: u32) -> (f64, usize, f64) {
+    let (bw, bh) = (a[0].width / block, a[0].height / block);
+    let blocks = (0..bh).flat_map(|by| (0..bw).map(move |bx| (bx, by)));
+    chi2_over_blocks(
+        blocks.map(|(bx, by)| {
+            let (r1, r2) = (
+                block_mean(runs[0], block, bx, by),
+                block_mean(runs[1], block, bx, by),
+            );
+            (
+                seed_stats(a, block, bx, by),
+                (0.5 * (r1 + r2), (r1 - r2).powi(2) / 4.0),
+            )
+        }),
+        a.len(),
+    )
+}
+
+/// The mean over a block's pixels and channels.
+pub fn block_mean(img: &Image, block: u32, bx: u32, by: u32) -> f64 {
+    let mut s = 0.0f64;
+    for y in by * block..(by + 1) * block {
+        for x in bx * block..(bx + 1) * block {
+            s += img.get(x, y).iter().map(|&v| v as f64).sum::<f64>() / 3.0;
+        }
+    }
+    s / (block * block) as f64
+}
+
+/// A block's mean over seeds, and the variance of that mean (from the seeds' spread).
+fn seed_stats(imgs: &[Image], block: u32, bx: u32, by: u32) -> (f64, f64) {
+    let v: Vec<f64> = imgs.iter().map(|i| block_mean(i, block, bx, by)).collect();
+    let m = v.iter().sum::<f64>() / v.len() as f64;
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+    (m, var / v.len() as f64)
+}
+
+/// Sum of t^2 / blocks over ((mean, variance of the mean) of A, of B) per
+/// block, the blocks counted, and the bound derived for n seeds a side.
+fn chi2_over_blocks(
+    stats: impl Iterator<Item = ((f64, f64), (f64, f64))>,
+    n: usize,
+) -> (f64, usize, f64) {
     assert!(
         n >= 6,
         "at least 6 seeds a side (F(1, n - 1) needs n - 1 > 4)"
     );
-    let (w, h) = (a[0].width, a[0].height);
-    let (bw, bh) = (w / block, h / block);
-    let value = |img: &Image, bx: u32, by: u32| {
-        let mut s = 0.0f64;
-        for y in by * block..(by + 1) * block {
-            for x in bx * block..(bx + 1) * block {
-                s += img.get(x, y).iter().map(|&v| v as f64).sum::<f64>() / 3.0;
-            }
-        }
-        s / (block * block) as f64
-    };
-    let stats = |imgs: &[Image], bx: u32, by: u32| {
-        let v: Vec<f64> = imgs.iter().map(|i| value(i, bx, by)).collect();
-        let m = v.iter().sum::<f64>() / v.len() as f64;
-        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
-        (m, var / v.len() as f64)
-    };
     let (mut chi2, mut blocks) = (0.0, 0usize);
-    for by in 0..bh {
-        for bx in 0..bw {
-            let (ma, va) = stats(a, bx, by);
-            let (mb, vb) = stats(b, bx, by);
-            if va + vb == 0.0 {
-                // Noiseless (an emitter seen directly): equal, or as far
-                // apart as can be.
-                if ma != mb {
-                    chi2 = f64::INFINITY;
-                }
-                continue;
+    for ((ma, va), (mb, vb)) in stats {
+        if va + vb == 0.0 {
+            // Noiseless (an emitter seen directly): equal, or as far
+            // apart as can be.
+            if ma != mb {
+                chi2 = f64::INFINITY;
             }
-            chi2 += (ma - mb).powi(2) / (va + vb);
-            blocks += 1;
+            continue;
         }
+        chi2 += (ma - mb).powi(2) / (va + vb);
+        blocks += 1;
     }
     let v = (n - 1) as f64;
     let mean = v / (v - 2.0);
