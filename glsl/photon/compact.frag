@@ -4,8 +4,16 @@
 // the one holding its i-th stored record, and writes that record's
 // (cell, record) pair. Slots past the count get the invalid key. The order of
 // records does not matter: the sort breaks ties by record index.
+// RECORD_ORDER (the counting build): level 0 holds record i at
+// texel_of_zindex(i), so slots come in record order; and each slot's record
+// is counted into its grid slot's texel of u_counts (a histogram laid out in
+// Z order), which the counting build's prefix sums read.
 #include "common/addressing.glsl"
 #include "common/grid.glsl"
+#ifdef RECORD_ORDER
+#include "common/zorder.glsl"
+layout(r32i) uniform iimage2D u_counts;
+#endif
 
 uniform isampler2D u_pyramid;     // mip level 0: records; each level sums 2 x 2 below
 uniform int u_top;                // the one-texel level
@@ -40,7 +48,15 @@ void main() {
         }
         t = chosen;
     }
+#ifdef RECORD_ORDER
+    int record = zindex_of_texel(t);
+#else
     int record = index_of_texel(t, textureSize(u_pyramid, 0).x);
+#endif
     vec3 p = texelFetch(u_position, texel_of_index(record, u_record_width), 0).xyz;
-    o_pair = ivec4(grid_key(p), record, 0, 0);
+    int key = grid_key(p);
+    o_pair = ivec4(key, record, 0, 0);
+#ifdef RECORD_ORDER
+    imageAtomicAdd(u_counts, texel_of_zindex(key), 1);
+#endif
 }

@@ -2,8 +2,13 @@
 // Level 0 of a HistoPyramid (Ziegler et al. 2006) over the photon records:
 // 1 where record i (i = y * width + x of this power-of-two texture) is a stored
 // photon in use inside the grid, else 0. The same test as keys.frag.
+// RECORD_ORDER: record i sits at texel texel_of_zindex(i) instead, so that
+// the traversal (compact.frag) visits records in index order.
 #include "common/addressing.glsl"
 #include "common/grid.glsl"
+#ifdef RECORD_ORDER
+#include "common/zorder.glsl"
+#endif
 
 uniform sampler2D u_position;
 uniform sampler2D u_power;
@@ -16,7 +21,11 @@ uniform int u_photons_used;
 layout(location = 0) out ivec4 o_count;
 
 void main() {
+#ifdef RECORD_ORDER
+    int i = zindex_of_texel(ivec2(gl_FragCoord.xy));
+#else
     int i = index_of_texel(ivec2(gl_FragCoord.xy), u_level_width);
+#endif
     o_count = ivec4(0);
     if (i >= u_record_count) return;
     ivec2 t = texel_of_index(i, u_record_width);

@@ -1,12 +1,13 @@
-//! `photonmap bench build`: both photon-map builds on n = 2^k synthetic photons
-//! (the bitonic sort's faithful passes and its fused ones), beside a plain
-//! copy pass over the same texture (the bandwidth bound).
+//! `photonmap bench build`: the photon-map builds on n = 2^k synthetic photons
+//! (the counting build, the bitonic sort's faithful passes and its fused
+//! ones, stencil routing), beside a plain copy pass over the same texture
+//! (the bandwidth bound).
 
 use glam::Vec3;
 
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
 use crate::photon::bitonic::{sort_texture_size, BitonicBuild};
-use crate::photon::{Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
+use crate::photon::{CountingBuild, Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
 use crate::timing::{StageTiming, Timings};
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -40,6 +41,18 @@ pub struct BuildBenchRow {
     /// The same with the paper's read-back: GPU time plus the read-back's wall time.
     pub stencil_readback_seconds: f64,
     pub stencil_readback_wall_seconds: f64,
+    /// The whole bitonic build (compaction, sort, binary search, gather), GPU seconds.
+    pub bitonic_build_seconds: f64,
+    /// The counting build (the default), GPU seconds by stage, its passes,
+    /// and its whole time in copy passes and over the bitonic build's.
+    pub counting_compact_seconds: f64,
+    pub counting_prefix_seconds: f64,
+    pub counting_place_seconds: f64,
+    pub counting_gather_seconds: f64,
+    pub counting_seconds: f64,
+    pub counting_passes: u32,
+    pub counting_in_copy_passes: f64,
+    pub counting_to_bitonic: f64,
 }
 
 /// Photons at uniform random points of the unit cube, all stored, one frame.
@@ -143,6 +156,12 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     let mut tf = Timings::default();
     fused.build(&frames, grid, &mut tf)?;
     let fused_sort = sort_stage(&tf);
+    let counting = CountingBuild::new(gpu)?;
+    counting.build(&frames, grid, &mut Timings::default())?;
+    let mut tc = Timings::default();
+    counting.build(&frames, grid, &mut tc)?;
+    let counting_seconds: f64 = tc.stages.iter().map(|s| s.gpu_seconds).sum();
+    let bitonic_build_seconds: f64 = t.stages.iter().map(|s| s.gpu_seconds).sum();
     Ok(BuildBenchRow {
         photons: n,
         bitonic_passes: sort.passes as u32,
@@ -168,6 +187,15 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
         stencil_vertex_fetch_seconds: gpu_part(&fetch),
         stencil_readback_seconds: gpu_part(&readback) + readback_wall,
         stencil_readback_wall_seconds: readback_wall,
+        bitonic_build_seconds,
+        counting_compact_seconds: stage(&tc, "compact and count"),
+        counting_prefix_seconds: stage(&tc, "prefix sums"),
+        counting_place_seconds: stage(&tc, "place"),
+        counting_gather_seconds: stage(&tc, "gather"),
+        counting_seconds,
+        counting_passes: tc.stages.iter().map(|s| s.passes as u32).sum(),
+        counting_in_copy_passes: counting_seconds / copy_pass,
+        counting_to_bitonic: counting_seconds / bitonic_build_seconds,
     })
 }
 

@@ -34,8 +34,10 @@ pub fn in_range(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clon
 /// How photons are traced and the map is built.
 #[derive(Args, Clone, Debug)]
 pub struct PhotonMapArgs {
-    /// Photon-map build: bitonic sort + binary search, or stencil routing.
-    #[arg(long, value_enum, default_value_t = BuildMethod::Bitonic)]
+    /// Photon-map build: counting sort (O(log n) passes; the bitonic
+    /// build's map), bitonic sort + binary search (the paper's; what
+    /// `--faithful` runs), or stencil routing.
+    #[arg(long, value_enum, default_value_t = BuildMethod::Counting)]
     pub build: BuildMethod,
     /// Stencil routing: each cell holds m x m photons (1..=16).
     #[arg(long, default_value_t = 4, value_parser = in_range(1, 16))]
@@ -69,7 +71,7 @@ impl PhotonMapArgs {
     /// The first switch given that only the kNN map's build reads.
     pub fn build_switch_given(&self) -> Option<&'static str> {
         [
-            (self.build != BuildMethod::Bitonic, "--build"),
+            (self.build != BuildMethod::Counting, "--build"),
             (self.stencil_m != 4, "--stencil-m"),
             (self.feed != VertexFeed::VertexFetch, "--feed"),
             (self.grid.is_some(), "--grid"),

@@ -64,21 +64,23 @@ impl Bindings<'_> {
     /// shader declares its format). What a draw stores is visible to later
     /// draws after `Gpu::image_barrier`.
     pub fn image(&mut self, name: &str, texture: &Texture) -> &mut Self {
+        self.image_with_access(name, texture, glow::WRITE_ONLY)
+    }
+
+    /// Binds level 0 of `texture` as image `name` for reading and writing
+    /// (`imageLoad`, `imageAtomic*`).
+    pub fn image_read_write(&mut self, name: &str, texture: &Texture) -> &mut Self {
+        self.image_with_access(name, texture, glow::READ_WRITE)
+    }
+
+    fn image_with_access(&mut self, name: &str, texture: &Texture, access: u32) -> &mut Self {
         let unit = self.next_image;
         self.next_image += 1;
         let format = texture.format.gl().0;
         // SAFETY: as for `texture`; the texture is immutable-format storage
         // of `format`.
         self.set(name, |gl, l| unsafe {
-            gl.bind_image_texture(
-                unit,
-                Some(texture.raw),
-                0,
-                false,
-                0,
-                glow::WRITE_ONLY,
-                format,
-            );
+            gl.bind_image_texture(unit, Some(texture.raw), 0, false, 0, access, format);
             gl.uniform_1_i32(l, unit as i32);
         })
     }

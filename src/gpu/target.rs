@@ -129,6 +129,20 @@ impl Target {
         }
     }
 
+    /// Clears every (integer) colour attachment to `value`.
+    pub fn clear_i32(&self, value: [i32; 4]) {
+        self.bind();
+        self.gpu.apply(&DrawState::PLAIN);
+        // SAFETY: gpu module doc; attachments 0..n exist on this framebuffer.
+        unsafe {
+            for i in 0..self.attachments {
+                self.gpu
+                    .gl()
+                    .clear_buffer_i32_slice(glow::COLOR, i as u32, &value);
+            }
+        }
+    }
+
     /// Clears depth to `depth` and stencil to `stencil` (a target with_stencil).
     pub fn clear_depth_stencil(&self, depth: f32, stencil: i32) {
         self.bind();

@@ -291,16 +291,7 @@ impl BitonicBuild {
             b.int("u_level_width", w as i32)
                 .draw_fullscreen(&target, &DrawState::PLAIN)?;
         }
-        for level in 1..levels {
-            // Samplers see only the level below while this one is drawn.
-            pyramid.set_level_range(level - 1, level - 1);
-            let target = Target::for_level(&self.gpu, &pyramid, level)?;
-            self.pyramid_reduce
-                .bind()
-                .texture("u_below", &pyramid)
-                .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        }
-        pyramid.set_level_range(0, levels - 1);
+        reduce_pyramid(&self.gpu, &self.pyramid_reduce, &pyramid, levels)?;
         let count = pyramid.read_i32_texel(levels - 1)[0] as u32;
         let (cw, ch) = sort_texture_size(count.max(2) as u64);
         let pairs = Texture::new(&self.gpu, cw, ch, TexFormat::Rg32I)?;
@@ -349,7 +340,6 @@ impl BitonicBuild {
             drop(target);
             pairs
         };
-        let (w, h) = (pairs.width, pairs.height);
         let clock = StageClock::start(&self.gpu, &query);
         let (sorted, passes) = self.sort(pairs)?;
         clock.stop(timings, "bitonic sort", passes as usize);
@@ -357,29 +347,76 @@ impl BitonicBuild {
         let (grid_first, grid_width) = self.binary_search(&sorted, grid.slot_count())?;
         clock.stop(timings, "binary search", 1);
 
-        let t = || Texture::new(&self.gpu, w, h, TexFormat::Rgba32F);
-        let (position, power, incoming) = (t()?, t()?, t()?);
-        let target = Target::new(&self.gpu, &[&position, &power, &incoming])?;
         let clock = StageClock::start(&self.gpu, &query);
-        let mut b = self.gather.bind();
-        b.texture("u_sorted", &sorted)
-            .texture("u_position", &frames.position)
-            .texture("u_power", &frames.power)
-            .texture("u_incoming", &frames.incoming)
-            .int("u_sorted_width", w as i32)
-            .int("u_record_width", frames.width as i32)
-            .float("u_power_scale", frames.power_scale)
-            .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        clock.stop(timings, "gather", 1);
-        self.gpu.check("gathering sorted photons")?;
-        Ok(SortedPhotonMap {
-            pairs: sorted,
-            position,
-            power,
-            incoming,
+        let map = gather_records(
+            &self.gpu,
+            &self.gather,
+            frames,
+            sorted,
             grid_first,
             grid_width,
-            grid: *grid,
-        })
+            grid,
+        )?;
+        clock.stop(timings, "gather", 1);
+        Ok(map)
     }
+}
+
+/// Sums level 0 of a HistoPyramid up to its one-texel top, a pass a level
+/// (`photon/pyramid_reduce.frag`).
+pub(crate) fn reduce_pyramid(
+    gpu: &Gpu,
+    reduce: &Program,
+    pyramid: &Texture,
+    levels: u32,
+) -> Result<()> {
+    for level in 1..levels {
+        // Samplers see only the level below while this one is drawn.
+        pyramid.set_level_range(level - 1, level - 1);
+        let target = Target::for_level(gpu, pyramid, level)?;
+        reduce
+            .bind()
+            .texture("u_below", pyramid)
+            .draw_fullscreen(&target, &DrawState::PLAIN)?;
+    }
+    pyramid.set_level_range(0, levels - 1);
+    Ok(())
+}
+
+/// The sorted map from its sorted (slot, record) pairs and cell table: the
+/// records gathered into sorted order (`photon/gather.frag`), power scaled
+/// to the emitted count in use.
+pub(crate) fn gather_records(
+    gpu: &Gpu,
+    gather: &Program,
+    frames: &PhotonFrames,
+    sorted: Texture,
+    grid_first: Texture,
+    grid_width: u32,
+    grid: &Grid,
+) -> Result<SortedPhotonMap> {
+    let (w, h) = (sorted.width, sorted.height);
+    let t = || Texture::new(gpu, w, h, TexFormat::Rgba32F);
+    let (position, power, incoming) = (t()?, t()?, t()?);
+    let target = Target::new(gpu, &[&position, &power, &incoming])?;
+    gather
+        .bind()
+        .texture("u_sorted", &sorted)
+        .texture("u_position", &frames.position)
+        .texture("u_power", &frames.power)
+        .texture("u_incoming", &frames.incoming)
+        .int("u_sorted_width", w as i32)
+        .int("u_record_width", frames.width as i32)
+        .float("u_power_scale", frames.power_scale)
+        .draw_fullscreen(&target, &DrawState::PLAIN)?;
+    gpu.check("gathering sorted photons")?;
+    Ok(SortedPhotonMap {
+        pairs: sorted,
+        position,
+        power,
+        incoming,
+        grid_first,
+        grid_width,
+        grid: *grid,
+    })
 }

@@ -10,8 +10,8 @@ use crate::timing::Timings;
 
 use super::trace::{PhotonFrames, TraceConfig, TraceReport};
 use super::{
-    fit, BitonicBuild, BuildMethod, Grid, GridKind, GridStorage, PhotonMap, PhotonTracer,
-    RandomSource, StencilRouting, VertexFeed,
+    fit, BitonicBuild, BuildMethod, CountingBuild, Grid, GridKind, GridStorage, PhotonMap,
+    PhotonTracer, RandomSource, StencilRouting, VertexFeed,
 };
 
 /// How photons are traced and the map built (what the scene file does not fix).
@@ -37,7 +37,7 @@ pub struct PhotonConfig {
 impl Default for PhotonConfig {
     fn default() -> Self {
         Self {
-            build: BuildMethod::Bitonic,
+            build: BuildMethod::Counting,
             stencil_block: 4,
             feed: VertexFeed::VertexFetch,
             faithful: false,
@@ -50,6 +50,15 @@ impl Default for PhotonConfig {
 }
 
 impl PhotonConfig {
+    /// The build that runs: `--faithful` takes the paper's bitonic sort
+    /// where the counting build (the default) is asked for.
+    pub fn build_method(&self) -> BuildMethod {
+        match self.build {
+            BuildMethod::Counting if self.faithful => BuildMethod::Bitonic,
+            build => build,
+        }
+    }
+
     /// The tracer's configuration: `--faithful` takes the random-number texture.
     pub fn trace(&self) -> TraceConfig {
         TraceConfig {
@@ -178,7 +187,10 @@ pub fn build_map(
     check_storage(&grid)?;
     let mut build_stages = Timings::default();
     let t0 = std::time::Instant::now();
-    let map = match config.build {
+    let map = match config.build_method() {
+        BuildMethod::Counting => {
+            PhotonMap::Sorted(CountingBuild::new(gpu)?.build(&frames, &grid, &mut build_stages)?)
+        }
         BuildMethod::Bitonic => {
             PhotonMap::Sorted(BitonicBuild::with_addressing(gpu, config.faithful)?.build(
                 &frames,

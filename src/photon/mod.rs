@@ -4,6 +4,7 @@
 
 pub mod bitonic;
 pub mod build;
+pub mod counting;
 pub mod differentials;
 pub mod fit;
 pub mod halton;
@@ -18,6 +19,7 @@ use crate::scene::Scene;
 
 pub use bitonic::{BitonicBuild, SortedPhotonMap};
 pub use build::{build_map, check_storage, BuiltMap, PhotonConfig};
+pub use counting::CountingBuild;
 pub use halton::{RandomSource, ScrambledHalton, HALTON_DIMENSIONS};
 pub use projection::ProjectionMaps;
 pub use stencil_routing::{LostPower, RoutedPhotonMap, StencilRouting, VertexFeed};
@@ -186,6 +188,10 @@ impl Grid {
 /// Which photon-map build to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 pub enum BuildMethod {
+    /// Counting sort into the grid: a slot histogram, its prefix sums by
+    /// HistoPyramid and one pass placing each photon; O(log n) passes, the
+    /// bitonic build's map (`--faithful` takes the bitonic sort).
+    Counting,
     /// Bitonic merge sort + binary search (section 2.2.1): exact, O(log^2 n) passes.
     Bitonic,
     /// Stencil routing (section 2.2.2): one pass, at most m^2 photons a cell.
@@ -195,6 +201,7 @@ pub enum BuildMethod {
 impl std::fmt::Display for BuildMethod {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
+            BuildMethod::Counting => "counting sort + HistoPyramid prefix sums",
             BuildMethod::Bitonic => "bitonic sort + binary search",
             BuildMethod::Stencil => "stencil routing",
         })

@@ -204,6 +204,7 @@ fn every_glsl_file_compiles() {
             "radiosity/deposit.frag" => vec!["radiosity/deposit.vert"],
             "radiosity/item_buffer.frag" => vec!["radiosity/item_buffer.vert"],
             "vcm/light_trace.frag" => vec!["vcm/light_trace.vert"],
+            "photon/place.frag" => vec!["photon/place.vert"],
             _ => vec!["common/fullscreen.vert"],
         }
     };
@@ -227,6 +228,9 @@ fn every_glsl_file_compiles() {
             | "photon/binary_search.frag"
             | "photon/gather.frag" => {
                 vec![vec![], vec![("FLOAT_ADDRESSING", "1".into())]]
+            }
+            "photon/pyramid_base.frag" | "photon/compact.frag" => {
+                vec![vec![], vec![("RECORD_ORDER", "1".into())]]
             }
             "photon/emit.frag" | "photon/trace.frag" => {
                 vec![vec![], vec![("RANDOM_TEXTURE", "1".into())]]

@@ -439,3 +439,123 @@ fn float_addressing_refuses_sorts_past_2_pow_24() {
     let cpu = sorted_pairs(&keys);
     assert_eq!(got, cpu);
 }
+
+/// The counting build against the bitonic build (itself tested against a
+/// CPU sort above) and against the twin's order (`sorted_pairs` over each
+/// photon's slot): the same cell table, and in each slot the same photons.
+/// On llvmpipe, whose tiles shade their fragments in draw order, each slot's
+/// photons also lie in record order, so the maps are equal bit for bit.
+/// Cases: CORNELL BOX's traced photons (several frames, unstored records) in
+/// its uniform grid and in a hash table, and synthetic photons crowding one
+/// cell, others spread, some outside the grid.
+#[test]
+fn the_counting_build_gives_the_bitonic_builds_map() {
+    use photonmap::photon::{CountingBuild, PhotonTracer};
+    use photonmap::scene::pack::SceneTextures;
+    let gpu = common::gpu();
+    let in_draw_order = gpu.capabilities().gl_renderer.contains("llvmpipe");
+    let bitonic = BitonicBuild::new(&gpu).unwrap();
+    let counting = CountingBuild::new(&gpu).unwrap();
+    let scene = common::paper_scene("cornell_box");
+    let textures = SceneTextures::new(&gpu, &scene).unwrap();
+    let (traced, _) = PhotonTracer::new(&gpu)
+        .unwrap()
+        .trace_to_stored(&scene, &textures, 3)
+        .unwrap();
+    let mut rng = Rng(0xB0C5);
+    let mut points: Vec<[f32; 3]> = (0..5000)
+        .map(|i| match i % 5 {
+            0 | 1 => [0.51, 0.52, 0.53], // one crowded cell
+            2 => [1.5, 0.5, 0.5],        // outside the grid
+            _ => [rng.f64() as f32, rng.f64() as f32, rng.f64() as f32],
+        })
+        .collect();
+    points.push([1.0, 1.0, 1.0]); // on the max faces: the last cell
+    let synthetic = common::frames_from_points(&gpu, &points, |_| [1.0; 3]);
+    let unit = unit_grid([16, 8, 4]);
+    let cases = [
+        (
+            "CORNELL BOX, uniform grid",
+            &traced,
+            Grid::for_scene(&scene),
+        ),
+        (
+            "CORNELL BOX, 4096 hash buckets",
+            &traced,
+            Grid::for_scene(&scene).with_storage(GridStorage::Hashed { buckets: 4096 }),
+        ),
+        ("crowded cell, uniform grid", &synthetic, unit),
+        (
+            "crowded cell, 100 hash buckets",
+            &synthetic,
+            unit.with_storage(GridStorage::Hashed { buckets: 100 }),
+        ),
+    ];
+    for (name, frames, grid) in cases {
+        let a = bitonic
+            .build(frames, &grid, &mut Timings::default())
+            .unwrap();
+        let b = counting
+            .build(frames, &grid, &mut Timings::default())
+            .unwrap();
+        let first = |m: &photonmap::photon::SortedPhotonMap| {
+            let all: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
+            all[..=grid.slot_count() as usize].to_vec()
+        };
+        let (fa, fb) = (first(&a), first(&b));
+        assert_eq!(fa, fb, "{name}: the cell tables differ");
+        let valid = fb[grid.slot_count() as usize] as usize;
+        let pairs = |m: &photonmap::photon::SortedPhotonMap| {
+            let all: Vec<(i32, i32)> = m.pairs.read_i32().chunks(2).map(|c| (c[0], c[1])).collect();
+            assert!(
+                all[valid..].iter().all(|p| p.0 == INVALID_KEY),
+                "{name}: a pair past the {valid} photons is not the invalid key"
+            );
+            all[..valid].to_vec()
+        };
+        let (pa, pb) = (pairs(&a), pairs(&b));
+        if name.starts_with("crowded") {
+            // The twin: every point's slot, sorted on the CPU.
+            let keys: Vec<i32> = points
+                .iter()
+                .map(|&p| match grid.cell_of(glam::Vec3::from(p)) {
+                    Some(c) => grid.slot_of_cell(c) as i32,
+                    None => INVALID_KEY,
+                })
+                .collect();
+            let expected: Vec<(i32, i32)> = sorted_pairs(&keys)
+                .into_iter()
+                .filter(|p| p.0 != INVALID_KEY)
+                .collect();
+            assert_eq!(
+                pa, expected,
+                "{name}: the bitonic build is not the twin's order"
+            );
+            assert!(valid == points.len() - 1000, "{name}: {valid} photons kept");
+        }
+        let mut sorted_within = pb.clone();
+        sorted_within.sort_unstable();
+        assert_eq!(pa, sorted_within, "{name}: a slot holds other photons");
+        if in_draw_order {
+            assert_eq!(pa, pb, "{name}: not in record order within a slot");
+            let texels = |t: &Texture| t.read_f32()[..4 * valid].to_vec();
+            for (x, y) in [
+                (&a.position, &b.position),
+                (&a.power, &b.power),
+                (&a.incoming, &b.incoming),
+            ] {
+                assert!(
+                    texels(x)
+                        .iter()
+                        .zip(texels(y))
+                        .all(|(p, q)| p.to_bits() == q.to_bits()),
+                    "{name}: the sorted records differ"
+                );
+            }
+        }
+        eprintln!(
+            "{name}: {valid} photons, {} slots: the same map",
+            grid.slot_count()
+        );
+    }
+}

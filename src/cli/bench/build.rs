@@ -141,4 +141,33 @@ fn print_build_bench(b: &BuildBench) {
             r.fused_to_faithful
         );
     }
+    println!("counting build (the default; the same map), whole builds:");
+    println!(
+        "{:>9} {:>6} {:>10} {:>9} {:>9} {:>9} {:>10} {:>12} {:>11} {:>11}",
+        "photons",
+        "passes",
+        "compact ms",
+        "prefix ms",
+        "place ms",
+        "gather ms",
+        "build ms",
+        "copy passes",
+        "bitonic ms",
+        "/ bitonic"
+    );
+    for r in &b.rows {
+        println!(
+            "{:>9} {:>6} {:>10.2} {:>9.2} {:>9.2} {:>9.2} {:>10.2} {:>12.1} {:>11.2} {:>11.3}",
+            r.photons,
+            r.counting_passes,
+            r.counting_compact_seconds * 1e3,
+            r.counting_prefix_seconds * 1e3,
+            r.counting_place_seconds * 1e3,
+            r.counting_gather_seconds * 1e3,
+            r.counting_seconds * 1e3,
+            r.counting_in_copy_passes,
+            r.bitonic_build_seconds * 1e3,
+            r.counting_to_bitonic
+        );
+    }
 }

@@ -18,7 +18,7 @@
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::photon::{
-    BitonicBuild, BuildMethod, Grid, GridKind, PhotonBatch, PhotonMap, PhotonTracer,
+    BitonicBuild, BuildMethod, CountingBuild, Grid, GridKind, PhotonBatch, PhotonMap, PhotonTracer,
     StencilRouting, TraceConfig,
 };
 use crate::scene::pack::SceneTextures;
@@ -59,6 +59,7 @@ fn reads_radius(iteration: u32) -> bool {
 }
 
 enum Builder {
+    Counting(Box<CountingBuild>),
     Bitonic(Box<BitonicBuild>),
     Stencil(Box<StencilRouting>, u32),
 }
@@ -138,7 +139,8 @@ impl Sppm {
             },
         )?;
         let batch = photons.batch(&scene, sppm.photons_per_iteration)?;
-        let builder = match config.build {
+        let builder = match config.build_method() {
+            BuildMethod::Counting => Builder::Counting(Box::new(CountingBuild::new(gpu)?)),
             BuildMethod::Bitonic => Builder::Bitonic(Box::new(BitonicBuild::with_addressing(
                 gpu,
                 config.faithful,
@@ -323,6 +325,7 @@ impl Sppm {
             Grid::over_scene(&self.scene, self.cell, self.max_cells()).with_storage(self.storage);
         let mut stages = Timings::default();
         let map = match &self.builder {
+            Builder::Counting(b) => PhotonMap::Sorted(b.build(frames, &grid, &mut stages)?),
             Builder::Bitonic(b) => PhotonMap::Sorted(b.build(frames, &grid, &mut stages)?),
             Builder::Stencil(s, m) => PhotonMap::Routed(s.build(
                 frames,
@@ -358,7 +361,7 @@ impl Sppm {
 
     fn max_cells(&self) -> u64 {
         match self.builder {
-            Builder::Bitonic(_) => MAX_CELLS_SORTED,
+            Builder::Counting(_) | Builder::Bitonic(_) => MAX_CELLS_SORTED,
             Builder::Stencil(..) => MAX_CELLS_ROUTED,
         }
     }
