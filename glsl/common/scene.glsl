@@ -136,7 +136,8 @@ vec3 offset_origin(vec3 p, vec3 n, vec3 dir) {
 }
 
 // ---- BVH traversal: an ordered stack (near child first; the far one pushed
-// with its entry distance, and dropped unread once a closer hit is known).
+// with its entry distance, and dropped unread once a closer hit is known);
+// with SCENE_LINEAR_SCAN, a loop over every primitive.
 
 ivec4 bvh_node_texel(int node, int which) {
     int i = 2 * node + which;
@@ -185,6 +186,20 @@ vec4 leaf_hit(int prim, SceneRay r) { return intersect_primitive_ray(prim, r); }
 // "hit" is a box passed through, at its exit distance: for occlusion only.)
 int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
     if (u_primitive_count == 0) return -1;
+#ifdef SCENE_LINEAR_SCAN
+    // A small scene (LINEAR_SCAN_MAX, src/layout.rs): every primitive in
+    // turn, no stack, no boxes.
+    int found = -1;
+    for (int prim = 0; prim < u_primitive_count; ++prim) {
+        vec4 h = leaf_hit(prim, r);
+        if (h.w > 0.0 && h.x < best.x) {
+            best = h;
+            found = prim;
+            if (any_hit) return found;
+        }
+    }
+    return found;
+#else
     ivec4 lo = bvh_node_texel(0, 0), hi = bvh_node_texel(0, 1);
     if (box_entry(lo, hi, r, best.x) == BOX_MISS) return -1;
     int hit = -1;
@@ -228,6 +243,7 @@ int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
         b = stack_node[depth].y;
     }
     return hit;
+#endif
 }
 
 // Closest hit along a unit direction: returns the primitive or -1, with its record.

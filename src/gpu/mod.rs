@@ -53,6 +53,8 @@ struct Shared {
     pixel_window: Cell<Option<PixelWindow>>,
     /// The scissor rectangle last sent (None: scissor test off).
     scissor: Cell<Option<[i32; 4]>>,
+    /// Defines every program compiled from now on gets (`set_scene_defines`).
+    scene_defines: std::cell::RefCell<Vec<(&'static str, String)>>,
 }
 
 /// Which targets are image-shaped, and the part of them to draw.
@@ -105,8 +107,22 @@ impl Gpu {
                 max_texture_size,
                 pixel_window: Cell::new(None),
                 scissor: Cell::new(None),
+                scene_defines: std::cell::RefCell::new(Vec::new()),
             }),
         })
+    }
+
+    /// Defines that every program compiled from now on gets, after its own:
+    /// what the scene last packed allows its shaders to leave out (scene
+    /// packing sets them). Programs compiled earlier keep theirs, so each
+    /// define must choose between two ways that are both right for every
+    /// scene, and differ only in speed.
+    pub fn set_scene_defines(&self, defines: Vec<(&'static str, String)>) {
+        *self.inner.scene_defines.borrow_mut() = defines;
+    }
+
+    pub(crate) fn scene_defines(&self) -> Vec<(&'static str, String)> {
+        self.inner.scene_defines.borrow().clone()
     }
 
     pub(crate) fn gl(&self) -> &glow::Context {

@@ -271,7 +271,12 @@ impl Program {
         geometry: Option<&str>,
         defines: &[(&str, String)],
     ) -> Result<Self> {
-        let defines = with_layout(defines);
+        let mut defines = with_layout(defines);
+        for (name, value) in gpu.scene_defines() {
+            if !defines.iter().any(|(n, _)| *n == name) {
+                defines.push((name, value));
+            }
+        }
         let vs_source = preprocess(lookup, vertex, &defines)?;
         let fs_source = preprocess(lookup, fragment, &defines)?;
         let gs_source = geometry

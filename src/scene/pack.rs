@@ -303,6 +303,13 @@ impl SceneTextures {
 
     /// The textures with a hierarchy built already (tests pass their own).
     pub fn with_bvh(gpu: &Gpu, scene: &Scene, bvh: &FlatBvh) -> Result<Self> {
+        // Programs compiled from here on trace a small scene by a loop over
+        // its primitives (both ways find the same hits; the loop is faster).
+        gpu.set_scene_defines(if scene.shapes.len() <= crate::layout::LINEAR_SCAN_MAX {
+            vec![("SCENE_LINEAR_SCAN", "1".to_string())]
+        } else {
+            Vec::new()
+        });
         let p = PackedScene::new(scene);
         let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
         let order: Vec<i32> = bvh.order.iter().map(|&i| i as i32).collect();
