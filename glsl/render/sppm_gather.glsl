@@ -37,8 +37,12 @@ void sppm_gather(vec3 x, vec3 nf, float r2, out vec3 gathered, out float m) {
                 int cell = cx + u_grid_resolution.x * (cy + u_grid_resolution.y * cz);
                 int base;
                 int count = cell_photon_count(cell, base);
-                for (int i = 0; i < count; ++i) {
-                    ivec2 t = photon_texel(base, i);
+                if (count == 0) continue;
+                // The next photon's texel from the last one's: no division a
+                // photon (SIMD lanes pay dearly for them).
+                ivec2 origin = photon_block_origin(base);
+                ivec2 t = photon_texel(base, 0);
+                for (int i = 0; i < count; ++i, t = photon_texel_next(t, origin)) {
                     vec3 photon = texelFetch(u_map_position, t, 0).xyz;
                     vec3 offset = photon - x;
                     float dist2 = dot(offset, offset);

@@ -102,8 +102,11 @@ vec3 merge(vec3 x, vec3 nf, vec3 a, float q, float cos_in, vec3 camera, int segm
                 int cell = cx + u_grid_resolution.x * (cy + u_grid_resolution.y * cz);
                 int base;
                 int count = cell_photon_count(cell, base);
-                for (int i = 0; i < count; ++i) {
-                    ivec2 t = photon_texel(base, i);
+                if (count == 0) continue;
+                // No division a photon (photon_texel_next; see sppm_gather.glsl).
+                ivec2 origin = photon_block_origin(base);
+                ivec2 t = photon_texel(base, 0);
+                for (int i = 0; i < count; ++i, t = photon_texel_next(t, origin)) {
                     vec3 photon = texelFetch(u_map_position, t, 0).xyz;
                     vec3 offset = photon - x;
                     if (dot(offset, offset) >= u_radius2) continue;

@@ -5,7 +5,8 @@
 //! its own, so [`gpu`] gives each test one context, made on first use,
 //! shared by everything the test renders and destroyed when its thread ends.
 //! A test that must have a context of its own (another platform, on a
-//! thread it spawns) makes one with [`OwnGpu::new`].
+//! thread it spawns) makes one with [`OwnGpu::new`], holding
+//! [`rendering_turn`] meanwhile. Tests render one at a time (`RENDERING`).
 //!
 //! Contexts are made and destroyed one at a time in the whole process.
 //! Mesa's EGL and OSMesa lock their own state, and src/gpu/context.rs opens
@@ -54,18 +55,45 @@ impl Drop for OwnGpu {
     }
 }
 
-thread_local! {
-    static THIS_TESTS_GPU: OnceCell<OwnGpu> = const { OnceCell::new() };
+/// One test at a time renders. Mesa 22's llvmpipe crashes now and then
+/// (SIGSEGV) with two test threads rendering on contexts of their own at
+/// once: a core dump showed one thread uploading a texture
+/// (`tex_sub_image_2d`) inside swrast_dri while the other, in its first
+/// fused eye-path draw, waited on a lock of the driver's. Tests that do
+/// not render still run beside them.
+static RENDERING: Mutex<()> = Mutex::new(());
+
+/// This thread's turn to render, held until it is dropped: for a test that
+/// renders on contexts of its own (`OwnGpu`, on threads it spawns) rather
+/// than through [`gpu`].
+pub fn rendering_turn() -> MutexGuard<'static, ()> {
+    RENDERING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
-/// This test's context (the thread's): made on the first call, the same
-/// context on every later one.
+/// A test's context and its turn to render, dropped in that order when the
+/// test's thread ends.
+struct TestGpu {
+    gpu: OwnGpu,
+    _turn: MutexGuard<'static, ()>,
+}
+
+thread_local! {
+    static THIS_TESTS_GPU: OnceCell<TestGpu> = const { OnceCell::new() };
+}
+
+/// This test's context (the thread's): made on the first call, after
+/// waiting for the test's turn to render (`RENDERING`), the same context on
+/// every later one.
 pub fn gpu() -> Gpu {
     THIS_TESTS_GPU.with(|cell| {
-        let own = cell.get_or_init(|| {
-            OwnGpu::new(Platform::Auto)
-                .expect("a GL 4 context (install libegl1 libegl-mesa0 libgl1-mesa-dri)")
+        let test = cell.get_or_init(|| {
+            let turn = rendering_turn();
+            let gpu = OwnGpu::new(Platform::Auto)
+                .expect("a GL 4 context (install libegl1 libegl-mesa0 libgl1-mesa-dri)");
+            TestGpu { gpu, _turn: turn }
         });
-        Gpu::clone(own)
+        Gpu::clone(&test.gpu)
     })
 }

@@ -20,7 +20,7 @@ mod rng;
 
 // Every test binary compiles this module; none uses all of it.
 #[allow(unused_imports)]
-pub use context::{gpu, OwnGpu};
+pub use context::{gpu, rendering_turn, OwnGpu};
 #[allow(unused_imports)]
 pub use moved_text::moved_scene_text;
 #[allow(unused_imports)]

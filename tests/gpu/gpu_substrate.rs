@@ -394,6 +394,7 @@ fn layout_constants_reach_every_program_and_no_shader_redefines_them() {
 /// the later context's textures still upload and read back.
 #[test]
 fn dropping_another_context_leaves_this_one_current() {
+    let _turn = common::rendering_turn();
     std::thread::spawn(|| {
         let first = common::OwnGpu::new(photonmap::gpu::Platform::Auto).unwrap();
         let second = common::OwnGpu::new(photonmap::gpu::Platform::Auto).unwrap();

@@ -28,6 +28,7 @@ fn render_on(platform: Platform, name: &'static str) -> Image {
 
 #[test]
 fn osmesa_and_egl_surfaceless_render_the_paper_scenes_bit_identical() {
+    let _turn = common::rendering_turn();
     for name in ["glass_ball", "ring", "cornell_box"] {
         let a = render_on(Platform::Osmesa, name);
         let b = render_on(Platform::EglSurfaceless, name);
