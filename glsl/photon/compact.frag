@@ -9,14 +9,13 @@
 // is counted into its grid slot's texel of u_counts (a histogram laid out in
 // Z order), which the counting build's prefix sums read.
 #include "common/addressing.glsl"
+#include "common/histopyramid.glsl"
 #include "common/grid.glsl"
 #ifdef RECORD_ORDER
 #include "common/zorder.glsl"
 layout(r32i) uniform iimage2D u_counts;
 #endif
 
-uniform isampler2D u_pyramid;     // mip level 0: records; each level sums 2 x 2 below
-uniform int u_top;                // the one-texel level
 uniform sampler2D u_position;
 uniform int u_record_width;
 uniform int u_out_width;
@@ -24,12 +23,6 @@ uniform int u_count;              // stored records in all
 
 layout(location = 0) out ivec4 o_pair;
 
-
-int count_at(int level, ivec2 t) {
-    ivec2 size = textureSize(u_pyramid, level);
-    if (t.x >= size.x || t.y >= size.y) return 0;
-    return texelFetch(u_pyramid, t, level).x;
-}
 
 void main() {
     int slot = index_of_texel(ivec2(gl_FragCoord.xy), u_out_width);

@@ -7,20 +7,13 @@
 // one walk up the pyramid sums them. One extra entry past the last slot holds
 // the number of photons, as binary_search.frag writes it.
 #include "common/addressing.glsl"
+#include "common/histopyramid.glsl"
 #include "common/zorder.glsl"
 
-uniform isampler2D u_pyramid;  // level 0: photons per slot; each level sums 2 x 2 below
-uniform int u_top;             // the one-texel level
 uniform int u_grid_width;      // width of the cell table
 uniform int u_cell_count;      // slots
 
 layout(location = 0) out ivec4 o_first;
-
-int count_at(int level, ivec2 t) {
-    ivec2 size = textureSize(u_pyramid, level);
-    if (t.x >= size.x || t.y >= size.y) return 0;
-    return texelFetch(u_pyramid, t, level).x;
-}
 
 void main() {
     int slot = index_of_texel(ivec2(gl_FragCoord.xy), u_grid_width);

@@ -6,7 +6,8 @@
 use glam::Vec3;
 
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
-use crate::photon::bitonic::{sort_texture_size, BitonicBuild};
+use crate::photon::bitonic::BitonicBuild;
+use crate::photon::compaction::sort_texture_size;
 use crate::photon::{CountingBuild, Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
 use crate::timing::{StageTiming, Timings};
 

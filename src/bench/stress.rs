@@ -393,7 +393,7 @@ fn sizes(gpu: &Gpu, quick: bool, progress: &dyn Fn(&str), cases: &mut Vec<Stress
 
 /// Pairs out of order after a GPU bitonic sort of n random keys, against a CPU sort.
 fn sort_errors(gpu: &Gpu, n: usize) -> Result<usize> {
-    let (w, h) = crate::photon::bitonic::sort_texture_size(n as u64);
+    let (w, h) = crate::photon::compaction::sort_texture_size(n as u64);
     let keys: Vec<i32> = (0..n as u32)
         .map(|i| (crate::random::pcg_hash(99u32.wrapping_add(i + 1)) % 100_000) as i32)
         .collect();

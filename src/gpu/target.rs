@@ -116,30 +116,23 @@ impl Target {
 
     /// Clears every colour attachment to `value`.
     pub fn clear(&self, value: [f32; 4]) {
+        // SAFETY: gpu module doc; `i` is an attachment of this framebuffer.
+        self.clear_each(|gl, i| unsafe { gl.clear_buffer_f32_slice(glow::COLOR, i, &value) });
+    }
+
+    /// Clears every colour attachment, integer textures, to `value`.
+    pub fn clear_i32(&self, value: [i32; 4]) {
+        // SAFETY: as for `clear`.
+        self.clear_each(|gl, i| unsafe { gl.clear_buffer_i32_slice(glow::COLOR, i, &value) });
+    }
+
+    /// Binds the target and runs `clear` for each colour attachment.
+    fn clear_each(&self, clear: impl Fn(&glow::Context, u32)) {
         self.bind();
         // Colour writes must be on for a clear to write.
         self.gpu.apply(&DrawState::PLAIN);
-        // SAFETY: gpu module doc; attachments 0..n exist on this framebuffer.
-        unsafe {
-            for i in 0..self.attachments {
-                self.gpu
-                    .gl()
-                    .clear_buffer_f32_slice(glow::COLOR, i as u32, &value);
-            }
-        }
-    }
-
-    /// Clears every (integer) colour attachment to `value`.
-    pub fn clear_i32(&self, value: [i32; 4]) {
-        self.bind();
-        self.gpu.apply(&DrawState::PLAIN);
-        // SAFETY: gpu module doc; attachments 0..n exist on this framebuffer.
-        unsafe {
-            for i in 0..self.attachments {
-                self.gpu
-                    .gl()
-                    .clear_buffer_i32_slice(glow::COLOR, i as u32, &value);
-            }
+        for i in 0..self.attachments {
+            clear(self.gpu.gl(), i as u32);
         }
     }
 

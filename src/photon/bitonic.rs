@@ -8,6 +8,7 @@ use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
 use crate::timing::Timings;
 
+use super::compaction::{sort_texture_size, Compaction};
 use super::{Grid, PhotonFrames, StageClock};
 
 /// Float addresses are exact below 2^24 (the float mantissa).
@@ -27,12 +28,6 @@ pub struct SortedPhotonMap {
     pub grid_first: Texture,
     pub grid_width: u32,
     pub grid: Grid,
-}
-
-/// A 2D texture of n = 2^k texels: width 2^ceil(k/2), height 2^floor(k/2).
-pub fn sort_texture_size(n: u64) -> (u32, u32) {
-    let k = n.max(2).next_power_of_two().trailing_zeros();
-    (1 << k.div_ceil(2), 1 << (k / 2))
 }
 
 /// `keys` as the sort's RG32I records: (key, record index) a texel.
@@ -128,9 +123,7 @@ pub struct BitonicBuild {
     compact: bool,
     /// Float 1D -> 2D addressing (the paper's); exact below 2^24 only.
     float_addressing: bool,
-    pyramid_base: Program,
-    pyramid_reduce: Program,
-    compact_pass: Program,
+    compaction: Compaction,
     keys: Program,
     bitonic: Program,
     bitonic_pair: Program,
@@ -162,9 +155,7 @@ impl BitonicBuild {
             bitonic_local: p("photon/bitonic_local.frag")?,
             compact: !float_addressing,
             float_addressing,
-            pyramid_base: p("photon/pyramid_base.frag")?,
-            pyramid_reduce: p("photon/pyramid_reduce.frag")?,
-            compact_pass: p("photon/compact.frag")?,
+            compaction: Compaction::new(gpu, &defines, false)?,
             keys: p("photon/keys.frag")?,
             bitonic: p("photon/bitonic.frag")?,
             search: p("photon/binary_search.frag")?,
@@ -259,9 +250,7 @@ impl BitonicBuild {
 
     /// For each slot 0..=slots (cells, or hash buckets), its lower bound in the sorted pairs.
     pub fn binary_search(&self, sorted: &Texture, cells: u32) -> Result<(Texture, u32)> {
-        let entries = cells as u64 + 1;
-        let grid_width = (entries as f64).sqrt().ceil() as u32;
-        let grid_height = (entries.div_ceil(grid_width as u64)) as u32;
+        let (grid_width, grid_height) = cell_table_size(cells);
         let first = Texture::new(&self.gpu, grid_width, grid_height, TexFormat::Rgba32I)?;
         let target = Target::new(&self.gpu, &[&first])?;
         self.search
@@ -280,33 +269,8 @@ impl BitonicBuild {
     /// slots of a power-of-two texture: HistoPyramid count, reduce, traverse.
     /// Returns the pairs and the number of stored records.
     pub fn compacted_pairs(&self, frames: &PhotonFrames, grid: &Grid) -> Result<(Texture, u32)> {
-        let (w, h) = sort_texture_size(frames.record_count() as u64);
-        let levels = 32 - w.max(h).leading_zeros();
-        let pyramid = Texture::with_levels(&self.gpu, w, h, TexFormat::Rgba32I, levels)?;
-        {
-            let target = Target::for_level(&self.gpu, &pyramid, 0)?;
-            let mut b = self.pyramid_base.bind();
-            grid.bind(&mut b);
-            frames.bind_records(&mut b);
-            b.int("u_level_width", w as i32)
-                .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        }
-        reduce_pyramid(&self.gpu, &self.pyramid_reduce, &pyramid, levels)?;
-        let count = pyramid.read_i32_texel(levels - 1)[0] as u32;
-        let (cw, ch) = sort_texture_size(count.max(2) as u64);
-        let pairs = Texture::new(&self.gpu, cw, ch, TexFormat::Rg32I)?;
-        let target = Target::new(&self.gpu, &[&pairs])?;
-        let mut b = self.compact_pass.bind();
-        grid.bind(&mut b);
-        b.texture("u_pyramid", &pyramid)
-            .int("u_top", levels as i32 - 1)
-            .texture("u_position", &frames.position)
-            .int("u_record_width", frames.width as i32)
-            .int("u_out_width", cw as i32)
-            .int("u_count", count as i32)
-            .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        self.gpu.check("compacting stored photons")?;
-        Ok((pairs, count))
+        let c = self.compaction.pairs(frames, grid, None)?;
+        Ok((c.pairs, c.count))
     }
 
     /// The whole build from traced photon frames, with its stages timed.
@@ -319,13 +283,9 @@ impl BitonicBuild {
         let query = Query::timer(&self.gpu)?;
         let pairs = if self.compact {
             let clock = StageClock::start(&self.gpu, &query);
-            let (pairs, _) = self.compacted_pairs(frames, grid)?;
-            let levels = 32
-                - sort_texture_size(frames.record_count() as u64)
-                    .0
-                    .leading_zeros();
-            clock.stop(timings, "compact", levels as usize + 1);
-            pairs
+            let c = self.compaction.pairs(frames, grid, None)?;
+            clock.stop(timings, "compact", c.passes as usize);
+            c.pairs
         } else {
             let (w, h) = sort_texture_size(frames.record_count() as u64);
             let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
@@ -362,25 +322,12 @@ impl BitonicBuild {
     }
 }
 
-/// Sums level 0 of a HistoPyramid up to its one-texel top, a pass a level
-/// (`photon/pyramid_reduce.frag`).
-pub(crate) fn reduce_pyramid(
-    gpu: &Gpu,
-    reduce: &Program,
-    pyramid: &Texture,
-    levels: u32,
-) -> Result<()> {
-    for level in 1..levels {
-        // Samplers see only the level below while this one is drawn.
-        pyramid.set_level_range(level - 1, level - 1);
-        let target = Target::for_level(gpu, pyramid, level)?;
-        reduce
-            .bind()
-            .texture("u_below", pyramid)
-            .draw_fullscreen(&target, &DrawState::PLAIN)?;
-    }
-    pyramid.set_level_range(0, levels - 1);
-    Ok(())
+/// The cell table's texture: `slots` + 1 entries (the count past the last
+/// slot), about square.
+pub(crate) fn cell_table_size(slots: u32) -> (u32, u32) {
+    let entries = slots as u64 + 1;
+    let width = (entries as f64).sqrt().ceil() as u32;
+    (width, entries.div_ceil(width as u64) as u32)
 }
 
 /// The sorted map from its sorted (slot, record) pairs and cell table: the

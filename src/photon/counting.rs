@@ -22,76 +22,33 @@
 use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
 use crate::timing::Timings;
 
-use super::bitonic::{gather_records, reduce_pyramid, sort_texture_size};
+use super::bitonic::{cell_table_size, gather_records};
+use super::compaction::{pyramid_levels, sort_texture_size, Compaction};
 use super::{Grid, PhotonFrames, SortedPhotonMap, StageClock};
-
-/// Mip levels of a HistoPyramid over a `w` x `h` power-of-two base.
-fn pyramid_levels(w: u32, h: u32) -> u32 {
-    32 - w.max(h).leading_zeros()
-}
 
 pub struct CountingBuild {
     gpu: Gpu,
-    pyramid_base: Program,
-    pyramid_reduce: Program,
-    compact: Program,
+    compaction: Compaction,
     prefix: Program,
     place: Program,
     gather: Program,
+    /// What the placement draws into: nothing (every vertex is clipped and
+    /// stores through images), but a draw needs a target.
+    no_pixels: (Texture, Target),
 }
 
 impl CountingBuild {
     pub fn new(gpu: &Gpu) -> Result<Self> {
-        let record_order = [("RECORD_ORDER", "1".to_string())];
+        let unused = Texture::new(gpu, 1, 1, TexFormat::R32I)?;
+        let target = Target::new(gpu, &[&unused])?;
         Ok(Self {
             gpu: gpu.clone(),
-            pyramid_base: Program::fullscreen_with(gpu, "photon/pyramid_base.frag", &record_order)?,
-            pyramid_reduce: Program::fullscreen(gpu, "photon/pyramid_reduce.frag")?,
-            compact: Program::fullscreen_with(gpu, "photon/compact.frag", &record_order)?,
+            compaction: Compaction::new(gpu, &[], true)?,
             prefix: Program::fullscreen(gpu, "photon/prefix_first.frag")?,
             place: Program::new(gpu, "photon/place.vert", "photon/place.frag", &[])?,
             gather: Program::fullscreen(gpu, "photon/gather.frag")?,
+            no_pixels: (unused, target),
         })
-    }
-
-    /// Step 1: the stored records' (slot, record) pairs in record order, and
-    /// the histogram of their slots (level 0 of `counts`, zeroed here).
-    fn compacted_pairs(
-        &self,
-        frames: &PhotonFrames,
-        grid: &Grid,
-        counts: &Texture,
-    ) -> Result<(Texture, u32)> {
-        let (w, h) = sort_texture_size(frames.record_count() as u64);
-        let levels = pyramid_levels(w, h);
-        let pyramid = Texture::with_levels(&self.gpu, w, h, TexFormat::Rgba32I, levels)?;
-        {
-            let target = Target::for_level(&self.gpu, &pyramid, 0)?;
-            let mut b = self.pyramid_base.bind();
-            grid.bind(&mut b);
-            frames.bind_records(&mut b);
-            b.int("u_level_width", w as i32)
-                .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        }
-        reduce_pyramid(&self.gpu, &self.pyramid_reduce, &pyramid, levels)?;
-        let count = pyramid.read_i32_texel(levels - 1)[0] as u32;
-        Target::for_level(&self.gpu, counts, 0)?.clear_i32([0; 4]);
-        let (cw, ch) = sort_texture_size(count.max(2) as u64);
-        let pairs = Texture::new(&self.gpu, cw, ch, TexFormat::Rg32I)?;
-        let target = Target::new(&self.gpu, &[&pairs])?;
-        let mut b = self.compact.bind();
-        grid.bind(&mut b);
-        b.texture("u_pyramid", &pyramid)
-            .int("u_top", levels as i32 - 1)
-            .texture("u_position", &frames.position)
-            .int("u_record_width", frames.width as i32)
-            .int("u_out_width", cw as i32)
-            .int("u_count", count as i32)
-            .image_read_write("u_counts", counts)
-            .draw_fullscreen(&target, &DrawState::PLAIN)?;
-        self.gpu.image_barrier();
-        self.gpu.check("compacting and counting stored photons")?;
-        Ok((pairs, count))
     }
 
     /// The whole build from traced photon frames, with its stages timed.
@@ -109,18 +66,13 @@ impl CountingBuild {
         let counts = Texture::with_levels(&self.gpu, hw, hh, TexFormat::R32I, levels)?;
 
         let clock = StageClock::start(&self.gpu, &query);
-        let (pairs, count) = self.compacted_pairs(frames, grid, &counts)?;
-        let record_levels = {
-            let (w, h) = sort_texture_size(frames.record_count() as u64);
-            pyramid_levels(w, h)
-        };
-        clock.stop(timings, "compact and count", record_levels as usize + 1);
+        let compacted = self.compaction.pairs(frames, grid, Some(&counts))?;
+        clock.stop(timings, "compact and count", compacted.passes as usize);
+        let (pairs, count) = (compacted.pairs, compacted.count);
 
         let clock = StageClock::start(&self.gpu, &query);
-        reduce_pyramid(&self.gpu, &self.pyramid_reduce, &counts, levels)?;
-        let entries = slots as u64 + 1;
-        let grid_width = (entries as f64).sqrt().ceil() as u32;
-        let grid_height = entries.div_ceil(grid_width as u64) as u32;
+        self.compaction.reduce(&counts, levels)?;
+        let (grid_width, grid_height) = cell_table_size(slots);
         let grid_first = Texture::new(&self.gpu, grid_width, grid_height, TexFormat::Rgba32I)?;
         {
             let target = Target::new(&self.gpu, &[&grid_first])?;
@@ -139,10 +91,6 @@ impl CountingBuild {
         let sorted = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
         let clock = StageClock::start(&self.gpu, &query);
         Target::new(&self.gpu, &[&sorted])?.clear_i32([crate::layout::INVALID_KEY, 0, 0, 0]);
-        // Every vertex stores through images and is clipped: the draw needs
-        // a target, not its texels.
-        let unused = Texture::new(&self.gpu, 1, 1, TexFormat::R32I)?;
-        let points = Target::new(&self.gpu, &[&unused])?;
         self.place
             .bind()
             .texture("u_pairs", &pairs)
@@ -152,7 +100,7 @@ impl CountingBuild {
             .image_read_write("u_counts", &counts)
             .image("u_sorted", &sorted)
             .int("u_sorted_width", w as i32)
-            .draw_points(&points, &DrawState::NO_COLOR, 0, count as i32)?;
+            .draw_points(&self.no_pixels.1, &DrawState::NO_COLOR, 0, count as i32)?;
         self.gpu.image_barrier();
         self.gpu.check("placing photons")?;
         clock.stop(timings, "place", 1);

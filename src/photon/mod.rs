@@ -4,6 +4,7 @@
 
 pub mod bitonic;
 pub mod build;
+pub mod compaction;
 pub mod counting;
 pub mod differentials;
 pub mod fit;

@@ -8,10 +8,15 @@ use crate::common::Rng;
 
 use photonmap::gpu::{Gpu, TexFormat, Texture};
 use photonmap::photon::bitonic::{
-    fused_plan, key_records, pass_count, sort_texture_size, sorted_pairs, BitonicBuild, INVALID_KEY,
+    fused_plan, key_records, pass_count, sorted_pairs, BitonicBuild, INVALID_KEY,
 };
-use photonmap::photon::{Grid, GridStorage, StencilRouting, VertexFeed};
+use photonmap::photon::compaction::sort_texture_size;
+use photonmap::photon::{
+    Grid, GridStorage, PhotonFrames, PhotonTracer, SortedPhotonMap, StencilRouting, VertexFeed,
+};
 use photonmap::render::Timings;
+use photonmap::scene::pack::SceneTextures;
+use photonmap::scene::Scene;
 use photonmap::twins::photon::route;
 
 /// Sorts on the GPU in RG32I (what the build uses) or RGBA32I.
@@ -367,17 +372,32 @@ fn the_stencil_pattern_and_saturation_are_as_the_paper_describes() {
     }
 }
 
+/// CORNELL BOX and its photons traced to the stored count with `seed`.
+fn cornell_box_photons(gpu: &Gpu, seed: u32) -> (Scene, PhotonFrames) {
+    let scene = common::paper_scene("cornell_box");
+    let textures = SceneTextures::new(gpu, &scene).unwrap();
+    let (frames, _) = PhotonTracer::new(gpu)
+        .unwrap()
+        .trace_to_stored(&scene, &textures, seed)
+        .unwrap();
+    (scene, frames)
+}
+
+/// A sorted map's cell table, entries 0..=slots.
+fn cell_table(m: &SortedPhotonMap, slots: u32) -> Vec<i32> {
+    let all: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
+    all[..=slots as usize].to_vec()
+}
+
+/// A sorted map's (slot, record) pairs, every texel.
+fn sorted_pairs_of(m: &SortedPhotonMap) -> Vec<(i32, i32)> {
+    m.pairs.read_i32().chunks(2).map(|c| (c[0], c[1])).collect()
+}
+
 #[test]
 fn compaction_gives_the_same_map_as_sorting_every_record() {
-    use photonmap::photon::PhotonTracer;
-    use photonmap::scene::pack::SceneTextures;
     let gpu = common::gpu();
-    let scene = common::paper_scene("cornell_box");
-    let textures = SceneTextures::new(&gpu, &scene).unwrap();
-    let (frames, _) = PhotonTracer::new(&gpu)
-        .unwrap()
-        .trace_to_stored(&scene, &textures, 2)
-        .unwrap();
+    let (scene, frames) = cornell_box_photons(&gpu, 2);
     let grid = Grid::for_scene(&scene);
     let build = BitonicBuild::new(&gpu).unwrap();
     let compacted = build
@@ -387,24 +407,11 @@ fn compaction_gives_the_same_map_as_sorting_every_record() {
     let full = build
         .build(&frames, &grid, &mut Timings::default())
         .unwrap();
-    let first = |m: &photonmap::photon::SortedPhotonMap| {
-        m.grid_first
-            .read_i32()
-            .chunks(4)
-            .map(|c| c[0])
-            .collect::<Vec<_>>()
-    };
+    let first = |m: &SortedPhotonMap| cell_table(m, grid.slot_count());
     assert_eq!(first(&compacted), first(&full), "cell ranges differ");
     let valid = first(&full)[grid.cell_count() as usize] as usize;
     assert!(valid > 60_000, "{valid} photons in the map");
-    let pairs = |m: &photonmap::photon::SortedPhotonMap| {
-        m.pairs
-            .read_i32()
-            .chunks(2)
-            .take(valid)
-            .map(|c| (c[0], c[1]))
-            .collect::<Vec<_>>()
-    };
+    let pairs = |m: &SortedPhotonMap| sorted_pairs_of(m)[..valid].to_vec();
     assert_eq!(
         pairs(&compacted),
         pairs(&full),
@@ -450,18 +457,12 @@ fn float_addressing_refuses_sorts_past_2_pow_24() {
 /// cell, others spread, some outside the grid.
 #[test]
 fn the_counting_build_gives_the_bitonic_builds_map() {
-    use photonmap::photon::{CountingBuild, PhotonTracer};
-    use photonmap::scene::pack::SceneTextures;
+    use photonmap::photon::CountingBuild;
     let gpu = common::gpu();
     let in_draw_order = gpu.capabilities().gl_renderer.contains("llvmpipe");
     let bitonic = BitonicBuild::new(&gpu).unwrap();
     let counting = CountingBuild::new(&gpu).unwrap();
-    let scene = common::paper_scene("cornell_box");
-    let textures = SceneTextures::new(&gpu, &scene).unwrap();
-    let (traced, _) = PhotonTracer::new(&gpu)
-        .unwrap()
-        .trace_to_stored(&scene, &textures, 3)
-        .unwrap();
+    let (scene, traced) = cornell_box_photons(&gpu, 3);
     let mut rng = Rng(0xB0C5);
     let mut points: Vec<[f32; 3]> = (0..5000)
         .map(|i| match i % 5 {
@@ -498,15 +499,14 @@ fn the_counting_build_gives_the_bitonic_builds_map() {
         let b = counting
             .build(frames, &grid, &mut Timings::default())
             .unwrap();
-        let first = |m: &photonmap::photon::SortedPhotonMap| {
-            let all: Vec<i32> = m.grid_first.read_i32().chunks(4).map(|c| c[0]).collect();
-            all[..=grid.slot_count() as usize].to_vec()
-        };
-        let (fa, fb) = (first(&a), first(&b));
+        let (fa, fb) = (
+            cell_table(&a, grid.slot_count()),
+            cell_table(&b, grid.slot_count()),
+        );
         assert_eq!(fa, fb, "{name}: the cell tables differ");
         let valid = fb[grid.slot_count() as usize] as usize;
-        let pairs = |m: &photonmap::photon::SortedPhotonMap| {
-            let all: Vec<(i32, i32)> = m.pairs.read_i32().chunks(2).map(|c| (c[0], c[1])).collect();
+        let pairs = |m: &SortedPhotonMap| {
+            let all = sorted_pairs_of(m);
             assert!(
                 all[valid..].iter().all(|p| p.0 == INVALID_KEY),
                 "{name}: a pair past the {valid} photons is not the invalid key"

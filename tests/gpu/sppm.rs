@@ -142,6 +142,14 @@ fn sppm_image(scene: &Scene, w: u32, h: u32, seed: u32, o: &SppmOptions) -> Imag
     .image
 }
 
+/// The mean of independent samples and its standard error (from their spread).
+fn mean_and_standard_error(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
 fn mean_of(img: &Image) -> f64 {
     img.mean().iter().sum::<f64>() / 3.0
 }
@@ -299,9 +307,7 @@ fn the_furnace_seen_from_inside_glass_is_ior_squared_as_bright() {
         let ratios: Vec<f64> = (1..=8)
             .map(|seed| mean_of(&image(seed)) / expected)
             .collect();
-        let mean = ratios.iter().sum::<f64>() / 8.0;
-        let sd = (ratios.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / 7.0).sqrt();
-        let se = sd / 8f64.sqrt();
+        let (mean, se) = mean_and_standard_error(&ratios);
         eprintln!("furnace in glass, {name}: {mean:.4} +- {se:.4} of ior^2 L (seeds {ratios:.4?})");
         assert!(
             se < 0.01,
@@ -348,8 +354,7 @@ fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
     let (chi2, blocks, bound) = common::block_chi2_against_runs(&images, [&runs[0], &runs[1]], 4);
     let reference = 0.5 * (mean_of(&runs[0]) + mean_of(&runs[1]));
     let ratios: Vec<f64> = images.iter().map(|i| mean_of(i) / reference).collect();
-    let energy = ratios.iter().sum::<f64>() / 8.0;
-    let se = (ratios.iter().map(|r| (r - energy).powi(2)).sum::<f64>() / 7.0 / 8.0).sqrt();
+    let (energy, se) = mean_and_standard_error(&ratios);
     eprintln!(
         "glass tank {w} x {h}: {blocks} blocks, chi^2/n = {chi2:.2} (bound {bound:.2}); energy {energy:.4} +- {se:.4} of Mitsuba's (8 x 32 SPPM iterations in {seconds:.1} s)"
     );
