@@ -4,14 +4,14 @@
 // common/specular_step.glsl) and on past diffuse vertices by cosine
 // sampling and Russian roulette. At each diffuse vertex it takes
 // - next-event estimation: one point on one light, picked by power;
-// - connections to every stored vertex of its light path (light path
-//   pixel index mod N, vcm/light_vertex.glsl);
+// - connections to light vertices drawn from all of this iteration's (the
+//   light vertex cache: the map's compacted vertices, vcm/light_vertex.glsl);
 // - merging with the light vertices of this iteration's map within the
 //   radius (the map's photons are the light vertices);
 // and where it meets a light, the light's radiance. Each is weighted by the
 // balance heuristic over every technique that could make its path
 // (vcm/mis.glsl). Light tracing, the one technique with no camera vertex,
-// is vcm/light_trace.vert's. u_mode chooses the techniques: VCM_MODE_*
+// is vcm/light_connect.frag's. u_mode chooses the techniques: VCM_MODE_*
 // (src/render/vcm/options.rs names them).
 #include "common/camera.glsl"
 #include "common/direct_light.glsl"
@@ -27,7 +27,10 @@ uniform int u_max_segments;       // longest path, in segments
 uniform float u_radius2;          // merging radius squared
 uniform isampler2D u_map_pairs;   // sorted (key, record): a map photon's record
 uniform sampler2D u_map_incoming;
-uniform int u_merge;              // 1: the map is built (merging runs)
+uniform int u_merge;              // 1: merging runs
+uniform int u_map_built;          // 1: the map of the light vertices is bound
+uniform int u_slots;              // its slots; u_grid_first[u_slots] counts its vertices
+uniform int u_connections;        // light vertices a camera vertex connects to
 
 layout(location = 0) out vec4 o_radiance;
 // What each technique carried (their sum is o_radiance): lights hit,
@@ -86,16 +89,18 @@ bool sample_light(inout uint rng, vec3 x, out vec3 radiance, out vec3 wi, out fl
 }
 
 // Merging at camera vertex x (normal nf facing where the path came from,
-// albedo a, continuation q, arriving cosine cos_in, `segments` from the
-// camera): the sum over this iteration's light vertices within the radius
-// of weight x BRDF x power, over pi r^2.
-vec3 merge(vec3 x, vec3 nf, vec3 a, float q, float cos_in, vec3 camera, int segments) {
+// albedo a, continuation q of camera paths and q_light of light paths,
+// arriving cosine cos_in, `segments` from the camera): the sum over this
+// iteration's light vertices within the radius of weight x BRDF x power,
+// over pi r^2.
+vec3 merge(vec3 x, vec3 nf, vec3 a, float q, float q_light, float cos_in, vec3 camera,
+           int segments) {
     float r = sqrt(u_radius2);
     vec3 cell_size = (u_grid_max - u_grid_min) / vec3(u_grid_resolution);
     ivec3 lo = clamp(ivec3(floor((x - r - u_grid_min) / cell_size)), ivec3(0), u_grid_resolution - 1);
     ivec3 hi = clamp(ivec3(floor((x + r - u_grid_min) / cell_size)), ivec3(0), u_grid_resolution - 1);
     vec3 sum = vec3(0.0);
-    float camera_rev_pdf_w = q * cos_in / PI;
+    float camera_rev_pdf_w = q_light * cos_in / PI;
     for (int cz = lo.z; cz <= hi.z; ++cz)
         for (int cy = lo.y; cy <= hi.y; ++cy)
             for (int cx = lo.x; cx <= hi.x; ++cx) {
@@ -125,14 +130,25 @@ vec3 merge(vec3 x, vec3 nf, vec3 a, float q, float cos_in, vec3 camera, int segm
     return sum * (a / PI) / (PI * u_radius2);
 }
 
-// Connections from camera vertex x to every stored vertex of light path
-// `path` (its texel in frame 0).
-vec3 connect(ivec2 path, vec3 x, vec3 nf, vec3 a, float q, float cos_in, vec3 camera, int segments) {
+// The light vertices of this iteration's map: its slot table's last entry.
+int light_vertex_count() {
+    return texelFetch(u_grid_first, texel_of_index(u_slots, u_grid_width), 0).x;
+}
+
+// Connections from camera vertex x to u_connections light vertices drawn
+// uniformly from all `count` of this iteration (Davidovic et al. 2014's light
+// vertex cache). Scaled by count / (N u_connections), the sum is in
+// expectation the connections to every vertex of one light path, so each
+// path length is connected as often as that and the MIS weights stand.
+vec3 connect(inout uint rng, int count, vec3 x, vec3 nf, vec3 a, float q, float q_light,
+             float cos_in, vec3 camera, int segments) {
     vec3 sum = vec3(0.0);
     vec3 origin = x + offset_scale(x) * nf;
-    for (int b = 1; b < u_lv_frames; ++b) {
+    for (int c = 0; c < u_connections; ++c) {
+        int index = min(int(rng_next(rng) * float(count)), count - 1);
+        int record = texelFetch(u_map_pairs, texel_of_index(index, u_sorted_width), 0).y;
         LightVertex v;
-        if (!light_vertex(path + ivec2(0, b * u_lv_frame_height), v)) continue;
+        if (!light_vertex(texel_of_index(record, u_lv_width), v)) continue;
         if (v.segments + segments + 1 > u_max_segments) continue;
         vec3 to = v.p - x;
         float d2 = dot(to, to);
@@ -144,14 +160,16 @@ vec3 connect(ivec2 path, vec3 x, vec3 nf, vec3 a, float q, float cos_in, vec3 ca
         float cos_light = -dot(light_side, dir);
         if (cos_camera <= 0.0 || cos_light <= 0.0) continue;
         if (occluded_toward(origin, v.p + offset_scale(v.p) * light_side)) continue;
-        float q_light = continuation(v.albedo);
+        float q_vertex = continuation(v.albedo);
         float light_cos_in = abs(dot(v.n, v.incoming));
         float w = mis_vertex_connection_weight(camera, v.partials,
-            q * cos_camera / PI * cos_light / d2, q * cos_in / PI,
-            q_light * cos_light / PI * cos_camera / d2, q_light * light_cos_in / PI);
+            q * cos_camera / PI * cos_light / d2, q_light * cos_in / PI,
+            q_vertex * cos_light / PI * cos_camera / d2,
+            camera_continuation(q_vertex) * light_cos_in / PI);
         sum += w * (v.albedo / PI) * v.power * (cos_camera * cos_light / d2);
     }
-    return sum * u_light_paths * (a / PI);
+    // v.power is per light path (throughput / N): x N, then x count / (N n).
+    return sum * (float(count) / float(u_connections)) * (a / PI);
 }
 
 void main() {
@@ -163,9 +181,7 @@ void main() {
     float image_distance = u_image_size.y / (2.0 * u_tan_half_fov.y);
     vec3 camera = u_mode == VCM_MODE_PT ? vec3(0.0)
                 : mis_camera_start(image_distance * image_distance / (cos_camera * cos_camera * cos_camera));
-    int pixel = int(px.y) * int(u_image_size.x) + int(px.x);
-    int light_path = pixel % int(u_light_paths);
-    ivec2 path_texel = ivec2(light_path % u_lv_width, light_path / u_lv_width);
+    int light_vertices = u_map_built != 0 ? light_vertex_count() : 0;
     vec3 throughput = vec3(1.0);
     // Per technique: lights hit, next-event estimation, connections, merging.
     vec3 emission = vec3(0.0), light_sample = vec3(0.0), connection = vec3(0.0), merging = vec3(0.0);
@@ -206,10 +222,11 @@ void main() {
         if (kind == MAT_DIFFUSE) {
             if (u_mode == VCM_MODE_LT) break; // light tracing sees diffuse surfaces itself
             vec3 a = material_texel(mat, 1).rgb;
-            float q = continuation(a);
+            float q_light = continuation(a);
+            float q = camera_continuation(q_light);
             vec3 brdf = a / PI;
             if (u_mode == VCM_MODE_PPM) {
-                if (u_merge != 0) merging += throughput * merge(p, nf, a, q, cos_in, camera, segments);
+                if (u_merge != 0) merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);
                 break;
             }
             vec3 origin = p + offset_scale(p) * nf;
@@ -224,15 +241,15 @@ void main() {
                         float bsdf_dir = delta ? 0.0 : q * cos_x / PI;
                         float w = u_mode == VCM_MODE_PT ? 1.0 / (bsdf_dir / direct_pdf_w + 1.0)
                                 : mis_light_sample_weight(camera, direct_pdf_w, emission_pdf_w, cos_light,
-                                                          cos_x, bsdf_dir, q * cos_in / PI);
+                                                          cos_x, bsdf_dir, q_light * cos_in / PI);
                         light_sample += w * throughput * brdf * radiance * (cos_x / direct_pdf_w);
                     }
                 }
             }
-            if (connections())
-                connection += throughput * connect(path_texel, p, nf, a, q, cos_in, camera, segments);
+            if (connections() && light_vertices > 0)
+                connection += throughput * connect(rng, light_vertices, p, nf, a, q, q_light, cos_in, camera, segments);
             if (u_mode == VCM_MODE_VCM && u_merge != 0)
-                merging += throughput * merge(p, nf, a, q, cos_in, camera, segments);
+                merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);
             // Continue by Russian roulette and a cosine-distributed direction.
             if (rng_next(rng) >= q) break;
             float u1 = rng_next(rng), u2 = rng_next(rng);
@@ -240,7 +257,7 @@ void main() {
             float cos_out = dot(nf, next);
             if (cos_out <= 0.0) break;
             camera = u_mode == VCM_MODE_PT ? vec3(1.0 / (q * cos_out / PI), 0.0, 0.0)
-                   : mis_scatter(camera, cos_out, q * cos_out / PI, q * cos_in / PI);
+                   : mis_scatter(camera, cos_out, q * cos_out / PI, q_light * cos_in / PI);
             throughput *= a / q;
             specular_path = false;
             o = offset_origin(p, nf, next);

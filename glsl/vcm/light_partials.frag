@@ -4,7 +4,8 @@
 // stored beside each record (dVCM, dVC, dVM, segments from the light) for
 // the camera paths, the light tracing splats and the merging to read. A
 // diffuse vertex is left by a cosine-distributed direction about its
-// geometric normal, continued with its largest albedo channel's probability;
+// geometric normal, continued with its largest albedo channel's probability
+// (a camera path there with camera_continuation of it);
 // a mirror or glass by a delta. src/twins/vcm.rs is the twin of the
 // recurrences.
 #include "common/scene.glsl"
@@ -70,7 +71,8 @@ void main() {
         if (material_kind(mat) == MAT_DIFFUSE) {
             vec3 albedo = material_texel(mat, 1).rgb;
             float q = max(albedo.r, max(albedo.g, albedo.b));
-            partials = mis_scatter(partials, cos_out, q * cos_out / PI, q * cos_in / PI);
+            partials = mis_scatter(partials, cos_out, q * cos_out / PI,
+                                   camera_continuation(q) * cos_in / PI);
         } else {
             partials = mis_scatter_specular(partials, cos_out);
         }

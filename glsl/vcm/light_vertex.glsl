@@ -3,7 +3,7 @@
 // vcm/light_partials.frag adds beside them (dVCM, dVC, dVM, path length in
 // segments from the light). A vertex's throughput is the photon's power
 // times the light paths traced (N): the power is already per light path.
-// vcm/camera_path.frag and vcm/light_trace.vert read them.
+// vcm/camera_path.frag and vcm/light_connect.frag read them.
 #include "common/scene.glsl"
 #include "common/addressing.glsl"
 

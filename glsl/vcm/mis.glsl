@@ -11,6 +11,15 @@
 uniform float u_vm_factor;
 uniform float u_vc_factor;
 uniform float u_light_paths;
+// Camera paths go on past a diffuse vertex with this fraction of the light
+// paths' continuation probability there (`--camera-continuation`): each
+// subpath's own probability enters the pdfs of the directions it samples.
+uniform float u_camera_continuation;
+
+// The camera path's continuation probability where a light path's is q.
+float camera_continuation(float q) {
+    return u_camera_continuation * q;
+}
 
 // A light subpath at its light: pick x area pdf of the point (pick for a
 // point light), that x the direction's pdf, the cosine at the light.

@@ -208,6 +208,14 @@ fn fraction(s: &str) -> Result<f32, String> {
     }
 }
 
+/// A fraction in (0, 1].
+fn unit_fraction(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
+        _ => Err(format!("{s}: the allowed range is (0, 1]")),
+    }
+}
+
 /// Stochastic progressive photon mapping (`--method sppm`).
 #[derive(Args, Clone, Debug)]
 pub struct SppmArgs {
@@ -310,14 +318,22 @@ pub struct VcmArgs {
     #[arg(long, value_enum, value_name = "MODE")]
     pub vcm_mode: Option<VcmMode>,
     /// VCM: light paths traced an iteration (1..=4194304; default 16384).
-    /// Camera path i connects to light path i mod N.
     #[arg(long, value_name = "N", value_parser = in_range(1, 1 << 22))]
     pub light_paths: Option<u32>,
+    /// VCM: light vertices each diffuse camera vertex connects to, drawn
+    /// from all of the iteration's (1..=16; default 1).
+    #[arg(long, value_name = "N", value_parser = in_range(1, 16))]
+    pub connections: Option<u32>,
+    /// VCM (bpt, vcm): camera paths go on past a diffuse vertex with this
+    /// fraction of a light path's probability there, in (0, 1] (default
+    /// 0.1); light tracing, connections and merging carry the rest, weighted.
+    #[arg(long, value_name = "F", value_parser = unit_fraction)]
+    pub camera_continuation: Option<f32>,
     /// VCM: the longest path, in segments (2..=64; default 32); Russian
     /// roulette ends most far sooner.
     #[arg(long, value_name = "N", value_parser = in_range(2, 64))]
     pub max_path_length: Option<u32>,
-    /// VCM: the merging radius at the first iteration (default: 4 pixel
+    /// VCM: the merging radius at the first iteration (default: 3 pixel
     /// footprints at the camera's look-at distance).
     #[arg(long, value_name = "R", value_parser = positive)]
     pub merge_radius: Option<f64>,
@@ -331,6 +347,8 @@ impl VcmArgs {
     pub fn any_given(&self) -> bool {
         self.vcm_mode.is_some()
             || self.light_paths.is_some()
+            || self.connections.is_some()
+            || self.camera_continuation.is_some()
             || self.max_path_length.is_some()
             || self.merge_radius.is_some()
             || self.merge_alpha.is_some()
@@ -345,6 +363,8 @@ impl VcmArgs {
             iterations: iterations.iteration_limit(),
             seconds: iterations.time,
             light_paths: self.light_paths.unwrap_or(d.light_paths),
+            connections: self.connections.unwrap_or(d.connections),
+            camera_continuation: self.camera_continuation.unwrap_or(d.camera_continuation),
             max_segments: self.max_path_length.unwrap_or(d.max_segments),
             initial_radius: self.merge_radius.map(|r| r as f32),
             alpha: self.merge_alpha.unwrap_or(d.alpha),

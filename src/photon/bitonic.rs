@@ -28,6 +28,9 @@ pub struct SortedPhotonMap {
     pub grid_first: Texture,
     pub grid_width: u32,
     pub grid: Grid,
+    /// Photons it holds, where the build counted them (a compacting build;
+    /// the sort of every record does not).
+    pub stored: Option<u32>,
 }
 
 /// `keys` as the sort's RG32I records: (key, record index) a texel.
@@ -281,11 +284,11 @@ impl BitonicBuild {
         timings: &mut Timings,
     ) -> Result<SortedPhotonMap> {
         let query = Query::timer(&self.gpu)?;
-        let pairs = if self.compact {
+        let (pairs, stored) = if self.compact {
             let clock = StageClock::start(&self.gpu, &query);
             let c = self.compaction.pairs(frames, grid, None)?;
             clock.stop(timings, "compact", c.passes as usize);
-            c.pairs
+            (c.pairs, Some(c.count))
         } else {
             let (w, h) = sort_texture_size(frames.record_count() as u64);
             let pairs = Texture::new(&self.gpu, w, h, TexFormat::Rg32I)?;
@@ -298,7 +301,7 @@ impl BitonicBuild {
                 .draw_fullscreen(&target, &DrawState::PLAIN)?;
             clock.stop(timings, "keys", 1);
             drop(target);
-            pairs
+            (pairs, None)
         };
         let clock = StageClock::start(&self.gpu, &query);
         let (sorted, passes) = self.sort(pairs)?;
@@ -308,15 +311,18 @@ impl BitonicBuild {
         clock.stop(timings, "binary search", 1);
 
         let clock = StageClock::start(&self.gpu, &query);
-        let map = gather_records(
-            &self.gpu,
-            &self.gather,
-            frames,
-            sorted,
-            grid_first,
-            grid_width,
-            grid,
-        )?;
+        let map = SortedPhotonMap {
+            stored,
+            ..gather_records(
+                &self.gpu,
+                &self.gather,
+                frames,
+                sorted,
+                grid_first,
+                grid_width,
+                grid,
+            )?
+        };
         clock.stop(timings, "gather", 1);
         Ok(map)
     }
@@ -365,5 +371,6 @@ pub(crate) fn gather_records(
         grid_first,
         grid_width,
         grid: *grid,
+        stored: None,
     })
 }

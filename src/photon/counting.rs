@@ -106,15 +106,18 @@ impl CountingBuild {
         clock.stop(timings, "place", 1);
 
         let clock = StageClock::start(&self.gpu, &query);
-        let map = gather_records(
-            &self.gpu,
-            &self.gather,
-            frames,
-            sorted,
-            grid_first,
-            grid_width,
-            grid,
-        )?;
+        let map = SortedPhotonMap {
+            stored: Some(count),
+            ..gather_records(
+                &self.gpu,
+                &self.gather,
+                frames,
+                sorted,
+                grid_first,
+                grid_width,
+                grid,
+            )?
+        };
         clock.stop(timings, "gather", 1);
         Ok(map)
     }

@@ -184,12 +184,15 @@ pub fn merge_weight(
 
 /// A full path for the explicit weights: `points[0]` on an area light (its
 /// normal `normals[0]`), diffuse surface vertices, and `points[k]` the
-/// camera. Each diffuse vertex continues with probability `continuation[i]`
-/// and samples cosine-distributed directions.
+/// camera. A light subpath goes on from diffuse vertex i with probability
+/// `continuation[i]`, a camera subpath with `camera_continuation[i]` (the
+/// renderer's camera paths take a fraction of the light paths'); both
+/// sample cosine-distributed directions.
 pub struct Path {
     pub points: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub continuation: Vec<f64>,
+    pub camera_continuation: Vec<f64>,
     /// The light's pick probability over its area.
     pub light_direct_pdf_a: f64,
     /// The camera's forward axis and image plane distance (in pixels).
@@ -216,8 +219,9 @@ fn distance2(path: &Path, a: usize, b: usize) -> f64 {
 
 /// The solid-angle pdf with which vertex `from` samples the direction to
 /// `to`: the light's cosine emission (its pick and area pdf belong to vertex
-/// 0), the camera's pixel sample, or a diffuse vertex's cosine lobe times its
-/// continuation probability.
+/// 0), the camera's pixel sample, or a diffuse vertex's cosine lobe times the
+/// continuation probability of the subpath that samples it: the light
+/// subpath's toward the camera (`to` > `from`), the camera subpath's back.
 fn direction_pdf(path: &Path, from: usize, to: usize) -> f64 {
     let k = path.points.len() - 1;
     if from == 0 {
@@ -227,7 +231,12 @@ fn direction_pdf(path: &Path, from: usize, to: usize) -> f64 {
         let cos = f64::from(path.camera_forward.dot(d));
         path.image_plane_distance.powi(2) / cos.powi(3)
     } else {
-        path.continuation[from] * cosine(path, from, to) / std::f64::consts::PI
+        let continuation = if to > from {
+            path.continuation[from]
+        } else {
+            path.camera_continuation[from]
+        };
+        continuation * cosine(path, from, to) / std::f64::consts::PI
     }
 }
 
@@ -415,7 +424,9 @@ mod tests {
     fn random_path(rng: &mut Rng, k: usize) -> Path {
         let points: Vec<Vec3> = (0..=k).map(|_| rng.vec(4.0)).collect();
         let normals = (0..=k).map(|_| rng.vec(2.0).normalize()).collect();
-        let continuation = (0..=k).map(|_| 0.3 + 0.7 * rng.next()).collect();
+        let continuation: Vec<f64> = (0..=k).map(|_| 0.3 + 0.7 * rng.next()).collect();
+        let fraction = 0.01 + 0.99 * rng.next();
+        let camera_continuation = continuation.iter().map(|q| fraction * q).collect();
         // The camera looks roughly at its first vertex (cos well above 0).
         let toward = (points[k - 1] - points[k]).normalize();
         let camera_forward = (toward + 0.3 * rng.vec(1.0)).normalize();
@@ -423,13 +434,15 @@ mod tests {
             points,
             normals,
             continuation,
+            camera_continuation,
             light_direct_pdf_a: 0.05 + rng.next(),
             camera_forward,
             image_plane_distance: 100.0 + 500.0 * rng.next(),
         }
     }
 
-    /// For random diffuse paths of 2 to 7 segments, with every technique
+    /// For random diffuse paths of 2 to 7 segments, camera subpaths going on
+    /// with a random fraction of the light subpaths' probability, with every technique
     /// (VCM), connections only (BPT) and merging only (BPM): the weights the
     /// recurrences give equal the balance heuristic over every technique's
     /// full path pdf, and they sum to 1.

@@ -533,6 +533,11 @@ fn vcm_runs_merges_and_refuses_what_it_cannot_do() {
         (&["--method", "vcm", "--max-path-length", "1"][..], "2..=64"),
         (&["--method", "vcm", "--merge-alpha", "1"][..], "(0, 1)"),
         (&["--method", "vcm", "--light-paths", "0"][..], "1..="),
+        (&["--method", "vcm", "--connections", "17"][..], "1..=16"),
+        (
+            &["--method", "vcm", "--camera-continuation", "0"][..],
+            "(0, 1]",
+        ),
     ] {
         assert_render_refused(&d, "cornell_box", args, says);
     }

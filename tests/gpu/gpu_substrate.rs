@@ -203,7 +203,7 @@ fn every_glsl_file_compiles() {
             "radiosity/select.frag" => vec!["radiosity/select.vert"],
             "radiosity/deposit.frag" => vec!["radiosity/deposit.vert"],
             "radiosity/item_buffer.frag" => vec!["radiosity/item_buffer.vert"],
-            "vcm/light_trace.frag" => vec!["vcm/light_trace.vert"],
+            "vcm/light_splat.frag" => vec!["vcm/light_splat.vert"],
             "photon/place.frag" => vec!["photon/place.vert"],
             _ => vec!["common/fullscreen.vert"],
         }

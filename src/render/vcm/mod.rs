@@ -8,15 +8,18 @@
 //! 2. **Their MIS partials** (`glsl/vcm/light_partials.frag`): one fragment
 //!    a light path walks its frames and writes dVCM, dVC, dVM and the path's
 //!    length beside each record, a fifth attachment of the photon frames.
-//! 3. **Light tracing** (`glsl/vcm/light_trace.vert`): every light vertex a
-//!    point, drawn where it projects with its weighted contribution, added
-//!    into the light image (blending).
-//! 4. **The map** of the light vertices (the bitonic build, unchanged), over
-//!    a grid sized by this iteration's radius r_i = r_1 i^((alpha - 1) / 2).
+//! 3. **The map** of the light vertices (the counting build), over a grid
+//!    sized by this iteration's radius r_i = r_1 i^((alpha - 1) / 2). Its
+//!    compacted vertices are also the light vertex cache that connections
+//!    draw from and light tracing walks.
+//! 4. **Light tracing** (`glsl/vcm/light_connect.frag`): a fragment a map
+//!    texel connects its vertex to the camera, shadow ray and weight, then
+//!    `glsl/vcm/light_splat.vert` draws each as a point where it projects,
+//!    added into the light image (blending).
 //! 5. **Camera paths** (`glsl/vcm/camera_path.frag`): one fragment a pixel,
-//!    the whole path, taking next-event estimation, connections to its light
-//!    path's vertices and merging at every diffuse vertex, each weighted;
-//!    added into the camera image.
+//!    the whole path, taking next-event estimation, connections to light
+//!    vertices drawn from the cache and merging at every diffuse vertex,
+//!    each weighted; added into the camera image.
 //!
 //! The image is the two sums over the iterations run. `VcmMode` keeps
 //! a subset of the techniques, each unweighted where alone.
@@ -24,7 +27,7 @@
 use crate::error::Error;
 use crate::gpu::{DrawState, Gpu, Program, Result, Target, TexFormat, Texture};
 use crate::image::Image;
-use crate::photon::{BitonicBuild, Grid, PhotonBatch, PhotonTracer, SortedPhotonMap, TraceConfig};
+use crate::photon::{CountingBuild, Grid, PhotonBatch, PhotonTracer, SortedPhotonMap, TraceConfig};
 use crate::render::options::RenderOptions;
 use crate::render::plan::PassPlan;
 use crate::render::ray_trace::bind_camera;
@@ -47,8 +50,10 @@ pub const TECHNIQUES: [&str; 5] = [
     "light tracing",
 ];
 
-/// Cells of the light vertices' grid at most (the sorted map's cell table).
-const MAX_CELLS: u64 = 1 << 22;
+/// Cells of the light vertices' grid at most: the counting build's histogram
+/// and cell table cost a texel a cell each iteration, while a merge scans
+/// the cells its radius overlaps, so past this the cells grow instead.
+const MAX_CELLS: u64 = 1 << 18;
 
 pub struct Vcm {
     gpu: Gpu,
@@ -62,10 +67,16 @@ pub struct Vcm {
     /// The light vertices' MIS partials, beside the photon records.
     partials: Option<Texture>,
     partials_target: Option<(Texture, Target)>,
-    builder: BitonicBuild,
+    builder: CountingBuild,
+    /// This iteration's map of the light vertices (None: path tracing).
+    map: Option<SortedPhotonMap>,
     partials_program: Program,
     camera_program: Program,
+    connect_program: Program,
     splat_program: Program,
+    /// Light tracing's per-vertex results (contribution, landing), sized as
+    /// the map's texture; reallocated when that size changes.
+    connected: Option<(Texture, Texture, Target)>,
     /// Sums over the iterations: the camera paths' and light tracing's; and
     /// the camera paths' by technique (lights hit, next-event estimation,
     /// connections, merging), whose sum the camera image is.
@@ -145,10 +156,13 @@ impl Vcm {
             batch,
             partials,
             partials_target,
-            builder: BitonicBuild::with_addressing(gpu, false)?,
+            builder: CountingBuild::new(gpu)?,
+            map: None,
             partials_program: Program::fullscreen(gpu, "vcm/light_partials.frag")?,
             camera_program: Program::fullscreen(gpu, "vcm/camera_path.frag")?,
-            splat_program: Program::new(gpu, "vcm/light_trace.vert", "vcm/light_trace.frag", &[])?,
+            connect_program: Program::fullscreen(gpu, "vcm/light_connect.frag")?,
+            splat_program: Program::new(gpu, "vcm/light_splat.vert", "vcm/light_splat.frag", &[])?,
+            connected: None,
             camera_image,
             techniques,
             camera_target,
@@ -173,14 +187,14 @@ impl Vcm {
         self.initial_radius * (i as f32).powf((self.options.alpha - 1.0) * 0.5)
     }
 
-    /// One iteration: light paths, their partials, light tracing, the map,
+    /// One iteration: light paths, their partials, the map, light tracing,
     /// camera paths.
     pub fn iterate(&mut self, timings: &mut Timings) -> Result<()> {
         let i = self.iteration + 1;
         let seed = crate::random::sample_seed(self.seed, i);
         let radius = self.radius(i);
         let mode = self.options.mode;
-        let mut map = None;
+        self.map = None;
         if let Some(batch) = self.batch.as_mut() {
             let wall = std::time::Instant::now();
             self.photons
@@ -196,24 +210,29 @@ impl Vcm {
             self.light_partials()?;
             self.gpu.finish();
             timings.add_since("light vertex partials", 0.0, wall, 1);
+            let wall = std::time::Instant::now();
+            let frames = &self.batch.as_ref().expect("light paths").frames;
+            // Without merging the grid only compacts: one cell.
+            let grid = if mode.merges() {
+                Grid::over_scene(&self.scene, 2.0 * radius, MAX_CELLS)
+            } else {
+                Grid::over_scene(&self.scene, f32::MAX, 1)
+            };
+            let mut stages = Timings::default();
+            let map = self.builder.build(frames, &grid, &mut stages)?;
+            self.light_vertices = map.stored.expect("the counting build counts") as u64;
+            self.map = Some(map);
+            self.gpu.finish();
+            timings.add_folded("build map", &stages, wall);
             if mode.splats() {
                 let wall = std::time::Instant::now();
-                self.splat(radius)?;
+                self.light_trace(radius)?;
                 self.gpu.finish();
-                timings.add_since("light tracing", 0.0, wall, 1);
-            }
-            if mode.merges() {
-                let wall = std::time::Instant::now();
-                let frames = &self.batch.as_ref().expect("light paths").frames;
-                let grid = Grid::over_scene(&self.scene, 2.0 * radius, MAX_CELLS);
-                let mut stages = Timings::default();
-                map = Some(self.builder.build(frames, &grid, &mut stages)?);
-                self.gpu.finish();
-                timings.add_folded("build map", &stages, wall);
+                timings.add_since("light tracing", 0.0, wall, 2);
             }
         }
         let wall = std::time::Instant::now();
-        self.camera_paths(seed, radius, map.as_ref())?;
+        self.camera_paths(seed, radius)?;
         self.gpu.finish();
         timings.add_since("camera paths", 0.0, wall, 1);
         self.iteration = i;
@@ -247,7 +266,11 @@ impl Vcm {
         let mode = self.options.mode;
         b.float("u_vm_factor", if mode == VcmMode::Vcm { eta } else { 0.0 })
             .float("u_vc_factor", if mode.connects() { 1.0 / eta } else { 0.0 })
-            .float("u_light_paths", n);
+            .float("u_light_paths", n)
+            .float(
+                "u_camera_continuation",
+                self.options.camera_continuation_in_use(),
+            );
     }
 
     /// The light vertices' records and partials, as `glsl/vcm/light_vertex.glsl` reads them.
@@ -267,28 +290,55 @@ impl Vcm {
             .float("u_lv_power_scale", f.power_scale);
     }
 
-    /// Light tracing: every light vertex splatted into the light image.
-    fn splat(&self, radius: f32) -> Result<()> {
-        let Some(batch) = &self.batch else {
+    /// Light tracing: every light vertex of the map connected to the camera
+    /// (a fragment a map texel), then splatted into the light image.
+    fn light_trace(&mut self, radius: f32) -> Result<()> {
+        let Some(map) = &self.map else {
             return Ok(());
         };
-        let mut b = self.splat_program.bind();
-        self.textures.bind(&mut b);
-        bind_camera(&mut b, &self.scene.camera, &self.plan, 0);
-        self.bind_factors(&mut b, radius);
-        self.bind_light_vertices(&mut b);
-        b.int("u_mode", self.options.mode.code() as i32)
-            .int("u_max_segments", self.options.max_segments as i32)
+        let (w, h) = (map.pairs.width, map.pairs.height);
+        if self
+            .connected
+            .as_ref()
+            .is_none_or(|(c, _, _)| (c.width, c.height) != (w, h))
+        {
+            let contribution = Texture::new(&self.gpu, w, h, TexFormat::Rgba32F)?;
+            let landing = Texture::new(&self.gpu, w, h, TexFormat::Rgba32F)?;
+            let target = Target::new(&self.gpu, &[&contribution, &landing])?;
+            self.connected = Some((contribution, landing, target));
+        }
+        let (contribution, landing, target) = self.connected.as_ref().expect("allocated");
+        let map = self.map.as_ref().expect("built");
+        {
+            let mut b = self.connect_program.bind();
+            self.textures.bind(&mut b);
+            bind_camera(&mut b, &self.scene.camera, &self.plan, 0);
+            self.bind_factors(&mut b, radius);
+            self.bind_light_vertices(&mut b);
+            b.texture("u_map_pairs", &map.pairs)
+                .texture("u_grid_first", &map.grid_first)
+                .int("u_grid_width", map.grid_width as i32)
+                .int("u_slots", map.grid.slot_count() as i32)
+                .int("u_sorted_width", w as i32)
+                .int("u_mode", self.options.mode.code() as i32)
+                .int("u_max_segments", self.options.max_segments as i32)
+                .draw_fullscreen(target, &DrawState::PLAIN)?;
+        }
+        self.splat_program
+            .bind()
+            .texture("u_contribution", contribution)
+            .texture("u_landing", landing)
+            .int("u_width", w as i32)
             .draw_points(
                 &self.light_target,
                 &DrawState::ADDITIVE,
                 0,
-                batch.frames.record_count() as i32,
+                self.light_vertices as i32,
             )
     }
 
     /// Every pixel's camera path, added into the camera image.
-    fn camera_paths(&self, seed: u32, radius: f32, map: Option<&SortedPhotonMap>) -> Result<()> {
+    fn camera_paths(&self, seed: u32, radius: f32) -> Result<()> {
         let mut b = self.camera_program.bind();
         self.textures.bind(&mut b);
         bind_camera(&mut b, &self.scene.camera, &self.plan, 0);
@@ -307,7 +357,7 @@ impl Vcm {
                 .int("u_lv_frames", 0)
                 .float("u_lv_power_scale", 1.0);
         }
-        match map {
+        match &self.map {
             Some(m) => {
                 b.texture("u_map_position", &m.position)
                     .texture("u_map_power", &m.power)
@@ -316,7 +366,9 @@ impl Vcm {
                     .texture("u_grid_first", &m.grid_first)
                     .int("u_grid_width", m.grid_width as i32)
                     .int("u_sorted_width", m.position.width as i32)
-                    .int("u_merge", 1);
+                    .int("u_slots", m.grid.slot_count() as i32)
+                    .int("u_map_built", 1)
+                    .int("u_merge", self.options.mode.merges() as i32);
                 m.grid.bind(&mut b);
             }
             None => {
@@ -327,6 +379,8 @@ impl Vcm {
                     .texture("u_grid_first", &self.none_i32)
                     .int("u_grid_width", 1)
                     .int("u_sorted_width", 1)
+                    .int("u_slots", 0)
+                    .int("u_map_built", 0)
                     .int("u_merge", 0);
             }
         }
@@ -334,6 +388,7 @@ impl Vcm {
             .int("u_mode", self.options.mode.code() as i32)
             .int("u_max_segments", self.options.max_segments as i32)
             .float("u_radius2", radius * radius)
+            .int("u_connections", self.options.connections as i32)
             .draw_fullscreen(&self.camera_target, &DrawState::ADDITIVE)
     }
 
@@ -376,6 +431,20 @@ fn check(o: &VcmOptions) -> Result<()> {
             "vcm.light_paths",
             0.0,
             "trace at least one light path an iteration",
+        ));
+    }
+    if !(1..=16).contains(&o.connections) {
+        return Err(Error::out_of_range(
+            "vcm.connections",
+            o.connections as f32,
+            "the allowed range is 1..=16",
+        ));
+    }
+    if !(o.camera_continuation > 0.0 && o.camera_continuation <= 1.0) {
+        return Err(Error::out_of_range(
+            "vcm.camera_continuation",
+            o.camera_continuation,
+            "the allowed range is (0, 1]",
         ));
     }
     if !(2..=64).contains(&o.max_segments) {

@@ -74,9 +74,17 @@ pub struct VcmOptions {
     pub iterations: u32,
     /// Stop after this many seconds (the iterations begun finish).
     pub seconds: Option<f64>,
-    /// Light subpaths an iteration traces (N); camera path i connects to
-    /// light path i mod N.
+    /// Light subpaths an iteration traces (N).
     pub light_paths: u32,
+    /// Light vertices each diffuse camera vertex connects to, drawn
+    /// uniformly from all of the iteration's (the light vertex cache).
+    pub connections: u32,
+    /// With connections (bpt, vcm): a camera path goes on past a diffuse
+    /// vertex with this fraction, in (0, 1], of the probability a light path
+    /// goes on with there. Light tracing, connections and merging then carry
+    /// more of the light; the MIS weights count each subpath's own Russian
+    /// roulette, so the image converges to the same answer.
+    pub camera_continuation: f32,
     /// The longest path, in segments (the eye ray is one).
     pub max_segments: u32,
     /// The merging radius of iteration 1 (default: `start_pixels` pixel
@@ -89,10 +97,23 @@ pub struct VcmOptions {
 }
 
 impl VcmOptions {
+    /// The camera paths' continuation fraction the mode runs with: path
+    /// tracing alone needs its paths whole; light tracing and ppm end them
+    /// at the first diffuse vertex anyway.
+    pub fn camera_continuation_in_use(&self) -> f32 {
+        if self.mode.connects() {
+            self.camera_continuation
+        } else {
+            1.0
+        }
+    }
+
     pub const DEFAULT_LIGHT_PATHS: u32 = 1 << 14;
+    pub const DEFAULT_CONNECTIONS: u32 = 1;
+    pub const DEFAULT_CAMERA_CONTINUATION: f32 = 0.1;
     pub const DEFAULT_MAX_SEGMENTS: u32 = 32;
     pub const DEFAULT_ALPHA: f32 = 0.75;
-    pub const DEFAULT_START_PIXELS: f32 = 4.0;
+    pub const DEFAULT_START_PIXELS: f32 = 3.0;
 }
 
 impl Default for VcmOptions {
@@ -102,6 +123,8 @@ impl Default for VcmOptions {
             iterations: 64,
             seconds: None,
             light_paths: Self::DEFAULT_LIGHT_PATHS,
+            connections: Self::DEFAULT_CONNECTIONS,
+            camera_continuation: Self::DEFAULT_CAMERA_CONTINUATION,
             max_segments: Self::DEFAULT_MAX_SEGMENTS,
             initial_radius: None,
             start_pixels: Self::DEFAULT_START_PIXELS,

@@ -101,7 +101,7 @@ fn explain(run: &Vcm, options: &RenderOptions) -> Vec<ExplainLine> {
             "light tracing",
             mode.splats(),
             if mode.splats() {
-                "every light vertex connected to the camera and drawn as a point where it projects, added into the light image".into()
+                "every light vertex of the map connected to the camera in a fragment pass, then drawn as a point where it projects, added into the light image".into()
             } else {
                 format!("--vcm-mode {} connects no light vertex to the camera", mode.name())
             },
@@ -111,7 +111,7 @@ fn explain(run: &Vcm, options: &RenderOptions) -> Vec<ExplainLine> {
             mode.merges(),
             if mode.merges() {
                 format!(
-                    "a map of the light vertices each iteration (bitonic sort), radius {:.4} at the first iteration shrinking as i^({:.3})",
+                    "a map of the light vertices each iteration (counting sort), radius {:.4} at the first iteration shrinking as i^({:.3})",
                     run.initial_radius,
                     (o.alpha - 1.0) * 0.5
                 )
@@ -123,13 +123,21 @@ fn explain(run: &Vcm, options: &RenderOptions) -> Vec<ExplainLine> {
             "camera paths",
             true,
             format!(
-                "one path a pixel through mirrors and glass and on past diffuse vertices by Russian roulette; at each diffuse vertex: {}",
+                "one path a pixel through mirrors and glass and on past diffuse vertices by Russian roulette ({}); at each diffuse vertex: {}",
+                if mode.connects() {
+                    format!(
+                        "{} of the light paths' continuation probability",
+                        o.camera_continuation
+                    )
+                } else {
+                    "the light paths' continuation probability".into()
+                },
                 match mode {
                     crate::render::vcm::VcmMode::Pt => "next-event estimation, weighted against paths that hit a light",
                     crate::render::vcm::VcmMode::Lt => "nothing (light tracing draws what the camera sees of diffuse surfaces; lights seen directly or through mirrors and glass are the camera path's)",
                     crate::render::vcm::VcmMode::Ppm => "merging at the first, unweighted, and the path ends",
-                    crate::render::vcm::VcmMode::Bpt => "next-event estimation and a connection to every vertex of its light path, each weighted by the balance heuristic",
-                    crate::render::vcm::VcmMode::Vcm => "next-event estimation, a connection to every vertex of its light path and merging, each weighted by the balance heuristic",
+                    crate::render::vcm::VcmMode::Bpt => "next-event estimation and connections to light vertices drawn from all of the iteration's, each weighted by the balance heuristic",
+                    crate::render::vcm::VcmMode::Vcm => "next-event estimation, connections to light vertices drawn from all of the iteration's, and merging, each weighted by the balance heuristic",
                 }
             ),
         ),
