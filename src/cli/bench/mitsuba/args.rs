@@ -9,6 +9,24 @@ use photonmap::bench::regions::Rectangle;
 use crate::cli::args::in_range;
 use crate::cli::bench::output::BenchOutput;
 
+/// A progressive method `bench mitsuba` races.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ProgressiveMethod {
+    /// Stochastic progressive photon mapping.
+    Sppm,
+    /// Vertex connection and merging.
+    Vcm,
+}
+
+impl std::fmt::Display for ProgressiveMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ProgressiveMethod::Sppm => "sppm",
+            ProgressiveMethod::Vcm => "vcm",
+        })
+    }
+}
+
 #[derive(Args)]
 pub struct MitsubaBenchArgs {
     /// Scene file or embedded name.
@@ -44,16 +62,20 @@ pub struct MitsubaBenchArgs {
     /// mask leaves out. The table goes to regions.md. Repeat it for more.
     #[arg(long, value_name = "NAME=X0:X1:Y0:Y1", value_parser = rectangle)]
     pub region: Vec<Rectangle>,
-    /// Wall-time budgets in seconds (e.g. 30,60,120): photonmap's SPPM at
+    /// Wall-time budgets in seconds (e.g. 30,60,120): each of --methods at
     /// its defaults and each Mitsuba integrator render for each; the longest
     /// also records the convergence curves.
     #[arg(long, value_delimiter = ',', value_parser = budget_seconds)]
     pub seconds: Vec<f64>,
     /// photonmap's one-map render at its defaults with this many eye
-    /// samples per pixel (1..=1024), one render each; SPPM and Mitsuba get
-    /// each render's wall time (default 1 without --seconds, none with it).
+    /// samples per pixel (1..=1024), one render each; --methods and Mitsuba
+    /// get each render's wall time (default 1 without --seconds, none with it).
     #[arg(long, value_delimiter = ',', value_parser = in_range(1, 1024))]
     pub spp: Vec<u32>,
+    /// photonmap's progressive methods, each at its defaults, raced for
+    /// each --seconds budget: sppm, vcm.
+    #[arg(long, value_delimiter = ',', default_values_t = [ProgressiveMethod::Sppm, ProgressiveMethod::Vcm])]
+    pub methods: Vec<ProgressiveMethod>,
     /// Mitsuba's integrators: path (path tracing with next-event estimation),
     /// ptracer (light tracing, which finds a point light's caustic).
     #[arg(long, value_delimiter = ',', default_values_t = ["path".to_string(), "ptracer".to_string()])]

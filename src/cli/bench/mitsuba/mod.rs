@@ -1,4 +1,5 @@
-//! `photonmap bench mitsuba`: photonmap's SPPM at its defaults against what
+//! `photonmap bench mitsuba`: photonmap's progressive methods (SPPM and VCM,
+//! `--methods`) at their defaults against what
 //! a user would pick instead, Mitsuba 3, on the same machine for the same
 //! wall times (`--seconds`), all compared with independent ground truth
 //! (reference_images/truth/: Mitsuba plus a separate light tracer, on the
@@ -28,6 +29,7 @@ use anyhow::Result;
 use photonmap::bench::regions::Region;
 use photonmap::gpu::{Gpu, Platform};
 use photonmap::render::sppm::{render_sppm, SppmOptions};
+use photonmap::render::vcm::{render_vcm, VcmOptions};
 use photonmap::render::{render, EstimatePass, RenderObserver};
 use photonmap::scene::{embedded, Scene};
 
@@ -38,7 +40,7 @@ use report::{Curve, MitsubaBench, Row};
 use runner::Taken;
 use score::{Bench, Target};
 
-pub use args::MitsubaBenchArgs;
+pub use args::{MitsubaBenchArgs, ProgressiveMethod};
 
 /// Keeps SPPM's running image after the first iteration past each mark
 /// (seconds on the caller's clock, this observer's own time not counted).
@@ -95,8 +97,9 @@ fn label(budget: f64, spp: Option<u32>) -> String {
     }
 }
 
-/// SPPM at its defaults and each Mitsuba integrator for `budget` seconds:
-/// their rows, and their curves when `longest`.
+/// photonmap's progressive methods at their defaults and each Mitsuba
+/// integrator for `budget` seconds: their rows, and their curves when
+/// `longest`.
 fn race(
     a: &MitsubaBenchArgs,
     (gpu, scene, scale): (&Gpu, &Scene, u32),
@@ -108,28 +111,42 @@ fn race(
     let progress = a.output.progress();
     let tag = label(budget, spp);
     let checkpoints = if longest { marks(budget) } else { Vec::new() };
-    progress(&format!("photonmap SPPM, {budget:.1} s"));
-    let sppm = SppmOptions {
-        iterations: 1_000_000,
-        seconds: Some(budget),
-        ..SppmOptions::default()
-    };
     let o = reference_options(scene, scale, SEED);
-    let mut watch = Checkpoints::new(checkpoints.clone());
-    let s = render_sppm(gpu, scene, &o, &sppm, &mut watch)?;
-    let taken = (watch.seconds(), s.iterations, s.image);
-    let stem = format!("photonmap_sppm_{tag}");
-    let row = bench.row(
-        "photonmap SPPM",
-        Some(budget),
-        &taken,
-        Some(s.photons_emitted),
-        &stem,
-    )?;
-    if longest {
-        curves.push(bench.curve("photonmap SPPM", &stem, &watch.taken, &row)?);
+    for &method in &a.methods {
+        let label = match method {
+            ProgressiveMethod::Sppm => "photonmap SPPM",
+            ProgressiveMethod::Vcm => "photonmap VCM",
+        };
+        progress(&format!("{label}, {budget:.1} s"));
+        let mut watch = Checkpoints::new(checkpoints.clone());
+        let (iterations, paths, image) = match method {
+            ProgressiveMethod::Sppm => {
+                let sppm = SppmOptions {
+                    iterations: 1_000_000,
+                    seconds: Some(budget),
+                    ..SppmOptions::default()
+                };
+                let s = render_sppm(gpu, scene, &o, &sppm, &mut watch)?;
+                (s.iterations, s.photons_emitted, s.image)
+            }
+            ProgressiveMethod::Vcm => {
+                let vcm = VcmOptions {
+                    iterations: 1_000_000,
+                    seconds: Some(budget),
+                    ..VcmOptions::default()
+                };
+                let v = render_vcm(gpu, scene, &o, &vcm, &mut watch)?;
+                (v.iterations, v.light_paths, v.image)
+            }
+        };
+        let taken = (watch.seconds(), iterations, image);
+        let stem = format!("photonmap_{method}_{tag}");
+        let row = bench.row(label, Some(budget), &taken, Some(paths), &stem)?;
+        if longest {
+            curves.push(bench.curve(label, &stem, &watch.taken, &row)?);
+        }
+        rows.push(row);
     }
-    rows.push(row);
     for integrator in &a.integrators {
         progress(&format!("Mitsuba {integrator}, {budget:.1} s"));
         let (taken, along) =

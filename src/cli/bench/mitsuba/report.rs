@@ -20,13 +20,14 @@ pub struct Row {
     /// render's time with --spp (None for that render itself).
     pub budget: Option<f64>,
     /// Wall seconds it took (Mitsuba: its first render call on, JIT
-    /// included; SPPM: setup included).
+    /// included; SPPM and VCM: setup included).
     pub seconds: f64,
-    /// Samples per pixel (Mitsuba, the one-map render) or iterations (SPPM).
+    /// Samples per pixel (Mitsuba, the one-map render) or iterations (SPPM,
+    /// VCM: one camera path a pixel each).
     pub samples: u32,
     /// Camera paths a second: samples x width x height / seconds.
     pub paths_per_second: f64,
-    /// SPPM: photons emitted a second.
+    /// SPPM: photons emitted a second; VCM: light paths traced a second.
     pub photons_per_second: Option<f64>,
     /// RMSE over the reference's mean, on the mask's pixels: the headline.
     pub rel_rmse: f64,
