@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# SPPM's defaults against their alternatives at equal wall time, on each
+# SPPM's (or with METHOD=vcm, VCM's) defaults against their alternatives at
+# equal wall time, on each
 # scene's reference: each configuration renders for SECONDS at the
 # reference's size, then `photonmap compare` measures relative RMSE and
 # energy on the mask's pixels. Writes OUT/table.md (one row per
@@ -8,7 +9,7 @@
 # iterations spend their time) and OUT/split.md (the defaults' error split
 # into noise and bias by a second seed).
 #
-# Usage: [SPPM_CONFIGS=leak-grid] scripts/sppm-defaults.sh SECONDS OUT SCENE:REFERENCE.exr[:MASK.png] ...
+# Usage: [SPPM_CONFIGS=leak-grid | METHOD=vcm] scripts/sppm-defaults.sh SECONDS OUT SCENE:REFERENCE.exr[:MASK.png] ...
 # (SCENE: a paper scene's name, or a scene file's path)
 # Run it from the repository root on a quiet machine (a build or another
 # render at the same time changes the iterations each run gets).
@@ -31,7 +32,11 @@ fi
 
 # label|arguments (the defaults first; their second seed splits the error).
 # SPPM_CONFIGS=leak-grid compares the gather's leak test and the grid instead.
-case ${SPPM_CONFIGS:-defaults} in
+method=${METHOD:-sppm}
+case $method in sppm|vcm) ;; *) echo "METHOD: sppm or vcm" >&2; exit 2 ;; esac
+configs_of=${SPPM_CONFIGS:-defaults}
+[ "$method" = vcm ] && configs_of=vcm
+case $configs_of in
   defaults)
     configs=(
       "defaults|"
@@ -51,6 +56,19 @@ case ${SPPM_CONFIGS:-defaults} in
       "visibility leak test|--leak-test visibility"
       "disc leak test|--leak-test disc"
       "uniform grid|--grid uniform"
+    ) ;;
+  vcm)
+    configs=(
+      "defaults|"
+      "defaults, second seed|--seed 2"
+      "camera paths continue as light paths (--camera-continuation 1)|--camera-continuation 1"
+      "--camera-continuation 0.3|--camera-continuation 0.3"
+      "--camera-continuation 0.03|--camera-continuation 0.03"
+      "first radius 2 pixel footprints|--merge-start-pixels 2"
+      "first radius 4 pixel footprints|--merge-start-pixels 4"
+      "merge alpha 0.6|--merge-alpha 0.6"
+      "32768 light paths an iteration|--light-paths 32768"
+      "2 connections a camera vertex|--connections 2"
     ) ;;
   *) echo "SPPM_CONFIGS: defaults or leak-grid" >&2; exit 2 ;;
 esac
@@ -77,7 +95,7 @@ print(x1 - x0 + 1, y1 - y0 + 1)" "$reference")
     image="$out/${scene}_${tag}.exr"
     echo "$scene: $label" >&2
     # shellcheck disable=SC2086
-    "$bin" render "$file" --method sppm --time "$seconds" \
+    "$bin" render "$file" --method "$method" --time "$seconds" \
       --width "$width" --height "$height" $args -o "$image" --json --quiet > "$out/render.json"
     "$bin" compare "$image" "$reference" ${mask:+--mask "$mask"} --json > "$out/compare.json"
     python3 - "$scene" "$label" "$args" "$out/render.json" "$out/compare.json" >> "$runs" <<'EOF'
@@ -107,6 +125,7 @@ done
 
 prefix=""
 [ -n "${SPPM_CONFIGS:-}" ] && prefix="SPPM_CONFIGS=$SPPM_CONFIGS "
+[ "$method" = vcm ] && prefix="METHOD=vcm "
 python3 - "$runs" "$out" "$seconds" "$prefix$0 $seconds $out $*" <<'EOF'
 import json, sys
 runs, out, seconds, command = sys.argv[1:5]

@@ -337,6 +337,15 @@ pub struct VcmArgs {
     /// footprints at the camera's look-at distance).
     #[arg(long, value_name = "R", value_parser = positive)]
     pub merge_radius: Option<f64>,
+    /// VCM: the first merging radius in pixel footprints at the camera's
+    /// look-at distance (> 0; default 3).
+    #[arg(long, value_name = "P", value_parser = positive, conflicts_with = "merge_radius")]
+    pub merge_start_pixels: Option<f64>,
+    /// VCM: also write what each technique carried, one linear EXR each,
+    /// into this folder (made if missing): lights_hit, next_event_estimation,
+    /// connections, merging, light_tracing (they sum to the image).
+    #[arg(long, value_name = "DIR")]
+    pub vcm_techniques: Option<std::path::PathBuf>,
     /// VCM: the merging radius shrinks as i^((alpha - 1) / 2); alpha in
     /// (0, 1) (default 0.75).
     #[arg(long, value_name = "ALPHA", value_parser = fraction)]
@@ -351,6 +360,8 @@ impl VcmArgs {
             || self.camera_continuation.is_some()
             || self.max_path_length.is_some()
             || self.merge_radius.is_some()
+            || self.merge_start_pixels.is_some()
+            || self.vcm_techniques.is_some()
             || self.merge_alpha.is_some()
     }
 
@@ -367,8 +378,8 @@ impl VcmArgs {
             camera_continuation: self.camera_continuation.unwrap_or(d.camera_continuation),
             max_segments: self.max_path_length.unwrap_or(d.max_segments),
             initial_radius: self.merge_radius.map(|r| r as f32),
+            start_pixels: self.merge_start_pixels.map_or(d.start_pixels, |p| p as f32),
             alpha: self.merge_alpha.unwrap_or(d.alpha),
-            ..d
         }
     }
 }

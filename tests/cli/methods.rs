@@ -480,6 +480,38 @@ fn vcm_runs_merges_and_refuses_what_it_cannot_do() {
         assert_eq!(v["iterations"], 2, "{v}");
         assert_eq!(v["provenance"]["method"], "vcm", "{v}");
     }
+    // --vcm-techniques writes what each technique carried, which sums to
+    // the image.
+    let techniques = d.join("techniques");
+    let image = d.join("whole.exr");
+    Run::new(["render", "--quiet", "--width", "24", "--height", "24"])
+        .args(["--method", "vcm", "--iterations", "2"])
+        .arg("--vcm-techniques")
+        .arg(&techniques)
+        .scene("cornell_box")
+        .writing("--exr", &image)
+        .succeeds();
+    let whole = Image::read_exr(&image).unwrap();
+    let mut sum = Image::new(whole.width, whole.height);
+    for name in [
+        "lights_hit",
+        "next_event_estimation",
+        "connections",
+        "merging",
+        "light_tracing",
+    ] {
+        sum.add(&Image::read_exr(&techniques.join(format!("{name}.exr"))).unwrap());
+    }
+    for (i, (p, q)) in whole.pixels.iter().zip(&sum.pixels).enumerate() {
+        for c in 0..3 {
+            assert!(
+                (p[c] - q[c]).abs() <= 1e-4 * p[c].abs() + 1e-6,
+                "pixel {i}: the techniques sum to {} against {}",
+                q[c],
+                p[c]
+            );
+        }
+    }
     // merge --passes of two seeds is their average (equal iterations).
     let pass = |seed: &str| {
         let exr = d.join(format!("pass{seed}.exr"));
@@ -537,6 +569,10 @@ fn vcm_runs_merges_and_refuses_what_it_cannot_do() {
         (
             &["--method", "vcm", "--camera-continuation", "0"][..],
             "(0, 1]",
+        ),
+        (
+            &["--method", "vcm", "--vcm-techniques", "Cargo.toml"][..],
+            "not a folder",
         ),
     ] {
         assert_render_refused(&d, "cornell_box", args, says);

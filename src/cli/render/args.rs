@@ -406,7 +406,7 @@ impl RenderArgs {
     /// not go together are refused.
     pub(super) fn method(&self) -> Result<render::Method> {
         if self.vcm.any_given() && self.method != Method::Vcm {
-            bail!("--vcm-mode, --light-paths, --max-path-length, --merge-radius and --merge-alpha are VCM's: add --method vcm");
+            bail!("--vcm-mode, --light-paths, --connections, --camera-continuation, --max-path-length, --merge-radius, --merge-start-pixels, --merge-alpha and --vcm-techniques are VCM's: add --method vcm");
         }
         if matches!(self.method, Method::Sppm | Method::Vcm) {
             self.check_sppm_switches()?;

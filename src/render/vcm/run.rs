@@ -24,6 +24,9 @@ pub struct VcmOutput {
     pub initial_radius: f32,
     pub final_radius: f32,
     pub explain: Vec<ExplainLine>,
+    /// What each technique carried, in the order of `TECHNIQUES` (cut to
+    /// the crop as the image is); they sum to the image.
+    pub techniques: Vec<Image>,
 }
 
 /// Renders `scene` by vertex connection and merging: iterations until
@@ -48,7 +51,13 @@ pub fn render_vcm(
     } else {
         0
     };
+    let techniques = run
+        .technique_images()?
+        .into_iter()
+        .map(|t| options.cut(t))
+        .collect();
     Ok(VcmOutput {
+        techniques,
         explain: explain(&run, options),
         image,
         stopped_by,
