@@ -314,14 +314,14 @@ impl From<&SppmArgs> for SppmOptions {
 pub struct VcmArgs {
     /// VCM: its techniques: pt (path tracing with next-event estimation),
     /// lt (light tracing), ppm (merging at the first diffuse vertex), bpt
-    /// (every connection), vcm (every connection and merge; the default).
+    /// (connections, no merging), vcm (connections and merging; the default).
     #[arg(long, value_enum, value_name = "MODE")]
     pub vcm_mode: Option<VcmMode>,
     /// VCM: light paths traced an iteration (1..=4194304; default 16384).
     #[arg(long, value_name = "N", value_parser = in_range(1, 1 << 22))]
     pub light_paths: Option<u32>,
-    /// VCM: light vertices each diffuse camera vertex connects to, drawn
-    /// from all of the iteration's (1..=16; default 1).
+    /// VCM (bpt, vcm): light vertices each diffuse camera vertex connects
+    /// to, drawn from all of the iteration's (1..=16; default 1).
     #[arg(long, value_name = "N", value_parser = in_range(1, 16))]
     pub connections: Option<u32>,
     /// VCM (bpt, vcm): camera paths go on past a diffuse vertex with this

@@ -311,18 +311,15 @@ impl BitonicBuild {
         clock.stop(timings, "binary search", 1);
 
         let clock = StageClock::start(&self.gpu, &query);
-        let map = SortedPhotonMap {
-            stored,
-            ..gather_records(
-                &self.gpu,
-                &self.gather,
-                frames,
-                sorted,
-                grid_first,
-                grid_width,
-                grid,
-            )?
-        };
+        let table = (grid_first, grid_width);
+        let map = gather_records(
+            &self.gpu,
+            &self.gather,
+            frames,
+            (sorted, stored),
+            table,
+            grid,
+        )?;
         clock.stop(timings, "gather", 1);
         Ok(map)
     }
@@ -336,16 +333,16 @@ pub(crate) fn cell_table_size(slots: u32) -> (u32, u32) {
     (width, entries.div_ceil(width as u64) as u32)
 }
 
-/// The sorted map from its sorted (slot, record) pairs and cell table: the
+/// The sorted map from its sorted (slot, record) pairs (with the count
+/// stored, where the build counted it) and cell table: the
 /// records gathered into sorted order (`photon/gather.frag`), power scaled
 /// to the emitted count in use.
 pub(crate) fn gather_records(
     gpu: &Gpu,
     gather: &Program,
     frames: &PhotonFrames,
-    sorted: Texture,
-    grid_first: Texture,
-    grid_width: u32,
+    (sorted, stored): (Texture, Option<u32>),
+    (grid_first, grid_width): (Texture, u32),
     grid: &Grid,
 ) -> Result<SortedPhotonMap> {
     let (w, h) = (sorted.width, sorted.height);
@@ -371,6 +368,6 @@ pub(crate) fn gather_records(
         grid_first,
         grid_width,
         grid: *grid,
-        stored: None,
+        stored,
     })
 }

@@ -106,18 +106,15 @@ impl CountingBuild {
         clock.stop(timings, "place", 1);
 
         let clock = StageClock::start(&self.gpu, &query);
-        let map = SortedPhotonMap {
-            stored: Some(count),
-            ..gather_records(
-                &self.gpu,
-                &self.gather,
-                frames,
-                sorted,
-                grid_first,
-                grid_width,
-                grid,
-            )?
-        };
+        let table = (grid_first, grid_width);
+        let map = gather_records(
+            &self.gpu,
+            &self.gather,
+            frames,
+            (sorted, Some(count)),
+            table,
+            grid,
+        )?;
         clock.stop(timings, "gather", 1);
         Ok(map)
     }

@@ -69,19 +69,22 @@ fn mean_and_error(images: &[Image], mask: Option<&[bool]>) -> (f64, f64) {
 /// unbiased there too): every mode's mean over four seeds lies within 4 of
 /// its standard errors of the closed form, and that error is under 1%; bpt
 /// and vcm with camera paths that go on as light paths do, and with a tenth
-/// of that (the MIS weights count each subpath's own Russian roulette).
+/// of that (the MIS weights count each subpath's own Russian roulette), and
+/// vcm with three connections a camera vertex (their scale count / (N n)).
 #[test]
 fn every_mode_meets_the_furnace() {
     let scene = common::fixture("furnace");
     let expected = 0.5 / (std::f64::consts::PI * 0.5);
-    let runs = MODES
-        .iter()
-        .map(|&m| (m, 0.1))
-        .chain([(VcmMode::Bpt, 1.0), (VcmMode::Vcm, 1.0)]);
-    for (mode, camera_continuation) in runs {
+    let runs = MODES.iter().map(|&m| (m, 0.1, 1)).chain([
+        (VcmMode::Bpt, 1.0, 1),
+        (VcmMode::Vcm, 1.0, 1),
+        (VcmMode::Vcm, 0.1, 3),
+    ]);
+    for (mode, camera_continuation, connections) in runs {
         let o = VcmOptions {
             mode,
             camera_continuation,
+            connections,
             iterations: 8,
             light_paths: 1 << 12,
             // As SPPM's furnace test: a merging disc well inside the sphere's
@@ -96,7 +99,7 @@ fn every_mode_meets_the_furnace() {
         let (mean, se) = mean_and_error(&images, None);
         let (mean, se) = (mean / expected, se / expected);
         eprintln!(
-            "furnace, {mode:?} (camera continuation {camera_continuation}): {mean:.4} +- {se:.4} of the analytic L"
+            "furnace, {mode:?} (camera continuation {camera_continuation}, {connections} connections): {mean:.4} +- {se:.4} of the analytic L"
         );
         assert!(se < 0.01, "{mode:?}: the test lost its power ({se})");
         assert!((mean - 1.0).abs() < 4.0 * se, "{mode:?}: {mean} +- {se}");

@@ -52,23 +52,37 @@ pub(super) fn write_images(
     outputs: &[(PathBuf, Format)],
     provenance: &Provenance,
 ) -> Result<Vec<(String, Format)>> {
+    write_encoded(&encode_images(image, outputs, provenance)?)?;
+    Ok(outputs
+        .iter()
+        .map(|(p, f)| (p.display().to_string(), *f))
+        .collect())
+}
+
+/// `image` encoded for each output, refused (nothing encoded) where it holds
+/// NaN or infinite pixels.
+pub(super) fn encode_images(
+    image: &Image,
+    outputs: &[(PathBuf, Format)],
+    provenance: &Provenance,
+) -> Result<Vec<(PathBuf, Vec<u8>)>> {
     if image.has_non_finite() {
         bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
     }
-    // Encode everything first, so a failure writes nothing.
-    let encoded: Vec<(PathBuf, Vec<u8>)> = outputs
+    outputs
         .iter()
         .map(|(p, f)| Ok((p.clone(), f.encode(image, provenance)?)))
-        .collect::<Result<_>>()?;
+        .collect()
+}
+
+/// Encoded files written all or nothing.
+pub(super) fn write_encoded(encoded: &[(PathBuf, Vec<u8>)]) -> Result<()> {
     let files: Vec<(&Path, &[u8])> = encoded
         .iter()
         .map(|(p, b)| (p.as_path(), b.as_slice()))
         .collect();
     write_all_atomically(&files)?;
-    Ok(outputs
-        .iter()
-        .map(|(p, f)| (p.display().to_string(), *f))
-        .collect())
+    Ok(())
 }
 
 pub(super) fn write_software_reference(

@@ -1,13 +1,14 @@
 //! `--method vcm`: one view, iterations until --iterations or --time.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use photonmap::gpu::Platform;
 use photonmap::render::{self, StopReason};
 
+use super::args::Format;
 use super::args::{RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{print_explain, provenance, write_images, Report};
+use super::output::{encode_images, print_explain, provenance, write_encoded, Report};
 use crate::cli::progress::Work;
 
 /// `--method vcm`: one view, iterations until --iterations or --time.
@@ -35,10 +36,25 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let out = observer.finish_with(result, outputs.images(), &provenance)?;
     provenance.iterations = Some(out.iterations);
     provenance.photons_emitted = Some(out.light_paths);
-    let mut written = write_images(&out.image, outputs.images(), &provenance)?;
+    // The image and the technique images, all written or none.
+    let mut encoded = encode_images(&out.image, outputs.images(), &provenance)?;
+    let mut written: Vec<(String, Format)> = outputs
+        .images()
+        .iter()
+        .map(|(p, f)| (p.display().to_string(), *f))
+        .collect();
     if let Some(dir) = &args.vcm.vcm_techniques {
-        written.extend(write_techniques(dir, &out.techniques, &provenance)?);
+        let techniques = encode_techniques(dir, &out.techniques, &provenance)?;
+        written.extend(
+            techniques
+                .iter()
+                .map(|(p, _)| (p.display().to_string(), Format::Exr)),
+        );
+        encoded.extend(techniques);
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("--vcm-techniques {}: {e}", dir.display()))?;
     }
+    write_encoded(&encoded)?;
     if args.json {
         crate::cli::print_json(&Report {
             provenance: &provenance,
@@ -50,6 +66,9 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
                 "stopped_by": out.stopped_by,
                 "light_paths": out.light_paths,
                 "light_paths_per_iteration": vcm.light_paths,
+                "connections": vcm.connections,
+                "camera_continuation": vcm.camera_continuation_in_use(),
+                "merge_start_pixels": vcm.start_pixels,
                 "max_path_length": vcm.max_segments,
                 "initial_radius": out.initial_radius,
                 "final_radius": out.final_radius,
@@ -84,54 +103,35 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
 }
 
 /// Refuses, before the render, a `--vcm-techniques` folder that cannot be
-/// made: a file of that name, or a parent that is not a folder.
+/// made: a file of that name, or one whose nearest existing ancestor is not
+/// a folder.
 fn check_techniques_dir(dir: &std::path::Path) -> Result<()> {
-    if dir.exists() {
-        anyhow::ensure!(
-            dir.is_dir(),
-            "--vcm-techniques {}: not a folder",
-            dir.display()
-        );
-        return Ok(());
-    }
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-    if let Some(p) = parent {
-        anyhow::ensure!(
-            p.is_dir(),
-            "--vcm-techniques {}: its parent {} is not a folder",
+    let existing = dir
+        .ancestors()
+        .find(|p| p.as_os_str().is_empty() || p.exists());
+    match existing {
+        Some(p) if p.as_os_str().is_empty() || p.is_dir() => Ok(()),
+        Some(p) if p == dir => bail!("--vcm-techniques {}: not a folder", dir.display()),
+        Some(p) => bail!(
+            "--vcm-techniques {}: {} is not a folder",
             dir.display(),
             p.display()
-        );
+        ),
+        None => Ok(()),
     }
-    Ok(())
 }
 
-/// `--vcm-techniques DIR`: each technique's image as DIR/<technique>.exr,
-/// all written or none.
-fn write_techniques(
+/// `--vcm-techniques DIR`: each technique's image encoded as
+/// DIR/<technique>.exr.
+fn encode_techniques(
     dir: &std::path::Path,
     techniques: &[photonmap::render::Image],
     provenance: &photonmap::provenance::Provenance,
-) -> Result<Vec<(String, super::args::Format)>> {
-    use anyhow::Context;
-    let format = super::args::Format::Exr;
+) -> Result<Vec<(std::path::PathBuf, Vec<u8>)>> {
     let mut files = Vec::new();
     for (name, image) in render::vcm::TECHNIQUES.iter().zip(techniques) {
         let path = dir.join(name.replace([' ', '-'], "_") + ".exr");
-        anyhow::ensure!(
-            !image.has_non_finite(),
-            "{name} produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)"
-        );
-        files.push((path, format.encode(image, provenance)?));
+        files.extend(encode_images(image, &[(path, Format::Exr)], provenance)?);
     }
-    std::fs::create_dir_all(dir).with_context(|| format!("making {}", dir.display()))?;
-    let refs: Vec<(&std::path::Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    photonmap::image::write_all_atomically(&refs)?;
-    Ok(files
-        .iter()
-        .map(|(p, _)| (p.display().to_string(), format))
-        .collect())
+    Ok(files)
 }

@@ -98,7 +98,7 @@ pub struct Vcm {
     /// Stored light vertices of the last iteration (for reports).
     pub light_vertices: u64,
     /// What a sampler reads when its input is not made this iteration (path
-    /// tracing has no light vertices; only merging builds a map).
+    /// tracing has no light vertices and builds no map).
     none_f32: Texture,
     none_i32: Texture,
 }
@@ -219,7 +219,8 @@ impl Vcm {
             timings.add_since("light vertex partials", 0.0, wall, 1);
             let wall = std::time::Instant::now();
             let frames = &self.batch.as_ref().expect("light paths").frames;
-            // Without merging the grid only compacts: one cell.
+            // Without merging the map is only the light vertex cache, which
+            // light tracing and connections walk: one cell.
             let grid = if mode.merges() {
                 Grid::over_scene(
                     &self.scene,

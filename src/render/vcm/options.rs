@@ -16,9 +16,12 @@ pub enum VcmMode {
     /// Progressive photon mapping: merging at the camera path's first diffuse
     /// vertex, unweighted (biased; consistent as the radius shrinks).
     Ppm,
-    /// Bidirectional path tracing: every connection, no merging.
+    /// Bidirectional path tracing: next-event estimation, connections to
+    /// light vertices drawn from all of the iteration's and light tracing;
+    /// no merging.
     Bpt,
-    /// Vertex connection and merging: every connection and every merge.
+    /// Vertex connection and merging: the techniques of bpt and merging at
+    /// every diffuse camera vertex.
     #[default]
     Vcm,
 }

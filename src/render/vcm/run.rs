@@ -124,6 +124,11 @@ fn explain(run: &Vcm, options: &RenderOptions) -> Vec<ExplainLine> {
                     run.initial_radius,
                     (o.alpha - 1.0) * 0.5
                 )
+            } else if mode.traces_light_paths() {
+                format!(
+                    "--vcm-mode {} merges nothing; the light vertices are still compacted each iteration (counting sort, one cell) for light tracing and connections to walk",
+                    mode.name()
+                )
             } else {
                 format!("--vcm-mode {} merges nothing", mode.name())
             },
@@ -145,8 +150,8 @@ fn explain(run: &Vcm, options: &RenderOptions) -> Vec<ExplainLine> {
                     crate::render::vcm::VcmMode::Pt => "next-event estimation, weighted against paths that hit a light",
                     crate::render::vcm::VcmMode::Lt => "nothing (light tracing draws what the camera sees of diffuse surfaces; lights seen directly or through mirrors and glass are the camera path's)",
                     crate::render::vcm::VcmMode::Ppm => "merging at the first, unweighted, and the path ends",
-                    crate::render::vcm::VcmMode::Bpt => "next-event estimation and connections to light vertices drawn from all of the iteration's, each weighted by the balance heuristic",
-                    crate::render::vcm::VcmMode::Vcm => "next-event estimation, connections to light vertices drawn from all of the iteration's, and merging, each weighted by the balance heuristic",
+                    crate::render::vcm::VcmMode::Bpt => "next-event estimation and --connections connections to light vertices drawn from all of the iteration's, each weighted by the balance heuristic",
+                    crate::render::vcm::VcmMode::Vcm => "next-event estimation, --connections connections to light vertices drawn from all of the iteration's, and merging, each weighted by the balance heuristic",
                 }
             ),
         ),
