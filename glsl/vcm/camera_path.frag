@@ -28,8 +28,6 @@ uniform float u_radius2;          // merging radius squared
 uniform isampler2D u_map_pairs;   // sorted (key, record): a map photon's record
 uniform sampler2D u_map_incoming;
 uniform int u_merge;              // 1: merging runs
-uniform int u_map_built;          // 1: the map of the light vertices is bound
-uniform int u_slots;              // its slots; u_grid_first[u_slots] counts its vertices
 uniform int u_connections;        // light vertices a camera vertex connects to
 
 layout(location = 0) out vec4 o_radiance;
@@ -130,11 +128,6 @@ vec3 merge(vec3 x, vec3 nf, vec3 a, float q, float q_light, float cos_in, vec3 c
     return sum * (a / PI) / (PI * u_radius2);
 }
 
-// The light vertices of this iteration's map: its slot table's last entry.
-int light_vertex_count() {
-    return texelFetch(u_grid_first, texel_of_index(u_slots, u_grid_width), 0).x;
-}
-
 // Connections from camera vertex x to u_connections light vertices drawn
 // uniformly from all `count` of this iteration (Davidovic et al. 2014's light
 // vertex cache). Scaled by count / (N u_connections), the sum is in
@@ -181,7 +174,6 @@ void main() {
     float image_distance = u_image_size.y / (2.0 * u_tan_half_fov.y);
     vec3 camera = u_mode == VCM_MODE_PT ? vec3(0.0)
                 : mis_camera_start(image_distance * image_distance / (cos_camera * cos_camera * cos_camera));
-    int light_vertices = u_map_built != 0 ? light_vertex_count() : 0;
     vec3 throughput = vec3(1.0);
     // Per technique: lights hit, next-event estimation, connections, merging.
     vec3 emission = vec3(0.0), light_sample = vec3(0.0), connection = vec3(0.0), merging = vec3(0.0);
@@ -246,8 +238,8 @@ void main() {
                     }
                 }
             }
-            if (connections() && light_vertices > 0)
-                connection += throughput * connect(rng, light_vertices, p, nf, a, q, q_light, cos_in, camera, segments);
+            if (connections() && u_light_vertices > 0)
+                connection += throughput * connect(rng, u_light_vertices, p, nf, a, q, q_light, cos_in, camera, segments);
             if (u_mode == VCM_MODE_VCM && u_merge != 0)
                 merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);
             // Continue by Russian roulette and a cosine-distributed direction.

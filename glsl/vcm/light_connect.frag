@@ -16,9 +16,6 @@
 #include "vcm/light_vertex.glsl"
 
 uniform isampler2D u_map_pairs;   // the map's (slot, record), compacted
-uniform isampler2D u_grid_first;  // its slot table: entry u_slots is the vertex count
-uniform int u_grid_width;
-uniform int u_slots;
 uniform int u_sorted_width;
 uniform int u_mode;
 uniform int u_max_segments;
@@ -30,7 +27,7 @@ void main() {
     o_contribution = vec4(0.0);
     o_landing = vec4(0.0);
     int index = index_of_texel(ivec2(gl_FragCoord.xy), u_sorted_width);
-    if (index >= texelFetch(u_grid_first, texel_of_index(u_slots, u_grid_width), 0).x) return;
+    if (index >= u_light_vertices) return;
     int record = texelFetch(u_map_pairs, ivec2(gl_FragCoord.xy), 0).y;
     LightVertex v;
     if (!light_vertex(texel_of_index(record, u_lv_width), v)) return;

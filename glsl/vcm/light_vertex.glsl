@@ -16,6 +16,7 @@ uniform int u_lv_width;           // frame width
 uniform int u_lv_frame_height;
 uniform int u_lv_frames;          // frames holding a live photon
 uniform float u_lv_power_scale;
+uniform int u_light_vertices;     // stored this iteration: the map's count (0: none)
 
 struct LightVertex {
     vec3 p;

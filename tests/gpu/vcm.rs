@@ -26,7 +26,7 @@ fn options(scene: &Scene, w: u32, h: u32, seed: u32) -> RenderOptions {
 
 fn vcm_image(scene: &Scene, w: u32, h: u32, seed: u32, o: &VcmOptions) -> Image {
     let gpu = common::gpu();
-    render_vcm(&gpu, scene, &options(scene, w, h, seed), o, &mut ())
+    render_vcm(&gpu, scene, &options(scene, w, h, seed), o, false, &mut ())
         .unwrap()
         .image
 }

@@ -52,37 +52,32 @@ pub(super) fn write_images(
     outputs: &[(PathBuf, Format)],
     provenance: &Provenance,
 ) -> Result<Vec<(String, Format)>> {
-    write_encoded(&encode_images(image, outputs, provenance)?)?;
-    Ok(outputs
+    write_image_sets(&[(image, outputs)], provenance)
+}
+
+/// Each image to each of its outputs, all written or none: everything is
+/// encoded first, and nothing is written where an image holds NaN or
+/// infinite pixels.
+pub(super) fn write_image_sets(
+    sets: &[(&Image, &[(PathBuf, Format)])],
+    provenance: &Provenance,
+) -> Result<Vec<(String, Format)>> {
+    let mut encoded: Vec<(&Path, Vec<u8>)> = Vec::new();
+    for (image, outputs) in sets {
+        if image.has_non_finite() {
+            bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
+        }
+        for (p, f) in outputs.iter() {
+            encoded.push((p.as_path(), f.encode(image, provenance)?));
+        }
+    }
+    let files: Vec<(&Path, &[u8])> = encoded.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    write_all_atomically(&files)?;
+    Ok(sets
         .iter()
+        .flat_map(|(_, outputs)| outputs.iter())
         .map(|(p, f)| (p.display().to_string(), *f))
         .collect())
-}
-
-/// `image` encoded for each output, refused (nothing encoded) where it holds
-/// NaN or infinite pixels.
-pub(super) fn encode_images(
-    image: &Image,
-    outputs: &[(PathBuf, Format)],
-    provenance: &Provenance,
-) -> Result<Vec<(PathBuf, Vec<u8>)>> {
-    if image.has_non_finite() {
-        bail!("the render produced NaN or infinite pixels: nothing was written (a bug; please report it with the scene)");
-    }
-    outputs
-        .iter()
-        .map(|(p, f)| Ok((p.clone(), f.encode(image, provenance)?)))
-        .collect()
-}
-
-/// Encoded files written all or nothing.
-pub(super) fn write_encoded(encoded: &[(PathBuf, Vec<u8>)]) -> Result<()> {
-    let files: Vec<(&Path, &[u8])> = encoded
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomically(&files)?;
-    Ok(())
 }
 
 pub(super) fn write_software_reference(

@@ -1,5 +1,7 @@
 //! `--method vcm`: one view, iterations until --iterations or --time.
 
+use std::path::PathBuf;
+
 use anyhow::{bail, Result};
 
 use photonmap::gpu::Platform;
@@ -8,7 +10,7 @@ use photonmap::render::{self, StopReason};
 use super::args::Format;
 use super::args::{RenderArgs, Start};
 use super::observer::CliObserver;
-use super::output::{encode_images, print_explain, provenance, write_encoded, Report};
+use super::output::{print_explain, provenance, write_image_sets, Report};
 use crate::cli::progress::Work;
 
 /// `--method vcm`: one view, iterations until --iterations or --time.
@@ -32,29 +34,42 @@ pub(super) fn run(args: &RenderArgs, platform: Platform) -> Result<()> {
     let render::Method::Vcm(vcm) = &options.method else {
         unreachable!("--method vcm gives Method::Vcm");
     };
-    let result = render::vcm::render_vcm(&gpu, scene, &options, vcm, &mut observer);
+    let result = render::vcm::render_vcm(
+        &gpu,
+        scene,
+        &options,
+        vcm,
+        args.vcm.vcm_techniques.is_some(),
+        &mut observer,
+    );
     let out = observer.finish_with(result, outputs.images(), &provenance)?;
     provenance.iterations = Some(out.iterations);
     provenance.photons_emitted = Some(out.light_paths);
     // The image and the technique images, all written or none.
-    let mut encoded = encode_images(&out.image, outputs.images(), &provenance)?;
-    let mut written: Vec<(String, Format)> = outputs
-        .images()
-        .iter()
-        .map(|(p, f)| (p.display().to_string(), *f))
-        .collect();
-    if let Some(dir) = &args.vcm.vcm_techniques {
-        let techniques = encode_techniques(dir, &out.techniques, &provenance)?;
-        written.extend(
-            techniques
+    let technique_outputs: Vec<[(PathBuf, Format); 1]> = match &args.vcm.vcm_techniques {
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("--vcm-techniques {}: {e}", dir.display()))?;
+            render::vcm::TECHNIQUES
                 .iter()
-                .map(|(p, _)| (p.display().to_string(), Format::Exr)),
-        );
-        encoded.extend(techniques);
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("--vcm-techniques {}: {e}", dir.display()))?;
-    }
-    write_encoded(&encoded)?;
+                .map(|name| {
+                    [(
+                        dir.join(name.replace([' ', '-'], "_") + ".exr"),
+                        Format::Exr,
+                    )]
+                })
+                .collect()
+        }
+        None => Vec::new(),
+    };
+    let mut sets = vec![(&out.image, outputs.images())];
+    sets.extend(
+        out.techniques
+            .iter()
+            .zip(&technique_outputs)
+            .map(|(image, o)| (image, &o[..])),
+    );
+    let written = write_image_sets(&sets, &provenance)?;
     if args.json {
         crate::cli::print_json(&Report {
             provenance: &provenance,
@@ -119,19 +134,4 @@ fn check_techniques_dir(dir: &std::path::Path) -> Result<()> {
         ),
         None => Ok(()),
     }
-}
-
-/// `--vcm-techniques DIR`: each technique's image encoded as
-/// DIR/<technique>.exr.
-fn encode_techniques(
-    dir: &std::path::Path,
-    techniques: &[photonmap::render::Image],
-    provenance: &photonmap::provenance::Provenance,
-) -> Result<Vec<(std::path::PathBuf, Vec<u8>)>> {
-    let mut files = Vec::new();
-    for (name, image) in render::vcm::TECHNIQUES.iter().zip(techniques) {
-        let path = dir.join(name.replace([' ', '-'], "_") + ".exr");
-        files.extend(encode_images(image, &[(path, Format::Exr)], provenance)?);
-    }
-    Ok(files)
 }

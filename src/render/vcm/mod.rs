@@ -299,7 +299,8 @@ impl Vcm {
             .int("u_lv_width", f.width as i32)
             .int("u_lv_frame_height", f.frame_height as i32)
             .int("u_lv_frames", f.frames as i32)
-            .float("u_lv_power_scale", f.power_scale);
+            .float("u_lv_power_scale", f.power_scale)
+            .int("u_light_vertices", self.light_vertices as i32);
     }
 
     /// Light tracing: every light vertex of the map connected to the camera
@@ -320,7 +321,6 @@ impl Vcm {
             self.connected = Some((contribution, landing, target));
         }
         let (contribution, landing, target) = self.connected.as_ref().expect("allocated");
-        let map = self.map.as_ref().expect("built");
         {
             let mut b = self.connect_program.bind();
             self.textures.bind(&mut b);
@@ -328,9 +328,6 @@ impl Vcm {
             self.bind_factors(&mut b, radius);
             self.bind_light_vertices(&mut b);
             b.texture("u_map_pairs", &map.pairs)
-                .texture("u_grid_first", &map.grid_first)
-                .int("u_grid_width", map.grid_width as i32)
-                .int("u_slots", map.grid.slot_count() as i32)
                 .int("u_sorted_width", w as i32)
                 .int("u_mode", self.options.mode.code() as i32)
                 .int("u_max_segments", self.options.max_segments as i32)
@@ -367,7 +364,8 @@ impl Vcm {
                 .int("u_lv_width", 1)
                 .int("u_lv_frame_height", 1)
                 .int("u_lv_frames", 0)
-                .float("u_lv_power_scale", 1.0);
+                .float("u_lv_power_scale", 1.0)
+                .int("u_light_vertices", 0);
         }
         match &self.map {
             Some(m) => {
@@ -378,8 +376,6 @@ impl Vcm {
                     .texture("u_grid_first", &m.grid_first)
                     .int("u_grid_width", m.grid_width as i32)
                     .int("u_sorted_width", m.position.width as i32)
-                    .int("u_slots", m.grid.slot_count() as i32)
-                    .int("u_map_built", 1)
                     .int("u_merge", self.options.mode.merges() as i32);
                 m.grid.bind(&mut b);
             }
@@ -391,8 +387,6 @@ impl Vcm {
                     .texture("u_grid_first", &self.none_i32)
                     .int("u_grid_width", 1)
                     .int("u_sorted_width", 1)
-                    .int("u_slots", 0)
-                    .int("u_map_built", 0)
                     .int("u_merge", 0);
             }
         }

@@ -24,18 +24,21 @@ pub struct VcmOutput {
     pub initial_radius: f32,
     pub final_radius: f32,
     pub explain: Vec<ExplainLine>,
-    /// What each technique carried, in the order of `TECHNIQUES` (cut to
-    /// the crop as the image is); they sum to the image.
+    /// With `technique_images` asked: what each technique carried, in the order
+    /// of `TECHNIQUES` (cut to the crop as the image is), which sums to the
+    /// image; otherwise none.
     pub techniques: Vec<Image>,
 }
 
 /// Renders `scene` by vertex connection and merging: iterations until
-/// `vcm.iterations` or `vcm.seconds`, whichever comes first.
+/// `vcm.iterations` or `vcm.seconds`, whichever comes first. With
+/// `technique_images`, also reads back what each technique carried.
 pub fn render_vcm(
     gpu: &crate::gpu::Gpu,
     scene: &Scene,
     options: &RenderOptions,
     vcm: &VcmOptions,
+    technique_images: bool,
     observer: &mut dyn RenderObserver,
 ) -> Result<VcmOutput> {
     options.check_pixel_bounds()?;
@@ -51,11 +54,12 @@ pub fn render_vcm(
     } else {
         0
     };
-    let techniques = run
-        .technique_images()?
-        .into_iter()
-        .map(|t| options.cut(t))
-        .collect();
+    let techniques = if technique_images {
+        let images = run.technique_images()?;
+        images.into_iter().map(|t| options.cut(t)).collect()
+    } else {
+        Vec::new()
+    };
     Ok(VcmOutput {
         techniques,
         explain: explain(&run, options),

@@ -135,7 +135,7 @@ fn race(
                     seconds: Some(budget),
                     ..VcmOptions::default()
                 };
-                let v = render_vcm(gpu, scene, &o, &vcm, &mut watch)?;
+                let v = render_vcm(gpu, scene, &o, &vcm, false, &mut watch)?;
                 (v.iterations, v.light_paths, v.image)
             }
         };
