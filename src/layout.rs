@@ -22,6 +22,9 @@ pub const BVH_STACK: usize = 128;
 /// 24-triangle ball on a floor, most of whose triangles the BVH's boxes cull,
 /// 0.57 times (eye rays).
 pub const LINEAR_SCAN_MAX: usize = 16;
+/// The uniform-block binding point of a small scene's primitives
+/// (SCENE_PRIMITIVE_BLOCK in glsl/common/scene.glsl).
+pub const SCENE_BLOCK_BINDING: u32 = 0;
 /// 1 + 2 gamma(3) in f32: the slab test's far distance widened by its worst
 /// rounding, so a box never culls a ray its primitives would hit (pbrt-v4 6.1).
 pub const BOX_ROBUST: f32 = 1.0 + 3.0 * f32::EPSILON;
@@ -166,6 +169,8 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PRIMITIVES_PER_ROW", u(PRIMITIVES_PER_ROW)),
         ("BVH_ROW_TEXELS", u(BVH_ROW_TEXELS)),
         ("BVH_STACK", BVH_STACK.to_string()),
+        ("LINEAR_SCAN_MAX", LINEAR_SCAN_MAX.to_string()),
+        ("SCENE_BLOCK_BINDING", u(SCENE_BLOCK_BINDING)),
         ("BOX_ROBUST", format!("{BOX_ROBUST:?}")),
         ("PRIM_SPHERE", u(PRIM_SPHERE)),
         ("PRIM_CYLINDER", u(PRIM_CYLINDER)),

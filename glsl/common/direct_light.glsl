@@ -16,7 +16,7 @@ struct AreaLight { bool triangles; vec3 a, e1, e2, normal; float area; };
 AreaLight area_light(int l) {
     vec4 head = light_texel(l, 0);
     AreaLight L;
-    L.triangles = int(head.x) == LIGHT_TRIANGLES;
+    L.triangles = SCENE_HAS_LIGHT(LIGHT_TRIANGLES) && int(head.x) == LIGHT_TRIANGLES;
     L.a = light_texel(l, 1).xyz;
     L.e1 = light_texel(l, 2).xyz;
     L.e2 = light_texel(l, 3).xyz;
@@ -66,7 +66,7 @@ vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int pr
 
     for (int l = 0; l < (light_sampling ? u_light_count : 0); ++l) {
         vec4 head = light_texel(l, 0);
-        if (int(head.x) == LIGHT_POINT) {
+        if (SCENE_HAS_LIGHT(LIGHT_POINT) && int(head.x) == LIGHT_POINT) {
             if (!point_lights) continue;
             vec3 a = light_texel(l, 1).xyz;
             vec3 emitted = light_texel(l, 4).rgb;
@@ -79,6 +79,7 @@ vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int pr
                 sum += emitted * cos_s / (dist * dist);
             continue;
         }
+        if (!SCENE_HAS_LIGHT(LIGHT_AREA) && !SCENE_HAS_LIGHT(LIGHT_TRIANGLES)) continue;
         vec3 emitted = light_texel(l, 4).rgb;
         vec3 light_sum = vec3(0.0);
         AreaLight L = area_light(l);

@@ -17,21 +17,69 @@ uniform int u_light_count;
 // PRIM_*, MAT_*, LIGHT_* kind codes, the *_TEXELS row lengths and the BVH
 // sizes are #defines from src/layout.rs, injected into every program.
 
+// Scene defines (src/scene/pack.rs sets them for the scene last packed):
+// - SCENE_KINDS, SCENE_MATERIALS, SCENE_LIGHTS: bit PRIM_*, MAT_*, LIGHT_*
+//   set for each kind of primitive, material (on a shape) and light the
+//   scene holds; SCENE_SHADING_NORMALS: 1 where a triangle has vertex
+//   normals. The code of what the scene lacks is left out: llvmpipe runs
+//   both sides of every branch under a lane mask, so code no lane takes
+//   still costs its time.
+// - SCENE_PRIMITIVE_BLOCK: a small scene's primitives in a uniform block as
+//   well. In the linear scan every lane reads the same primitive, which
+//   llvmpipe loads once from a uniform block but gathers lane by lane from a
+//   texture.
+#ifndef SCENE_KINDS
+#define SCENE_KINDS 15
+#endif
+#ifndef SCENE_MATERIALS
+#define SCENE_MATERIALS 15
+#endif
+#ifndef SCENE_LIGHTS
+#define SCENE_LIGHTS 7
+#endif
+#ifndef SCENE_SHADING_NORMALS
+#define SCENE_SHADING_NORMALS 1
+#endif
+#define SCENE_HAS(kind) (((SCENE_KINDS >> kind) & 1) != 0)
+#define SCENE_HAS_MATERIAL(kind) (((SCENE_MATERIALS >> kind) & 1) != 0)
+#define SCENE_HAS_LIGHT(kind) (((SCENE_LIGHTS >> kind) & 1) != 0)
+#define SCENE_HAS_SPECULAR (SCENE_HAS_MATERIAL(MAT_MIRROR) || SCENE_HAS_MATERIAL(MAT_GLASS))
+
+#ifdef SCENE_PRIMITIVE_BLOCK
+layout(std140, binding = SCENE_BLOCK_BINDING) uniform ScenePrimitives {
+    vec4 scene_primitives[LINEAR_SCAN_MAX * PRIMITIVE_TEXELS];
+};
+#endif
+
 vec4 primitive_texel(int prim, int i) {
+#ifdef SCENE_PRIMITIVE_BLOCK
+    return scene_primitives[prim * PRIMITIVE_TEXELS + i];
+#else
     ivec2 at = ivec2((prim % PRIMITIVES_PER_ROW) * PRIMITIVE_TEXELS + i, prim / PRIMITIVES_PER_ROW);
     return texelFetch(u_primitives, at, 0);
+#endif
+}
+
+// The primitive's PRIM_* kind: a constant where the scene holds one kind.
+int primitive_kind(int prim) {
+    if (SCENE_KINDS == (1 << PRIM_SPHERE)) return PRIM_SPHERE;
+    if (SCENE_KINDS == (1 << PRIM_CYLINDER)) return PRIM_CYLINDER;
+    if (SCENE_KINDS == (1 << PRIM_PARALLELOGRAM)) return PRIM_PARALLELOGRAM;
+    if (SCENE_KINDS == (1 << PRIM_TRIANGLE)) return PRIM_TRIANGLE;
+    return int(primitive_texel(prim, 0).x);
 }
 
 vec4 intersect_primitive_ray(int prim, SceneRay r) {
-    vec4 head = primitive_texel(prim, 0);
-    int kind = int(head.x);
+    int kind = primitive_kind(prim);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (kind == PRIM_SPHERE) return intersect_sphere(r.o, r.d, a.xyz, a.w);
-    if (kind == PRIM_CYLINDER) return intersect_cylinder(r.o, r.d, a.xyz, b.xyz, a.w, b.w);
+    if (SCENE_HAS(PRIM_SPHERE) && kind == PRIM_SPHERE) return intersect_sphere(r.o, r.d, a.xyz, a.w);
+    if (SCENE_HAS(PRIM_CYLINDER) && kind == PRIM_CYLINDER)
+        return intersect_cylinder(r.o, r.d, a.xyz, b.xyz, a.w, b.w);
     vec4 c = primitive_texel(prim, 3);
-    if (kind == PRIM_TRIANGLE) return intersect_triangle(r, a.xyz, b.xyz, c.xyz);
-    return intersect_parallelogram(r.o, r.d, a.xyz, b.xyz, c.xyz);
+    if (SCENE_HAS(PRIM_TRIANGLE) && kind == PRIM_TRIANGLE) return intersect_triangle(r, a.xyz, b.xyz, c.xyz);
+    if (SCENE_HAS(PRIM_PARALLELOGRAM)) return intersect_parallelogram(r.o, r.d, a.xyz, b.xyz, c.xyz);
+    return NO_HIT;
 }
 
 vec4 intersect_primitive(int prim, vec3 o, vec3 d) {
@@ -41,16 +89,16 @@ vec4 intersect_primitive(int prim, vec3 o, vec3 d) {
 // The geometric normal of primitive `prim` at p: outward for spheres and
 // cylinders, e1 x e2 for planar shapes (v1 - v0, v2 - v0 for triangles).
 vec3 geometric_normal(int prim, vec3 p) {
-    int kind = int(primitive_texel(prim, 0).x);
+    int kind = primitive_kind(prim);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (kind == PRIM_SPHERE) return normalize(p - a.xyz);
-    if (kind == PRIM_CYLINDER) {
+    if (SCENE_HAS(PRIM_SPHERE) && kind == PRIM_SPHERE) return normalize(p - a.xyz);
+    if (SCENE_HAS(PRIM_CYLINDER) && kind == PRIM_CYLINDER) {
         vec3 r = p - a.xyz;
         return normalize(r - dot(r, b.xyz) * b.xyz);
     }
     vec3 c = primitive_texel(prim, 3).xyz;
-    if (kind == PRIM_TRIANGLE) return normalize(cross(b.xyz - a.xyz, c - a.xyz));
+    if (SCENE_HAS(PRIM_TRIANGLE) && kind == PRIM_TRIANGLE) return normalize(cross(b.xyz - a.xyz, c - a.xyz));
     return normalize(cross(b.xyz, c));
 }
 
@@ -58,16 +106,15 @@ vec3 geometric_normal(int prim, vec3 p) {
 // scales with the surface's coordinates, not with the ray's length (pbrt-v4, 6.8).
 // Also returns the geometric normal.
 vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
-    vec4 head = primitive_texel(prim, 0);
-    int kind = int(head.x);
+    int kind = primitive_kind(prim);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (kind == PRIM_SPHERE) {
+    if (SCENE_HAS(PRIM_SPHERE) && kind == PRIM_SPHERE) {
         vec3 p = o + hit.x * d;
         normal = normalize(p - a.xyz);
         return a.xyz + a.w * normal;
     }
-    if (kind == PRIM_CYLINDER) {
+    if (SCENE_HAS(PRIM_CYLINDER) && kind == PRIM_CYLINDER) {
         vec3 p = o + hit.x * d;
         vec3 on_axis = a.xyz + hit.y * b.xyz;
         vec3 r = p - on_axis;
@@ -75,7 +122,7 @@ vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
         return on_axis + a.w * normal;
     }
     vec3 c = primitive_texel(prim, 3).xyz;
-    if (kind == PRIM_TRIANGLE) {
+    if (SCENE_HAS(PRIM_TRIANGLE) && kind == PRIM_TRIANGLE) {
         normal = normalize(cross(b.xyz - a.xyz, c - a.xyz));
         return (1.0 - hit.y - hit.z) * a.xyz + hit.y * b.xyz + hit.z * c;
     }
@@ -91,7 +138,7 @@ int primitive_light(int prim) { return int(primitive_texel(prim, 0).w) - 1; }
 // ---- shading normals: a triangle's vertex normals, interpolated.
 
 // Whether the primitive has vertex normals (head .z = record + 1, 0: none).
-bool has_shading_normal(int prim) { return primitive_texel(prim, 0).z > 0.0; }
+bool has_shading_normal(int prim) { return SCENE_SHADING_NORMALS != 0 && primitive_texel(prim, 0).z > 0.0; }
 
 // The shading normal at p (a point of primitive prim, whose unit geometric
 // normal is n): the vertex normals interpolated by p's barycentric weights
@@ -99,6 +146,7 @@ bool has_shading_normal(int prim) { return primitive_texel(prim, 0).z > 0.0; }
 // where the interpolated normal points to the other side of the face.
 // src/reference/shading.rs is its twin.
 vec3 shading_normal(int prim, vec3 p, vec3 n) {
+    if (SCENE_SHADING_NORMALS == 0) return n;
     int record = int(primitive_texel(prim, 0).z) - 1;
     if (record < 0) return n;
     vec3 a = primitive_texel(prim, 1).xyz;

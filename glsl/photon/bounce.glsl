@@ -68,7 +68,7 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
     float u0 = photon_random_next(rng), u1 = photon_random_next(rng), u2 = photon_random_next(rng);
     bool stored = false;
     bool alive = true;
-    vec3 next;
+    vec3 next = d;
     // Vertex normals: the shading normal on the side the photon arrives at.
     bool shaded = has_shading_normal(prim);
     vec3 ms = nf;
@@ -91,7 +91,7 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
             float cos_g = -dot(nf, d);
             power *= cos_g > 0.0 ? max(-dot(ms, d), 0.0) / cos_g : 0.0;
         }
-    } else {
+    } else if (SCENE_HAS_SPECULAR) { // else no lane is here: only diffuse surfaces reflect
         bool entering = dot(n, d) < 0.0;
         float ior = kind == MAT_MIRROR ? 0.0 : material_texel(mat, 0).y;
         if (shaded) {

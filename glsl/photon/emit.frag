@@ -74,11 +74,11 @@ void main() {
 #endif
     vec3 p, d, power;
     float leaving = choice.z; // the primitive the photon leaves (-1: none)
-    if (int(head.x) == LIGHT_POINT) {
+    if (SCENE_HAS_LIGHT(LIGHT_POINT) && int(head.x) == LIGHT_POINT) {
         p = a;
         d = sample_sphere(u1, u2);
         power = 4.0 * PI * emitted;
-    } else if (int(head.x) == LIGHT_TRIANGLES) {
+    } else if (SCENE_HAS_LIGHT(LIGHT_TRIANGLES) && int(head.x) == LIGHT_TRIANGLES) {
         vec3 normal;
         int prim;
         p = sample_light_triangle(l, u1, u2, normal, prim);

@@ -8,3 +8,4 @@ pub mod mask;
 pub mod ray_rates;
 pub mod regions;
 pub mod stress;
+pub mod throughput;

@@ -17,6 +17,7 @@ pub mod query;
 pub mod state;
 pub mod target;
 pub mod texture;
+pub mod uniform_block;
 pub mod vertex;
 
 use std::cell::Cell;
@@ -33,6 +34,7 @@ pub use query::Query;
 pub use state::{Blend, Compare, DepthTest, DrawState, StencilOp, StencilTest};
 pub use target::{PingPong, Target};
 pub use texture::{TexFormat, Texel, Texture};
+pub use uniform_block::UniformBlock;
 pub use vertex::VertexBuffer;
 
 /// The GPU: a GL context plus the objects every pass shares.

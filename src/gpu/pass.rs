@@ -85,6 +85,33 @@ impl Bindings<'_> {
         })
     }
 
+    /// Binds `block` to uniform-block binding point `binding` (the
+    /// `layout(binding = ...)` its GLSL declaration names).
+    pub fn uniform_block(&mut self, binding: u32, block: &super::UniformBlock) -> &mut Self {
+        // SAFETY: gpu module doc; the buffer is the block's own.
+        unsafe {
+            self.gl
+                .bind_buffer_base(glow::UNIFORM_BUFFER, binding, Some(block.raw))
+        };
+        self
+    }
+
+    /// The scene defines the program was compiled with (`Gpu::set_scene_defines`).
+    pub fn scene_defines(&self) -> &[(&'static str, String)] {
+        &self.program.scene_defines
+    }
+
+    /// The program's name (its fragment stage's file).
+    pub fn program_name(&self) -> &str {
+        &self.program.name
+    }
+
+    /// Makes the next draw fail with `error` (a binding found wrong).
+    pub fn fail(&mut self, error: Error) -> &mut Self {
+        self.error.get_or_insert(error);
+        self
+    }
+
     pub fn int(&mut self, name: &str, v: i32) -> &mut Self {
         // SAFETY: as for `texture`.
         self.set(name, |gl, l| unsafe { gl.uniform_1_i32(l, v) })

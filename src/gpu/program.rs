@@ -220,6 +220,9 @@ pub struct Program {
     /// Every uniform either stage's source declares.
     declared: HashSet<String>,
     uniforms: std::cell::RefCell<HashMap<String, Option<glow::UniformLocation>>>,
+    /// The scene defines it was compiled with: scene packing checks them
+    /// against the scene it binds.
+    pub(crate) scene_defines: Vec<(&'static str, String)>,
 }
 
 impl Program {
@@ -272,11 +275,12 @@ impl Program {
         defines: &[(&str, String)],
     ) -> Result<Self> {
         let mut defines = with_layout(defines);
-        for (name, value) in gpu.scene_defines() {
-            if !defines.iter().any(|(n, _)| *n == name) {
-                defines.push((name, value));
-            }
-        }
+        let scene_defines: Vec<(&'static str, String)> = gpu
+            .scene_defines()
+            .into_iter()
+            .filter(|(name, _)| !defines.iter().any(|(n, _)| n == name))
+            .collect();
+        defines.extend(scene_defines.iter().map(|(n, v)| (*n, v.clone())));
         let vs_source = preprocess(lookup, vertex, &defines)?;
         let fs_source = preprocess(lookup, fragment, &defines)?;
         let gs_source = geometry
@@ -347,6 +351,7 @@ impl Program {
                 name: fragment.to_string(),
                 declared,
                 uniforms: Default::default(),
+                scene_defines,
             })
         }
     }

@@ -1,7 +1,7 @@
 //! The scene packed into float textures once, in the layout glsl/common/scene.glsl reads.
 
 use crate::error::Error;
-use crate::gpu::{Gpu, Result, TexFormat, Texture};
+use crate::gpu::{Gpu, Result, TexFormat, Texture, UniformBlock};
 use crate::layout::{
     BVH_ROW_TEXELS, LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, LIGHT_TRIANGLES,
     LIGHT_TRIANGLE_ROW_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE, MAT_EMITTER, MAT_GLASS, MAT_MIRROR,
@@ -264,6 +264,34 @@ pub struct SceneTextures {
     pub primitive_count: usize,
     pub light_count: usize,
     pub offset_floor: f32,
+    /// A small scene's primitives again, for the linear scan (see `bind`).
+    primitive_block: Option<UniformBlock>,
+    /// The scene's kind masks as `scene_masks` gives them.
+    masks: Vec<(&'static str, u32)>,
+}
+
+/// The masks of kinds a packed scene holds, as scene defines name them
+/// (glsl/common/scene.glsl): SCENE_KINDS (bit PRIM_* for each primitive
+/// kind), SCENE_MATERIALS (bit MAT_* for each kind of material on a
+/// shape), SCENE_LIGHTS (bit LIGHT_* for each light kind) and
+/// SCENE_SHADING_NORMALS (1 where a triangle has vertex normals); each kind
+/// read from the head texel the shaders read it from.
+fn scene_masks(scene: &Scene, p: &PackedScene) -> Vec<(&'static str, u32)> {
+    let kind =
+        |texels: &[[f32; 4]], stride: u32, i: usize| 1u32 << texels[i * stride as usize][0] as u32;
+    let primitives =
+        (0..scene.shapes.len()).fold(0, |m, i| m | kind(&p.primitives, PRIMITIVE_TEXELS, i));
+    let materials = scene.shapes.iter().fold(0, |m, s| {
+        m | kind(&p.materials, MATERIAL_TEXELS, s.material)
+    });
+    let lights = (0..scene.lights.len()).fold(0, |m, l| m | kind(&p.lights, LIGHT_TEXELS, l));
+    let normals = u32::from(scene.shapes.iter().any(|s| s.normals.is_some()));
+    vec![
+        ("SCENE_KINDS", primitives),
+        ("SCENE_MATERIALS", materials),
+        ("SCENE_LIGHTS", lights),
+        ("SCENE_SHADING_NORMALS", normals),
+    ]
 }
 
 fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture> {
@@ -303,14 +331,32 @@ impl SceneTextures {
 
     /// The textures with a hierarchy built already (tests pass their own).
     pub fn with_bvh(gpu: &Gpu, scene: &Scene, bvh: &FlatBvh) -> Result<Self> {
-        // Programs compiled from here on trace a small scene by a loop over
-        // its primitives (both ways find the same hits; the loop is faster).
-        gpu.set_scene_defines(if scene.shapes.len() <= crate::layout::LINEAR_SCAN_MAX {
-            vec![("SCENE_LINEAR_SCAN", "1".to_string())]
-        } else {
-            Vec::new()
-        });
         let p = PackedScene::new(scene);
+        let masks = scene_masks(scene, &p);
+        // A small scene is traced by a loop over its primitives (both ways
+        // find the same hits; the loop is faster), read from a uniform block.
+        let small = scene.shapes.len() <= crate::layout::LINEAR_SCAN_MAX;
+        let primitive_block = if small {
+            // The block's whole declared size (GL reads none past the buffer).
+            let mut texels = p.primitives.clone();
+            texels.resize(
+                crate::layout::LINEAR_SCAN_MAX * PRIMITIVE_TEXELS as usize,
+                [0.0; 4],
+            );
+            Some(UniformBlock::from_texels(gpu, &texels)?)
+        } else {
+            None
+        };
+        // Programs compiled from here on are specialised to this scene.
+        let mut defines: Vec<(&'static str, String)> = masks
+            .iter()
+            .map(|&(name, mask)| (name, mask.to_string()))
+            .collect();
+        if small {
+            defines.push(("SCENE_LINEAR_SCAN", "1".to_string()));
+            defines.push(("SCENE_PRIMITIVE_BLOCK", "1".to_string()));
+        }
+        gpu.set_scene_defines(defines);
         let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
         let order: Vec<i32> = bvh.order.iter().map(|&i| i as i32).collect();
         Ok(Self {
@@ -326,11 +372,34 @@ impl SceneTextures {
             primitive_count: p.primitive_count,
             light_count: p.light_count,
             offset_floor: p.offset_floor,
+            primitive_block,
+            masks,
         })
+    }
+
+    /// Whether a program compiled with these scene defines traces this
+    /// scene: its masks cover every kind of primitive, material and light
+    /// the scene holds (and its shading normals), and it reads primitives
+    /// from a uniform block only if this scene has one.
+    fn traced_by(&self, defines: &[(&'static str, String)]) -> bool {
+        let value = |name: &str| defines.iter().find(|(n, _)| *n == name).map(|(_, v)| v);
+        let covered = self.masks.iter().all(|&(name, mask)| {
+            value(name)
+                .map_or(Some(u32::MAX), |v| v.parse::<u32>().ok())
+                .is_some_and(|program| mask & !program == 0)
+        });
+        let block = value("SCENE_PRIMITIVE_BLOCK").is_some();
+        covered && (!block || self.primitive_block.is_some())
     }
 
     /// Binds the textures and counts that glsl/common/scene.glsl declares.
     pub fn bind(&self, b: &mut crate::gpu::Bindings<'_>) {
+        if !self.traced_by(b.scene_defines()) {
+            b.fail(Error::SceneMismatch(b.program_name().to_string()));
+        }
+        if let Some(block) = &self.primitive_block {
+            b.uniform_block(crate::layout::SCENE_BLOCK_BINDING, block);
+        }
         b.texture("u_primitives", &self.primitives)
             .texture("u_bvh_nodes", &self.bvh_nodes)
             .texture("u_bvh_order", &self.bvh_order)

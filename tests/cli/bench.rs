@@ -213,3 +213,85 @@ fn bench_mitsuba_refuses_bad_budgets_references_and_masks() {
         assert!(!out_dir.exists(), "{args:?} wrote {}", out_dir.display());
     }
 }
+
+/// `bench throughput` without Mitsuba: each SPPM stage with its records and
+/// copy-pass floor, and the direct-light render's rate; it refuses bad
+/// iteration counts and a Python without Mitsuba before it runs anything.
+#[test]
+fn bench_throughput_reports_each_stage_against_its_floor() {
+    let d = TempDir::new("throughput");
+    let v = Run::new([
+        "bench",
+        "throughput",
+        "--no-mitsuba",
+        "--scene",
+        "glass_ball",
+    ])
+    .args([
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--spp",
+        "2",
+        "--shadow-rays",
+        "2",
+    ])
+    .args([
+        "--iterations",
+        "1",
+        "3",
+        "--repeats",
+        "1",
+        "--json",
+        "--quiet",
+    ])
+    .writing("--out", &d)
+    .json();
+    let scene = &v["scenes"][0];
+    assert_eq!(scene["scene"], "glass_ball");
+    assert_eq!(scene["diffuse"], false);
+    let stages = scene["stages"].as_array().unwrap();
+    let stage = |name: &str| {
+        stages
+            .iter()
+            .find(|s| s["stage"].as_str().unwrap().starts_with(name))
+            .unwrap_or_else(|| panic!("no stage {name}: {stages:?}"))
+    };
+    let photons = v["sppm_photons_per_iteration"].as_u64().unwrap();
+    assert_eq!(stage("eye paths")["records"], 32 * 24);
+    assert_eq!(stage("trace photons")["records"], photons);
+    assert_eq!(stage("gather + update")["records"], 32 * 24);
+    for s in stages {
+        let (seconds, records) = (
+            s["seconds"].as_f64().unwrap(),
+            s["records"].as_f64().unwrap(),
+        );
+        let copy = s["copy_seconds"].as_f64().unwrap();
+        assert!(copy > 0.0, "{s}");
+        assert!((s["per_second"].as_f64().unwrap() * seconds - records).abs() <= 1e-6 * records);
+        assert!(
+            (s["copy_passes"].as_f64().unwrap() * copy - seconds).abs()
+                <= 1e-9 + 1e-6 * seconds.abs()
+        );
+    }
+    let direct = &scene["direct"];
+    let seconds = direct["seconds"].as_f64().unwrap();
+    assert!(seconds > 0.0);
+    let rate = direct["eye_paths_per_second"].as_f64().unwrap();
+    assert!((rate * seconds - (32 * 24 * 2) as f64).abs() < 1e-6 * rate * seconds);
+    assert!(direct["mitsuba_seconds"].is_null() && scene["mitsuba"].is_null());
+    assert!(d.join("throughput.json").is_file());
+
+    Run::new([
+        "bench",
+        "throughput",
+        "--no-mitsuba",
+        "--iterations",
+        "4",
+        "4",
+    ])
+    .refused_with("SHORT < LONG");
+    Run::new(["bench", "throughput", "--python", "/nonexistent/python3"])
+        .refused_with("/nonexistent/python3");
+}

@@ -428,3 +428,42 @@ fn a_closed_box_lit_from_inside_loses_no_photons() {
     );
     assert!(lost_open > 0, "the count cannot see a hole");
 }
+
+/// Shaders compiled after packing a scene leave out the tests of primitive
+/// kinds it lacks and read a small scene from a uniform block; such a
+/// program refuses a scene it cannot trace, and traces one it can.
+#[test]
+fn a_program_specialised_to_one_scene_refuses_another() {
+    use photonmap::error::Error;
+    use photonmap::gpu::{DrawState, Program, Target, TexFormat, Texture};
+    let gpu = common::gpu();
+    let mut rng = Rng(0x5eed_5ce7);
+    let triangles = diffuse_scene(soup(10, &mut rng, false));
+    let spheres = diffuse_scene(vec![Shape::new(
+        Geometry::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        },
+        0,
+    )]);
+    let packed_spheres = SceneTextures::new(&gpu, &spheres).unwrap();
+    let for_spheres = Program::fullscreen(&gpu, "test/intersect_twin.frag").unwrap();
+    let packed_triangles = SceneTextures::new(&gpu, &triangles).unwrap();
+    let out = Texture::new(&gpu, 4, 4, TexFormat::Rgba32F).unwrap();
+    let target = Target::new(&gpu, &[&out]).unwrap();
+    let draw = |textures: &SceneTextures| {
+        let mut b = for_spheres.bind();
+        textures.bind(&mut b);
+        b.texture("u_ray_origin", &out)
+            .texture("u_ray_direction", &out)
+            .texture("u_ray_normal", &out)
+            .int("u_primitive", 0)
+            .int("u_mode", 2)
+            .draw_fullscreen(&target, &DrawState::PLAIN)
+    };
+    match draw(&packed_triangles) {
+        Err(Error::SceneMismatch(program)) => assert!(program.contains("intersect_twin")),
+        other => panic!("a sphere-only program traced triangles: {other:?}"),
+    }
+    draw(&packed_spheres).expect("the program's own scene");
+}

@@ -19,6 +19,7 @@ pub mod reference;
 pub mod scene;
 pub mod stress;
 pub mod tables;
+pub mod throughput;
 
 use anyhow::Result;
 use clap::Subcommand;
@@ -27,8 +28,8 @@ use photonmap::gpu::Platform;
 
 /// `bench`'s line in `photonmap --help`.
 pub const ABOUT: &str = "Benchmarks with results to commit: stress, accuracy against a reference, \
-    meshes, IGI, differentials, against Mitsuba 3, the computation mask, builds and the \
-    estimate (`bench <name> --help`)";
+    meshes, IGI, differentials, against Mitsuba 3, the computation mask, builds, the \
+    estimate and each stage's throughput (`bench <name> --help`)";
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -64,6 +65,10 @@ pub enum BenchCommand {
     /// examined, cells opened, passes, lane use) for each variant of the
     /// search, each checked to give the paper search's image bit for bit.
     Estimate(estimate::EstimateBenchArgs),
+    /// Each stage's rate (eye paths, photon paths, photons built, gather
+    /// queries per second), its floor (a copy pass over as many texels) and
+    /// Mitsuba 3's direct-light and light-tracing rates on the same cores.
+    Throughput(throughput::ThroughputArgs),
 }
 
 pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
@@ -77,5 +82,6 @@ pub fn run(command: BenchCommand, platform: Platform) -> Result<()> {
         BenchCommand::Mitsuba(a) => mitsuba::run(&a, platform),
         BenchCommand::Estimate(a) => estimate::run(&a, platform),
         BenchCommand::Build(a) => build::run(&a, platform),
+        BenchCommand::Throughput(a) => throughput::run(&a, platform),
     }
 }

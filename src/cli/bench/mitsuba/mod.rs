@@ -41,6 +41,7 @@ use runner::Taken;
 use score::{Bench, Target};
 
 pub use args::{MitsubaBenchArgs, ProgressiveMethod};
+pub use runner::{check_variant, mitsuba_rates, MitsubaRates};
 
 /// Keeps SPPM's running image after the first iteration past each mark
 /// (seconds on the caller's clock, this observer's own time not counted).

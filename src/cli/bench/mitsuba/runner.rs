@@ -120,18 +120,23 @@ pub fn export(scene: &Scene, width: u32, height: u32, max_depth: i32) -> serde_j
 /// Fails, before any render, unless `--python` imports Mitsuba with the
 /// variant asked for.
 pub(super) fn check_mitsuba(a: &MitsubaBenchArgs) -> Result<()> {
-    let check = Command::new(&a.python)
+    check_variant(&a.python, &a.variant)
+}
+
+/// Fails unless `python` imports Mitsuba and sets `variant`.
+pub fn check_variant(python: &str, variant: &str) -> Result<()> {
+    let check = Command::new(python)
         .args([
             "-c",
-            &format!("import mitsuba; mitsuba.set_variant('{}')", a.variant),
+            &format!("import mitsuba; mitsuba.set_variant('{variant}')"),
         ])
         .output()
-        .with_context(|| format!("running {} (--python)", a.python))?;
+        .with_context(|| format!("running {python} (--python)"))?;
     if !check.status.success() {
         bail!(
             "{} cannot run Mitsuba's {} variant: {}\n{INSTALL}",
-            a.python,
-            a.variant,
+            python,
+            variant,
             String::from_utf8_lossy(&check.stderr)
                 .lines()
                 .last()
@@ -170,15 +175,7 @@ pub(super) fn render_mitsuba(
         .arg(format!("{seed}"))
         .output()
         .with_context(|| format!("running {}", a.python))?;
-    if !run.status.success() {
-        let err = String::from_utf8_lossy(&run.stderr);
-        let tail: Vec<&str> = err.lines().rev().take(6).collect();
-        bail!(
-            "Mitsuba failed ({}): {}\n{INSTALL}",
-            run.status,
-            tail.into_iter().rev().collect::<Vec<_>>().join("\n")
-        );
-    }
+    succeeded(&run)?;
     let report = report_line(&run.stdout)?;
     let taken = |r: &serde_json::Value, file: &Path| -> Result<Taken> {
         let image = Image::read_exr(file)?;
@@ -195,6 +192,20 @@ pub(super) fn render_mitsuba(
         along.push(taken(c, &file)?);
     }
     Ok((taken(&report, &exr)?, along))
+}
+
+/// Fails with the last lines of a script's stderr unless it succeeded.
+fn succeeded(run: &std::process::Output) -> Result<()> {
+    if !run.status.success() {
+        let err = String::from_utf8_lossy(&run.stderr);
+        let tail: Vec<&str> = err.lines().rev().take(6).collect();
+        bail!(
+            "Mitsuba failed ({}): {}\n{INSTALL}",
+            run.status,
+            tail.into_iter().rev().collect::<Vec<_>>().join("\n")
+        );
+    }
+    Ok(())
 }
 
 /// The script's report: its last line of stdout that is a JSON object.
@@ -230,4 +241,49 @@ pub(super) fn write_inputs(
 /// of what Mitsuba rendered.
 pub(super) fn remove_script(dir: &Path) {
     let _ = std::fs::remove_file(dir.join(SCRIPT_FILE));
+}
+
+/// The rate script, embedded; written beside `mitsuba_render.py`, whose
+/// scene it renders.
+const RATES_SCRIPT: &str = include_str!("throughput.py");
+
+/// Mitsuba 3's rates on a scene (`throughput.py`): wall seconds of its
+/// `direct` integrator, and light paths per second of `ptracer`.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct MitsubaRates {
+    /// The least of the timed `direct` renders, and the first (compiling) one.
+    pub direct_seconds: f64,
+    pub direct_first_seconds: f64,
+    /// Light paths of one `ptracer` render and the least of its times.
+    pub ptracer_paths: u64,
+    pub ptracer_seconds: f64,
+    pub ptracer_first_seconds: f64,
+}
+
+/// Runs `throughput.py` on `scene` at `size`: `direct` at `spp` with
+/// `emitter_samples`, and `ptracer` at `ptracer_spp`, each `repeats` times
+/// after one that compiles. `dir` holds the export, which stays.
+pub fn mitsuba_rates(
+    (python, variant): (&str, &str),
+    dir: &Path,
+    scene: &Scene,
+    size: (u32, u32),
+    (spp, emitter_samples, ptracer_spp, repeats): (u32, u32, u32, u32),
+) -> Result<MitsubaRates> {
+    write_inputs(dir, scene, size, -1)?;
+    let script = dir.join("throughput.py");
+    write_atomically(&script, RATES_SCRIPT.as_bytes())?;
+    let run = Command::new(python)
+        .arg(&script)
+        .arg(dir.join(EXPORT_FILE))
+        .args([spp, emitter_samples, ptracer_spp].map(|v| v.to_string()))
+        .arg(variant)
+        .arg(repeats.to_string())
+        .output()
+        .with_context(|| format!("running {python}"));
+    let _ = std::fs::remove_file(&script);
+    remove_script(dir);
+    let run = run?;
+    succeeded(&run)?;
+    Ok(serde_json::from_value(report_line(&run.stdout)?)?)
 }

@@ -1,0 +1,53 @@
+//! Uniform buffers: small read-only arrays that every fragment of a pass may
+//! read. llvmpipe loads an element once for all lanes where the index is the
+//! same in every lane (a loop over a scene's primitives), where a texel
+//! fetch always gathers lane by lane.
+
+use glow::HasContext;
+
+use super::{Error, Gpu, Result};
+
+/// A buffer of vec4s for a `layout(std140, binding = N) uniform` block.
+pub struct UniformBlock {
+    gpu: Gpu,
+    pub(crate) raw: glow::Buffer,
+}
+
+impl UniformBlock {
+    /// `texels` as the block's vec4 array (std140 lays vec4 arrays out
+    /// tightly); refused beyond the driver's GL_MAX_UNIFORM_BLOCK_SIZE.
+    pub fn from_texels(gpu: &Gpu, texels: &[[f32; 4]]) -> Result<Self> {
+        let gl = gpu.gl();
+        let bytes_needed = std::mem::size_of_val(texels);
+        // SAFETY: gpu module doc; a query of a limit.
+        let max = unsafe { gl.get_parameter_i32(glow::MAX_UNIFORM_BLOCK_SIZE) } as usize;
+        if bytes_needed > max {
+            return Err(Error::TooLarge(format!(
+                "a uniform block of {bytes_needed} bytes: this driver's hold at most {max}"
+            )));
+        }
+        // SAFETY: gpu module doc; the buffer is filled from `texels`' own
+        // bytes ([f32; 4] has no padding).
+        unsafe {
+            let raw = gl
+                .create_buffer()
+                .map_err(Error::creating("a uniform buffer"))?;
+            gl.bind_buffer(glow::UNIFORM_BUFFER, Some(raw));
+            let bytes = std::slice::from_raw_parts(texels.as_ptr().cast::<u8>(), bytes_needed);
+            gl.buffer_data_u8_slice(glow::UNIFORM_BUFFER, bytes, glow::STATIC_DRAW);
+            gl.bind_buffer(glow::UNIFORM_BUFFER, None);
+            gpu.check("creating a uniform buffer")?;
+            Ok(Self {
+                gpu: gpu.clone(),
+                raw,
+            })
+        }
+    }
+}
+
+impl Drop for UniformBlock {
+    fn drop(&mut self) {
+        // SAFETY: gpu module doc; the buffer is this value's own.
+        unsafe { self.gpu.gl().delete_buffer(self.raw) };
+    }
+}
