@@ -31,33 +31,40 @@ void main() {
     vec3 o = u_camera_position;
     vec3 d = eye_ray_direction(px, u_seed);
     vec3 throughput = vec3(1.0);
-    for (int depth = 0; depth < u_depths; ++depth) {
+    // The chain up to the first diffuse hit; its light is computed after the
+    // loop, once for every lane: inside it, llvmpipe would shade each depth
+    // at which some lane of a SIMD group stopped, with only those lanes.
+    bool diffuse = false;
+    int depth = 0, prim = -1, mat = -1;
+    vec3 p, n;
+    for (; depth < u_depths; ++depth) {
         vec4 hit;
-        int prim = closest_hit(o, d, hit);
+        prim = closest_hit(o, d, hit);
         if (prim < 0) return; // background radiance is zero
-        vec3 n;
-        vec3 p = surface_point(prim, o, d, hit, n);
-        int mat = primitive_material(prim);
+        p = surface_point(prim, o, d, hit, n);
+        mat = primitive_material(prim);
         int kind = material_kind(mat);
         if (kind == MAT_EMITTER) {
             o_radiance = vec4(throughput * emitter_seen(mat, n, d), 0.0);
             return;
         }
         if (kind == MAT_DIFFUSE) {
-            vec3 nf;
-            vec3 sum = direct_light(u_seed, px, depth, p, n, d, prim, mat, true, 0,
-                                      u_shadow_rays, u_shadow_rays, u_strata_x,
-                                      u_light_sampling != 0, nf);
-            o_radiance = vec4(throughput * (material_texel(mat, 1).rgb / PI) * sum, 0.0);
-            o_diffuse_position = vec4(p, 1.0);
-            o_diffuse_normal = vec4(nf, float(mat + 1));
-            o_diffuse_throughput = vec4(throughput, float(prim));
-            return;
+            diffuse = true;
+            break;
         }
-        if (kind != MAT_MIRROR && kind != MAT_GLASS) return;
+        if (!SCENE_HAS_SPECULAR || (kind != MAT_MIRROR && kind != MAT_GLASS)) return;
         vec3 next_origin, next;
         specular_step(u_seed, px, depth, p, n, d, prim, mat, kind, throughput, next_origin, next);
         o = next_origin;
         d = next;
     }
+    if (!diffuse) return;
+    vec3 nf;
+    vec3 sum = direct_light(u_seed, px, depth, p, n, d, prim, mat, true, 0,
+                            u_shadow_rays, u_shadow_rays, u_strata_x,
+                            u_light_sampling != 0, nf);
+    o_radiance = vec4(throughput * (material_texel(mat, 1).rgb / PI) * sum, 0.0);
+    o_diffuse_position = vec4(p, 1.0);
+    o_diffuse_normal = vec4(nf, float(mat + 1));
+    o_diffuse_throughput = vec4(throughput, float(prim));
 }

@@ -11,8 +11,10 @@
 // and where it meets a light, the light's radiance. Each is weighted by the
 // balance heuristic over every technique that could make its path
 // (vcm/mis.glsl). Light tracing, the one technique with no camera vertex,
-// is vcm/light_connect.frag's. u_mode chooses the techniques: VCM_MODE_*
-// (src/render/vcm/options.rs names them).
+// is vcm/light_connect.frag's. VCM_MODE chooses the techniques: one of
+// VCM_MODE_* (src/render/vcm/options.rs names them), compiled in, so that
+// the techniques a mode leaves out cost nothing (llvmpipe would run their
+// branches under an empty lane mask).
 #include "common/camera.glsl"
 #include "common/direct_light.glsl"
 #include "common/specular_step.glsl"
@@ -22,7 +24,6 @@
 #include "vcm/light_vertex.glsl"
 
 uniform uint u_seed;
-uniform int u_mode;
 uniform int u_max_segments;       // longest path, in segments
 uniform float u_radius2;          // merging radius squared
 uniform isampler2D u_map_pairs;   // sorted (key, record): a map photon's record
@@ -38,7 +39,7 @@ layout(location = 2) out vec4 o_light_sample;
 layout(location = 3) out vec4 o_connection;
 layout(location = 4) out vec4 o_merging;
 
-bool connections() { return u_mode == VCM_MODE_VCM || u_mode == VCM_MODE_BPT; }
+bool connections() { return VCM_MODE == VCM_MODE_VCM || VCM_MODE == VCM_MODE_BPT; }
 
 // One light picked by power, and a point on it: the radiance it sends
 // toward x, the direction and distance to it, the pdfs (pick x solid angle
@@ -54,12 +55,12 @@ bool sample_light(inout uint rng, vec3 x, out vec3 radiance, out vec3 wi, out fl
     float u1 = rng_next(rng), u2 = rng_next(rng);
     radiance = light_texel(l, 4).rgb;
     int kind = int(light_texel(l, 0).x);
-    delta = kind == LIGHT_POINT;
+    delta = SCENE_HAS_LIGHT(LIGHT_POINT) && kind == LIGHT_POINT;
     vec3 q, normal;
     float area = 1.0;
     if (delta) {
         q = light_texel(l, 1).xyz;
-    } else if (kind == LIGHT_TRIANGLES) {
+    } else if (SCENE_HAS_LIGHT(LIGHT_TRIANGLES) && kind == LIGHT_TRIANGLES) {
         int prim;
         q = sample_light_triangle(l, u1, u2, normal, prim);
         area = light_texel(l, 1).z;
@@ -120,7 +121,7 @@ vec3 merge(vec3 x, vec3 nf, vec3 a, float q, float q_light, float cos_in, vec3 c
                     int record = texelFetch(u_map_pairs, t, 0).y;
                     vec4 partials = texelFetch(u_lv_partials, texel_of_index(record, u_lv_width), 0);
                     if (int(partials.w) + segments > u_max_segments) continue;
-                    float w = u_mode == VCM_MODE_PPM ? 1.0
+                    float w = VCM_MODE == VCM_MODE_PPM ? 1.0
                             : mis_merge_weight(camera, partials.xyz, q * cos_light / PI, camera_rev_pdf_w);
                     sum += w * texelFetch(u_map_power, t, 0).rgb;
                 }
@@ -172,7 +173,7 @@ void main() {
     vec3 d = eye_ray_direction(px, u_seed);
     float cos_camera = -dot(d, u_camera_backward);
     float image_distance = u_image_size.y / (2.0 * u_tan_half_fov.y);
-    vec3 camera = u_mode == VCM_MODE_PT ? vec3(0.0)
+    vec3 camera = VCM_MODE == VCM_MODE_PT ? vec3(0.0)
                 : mis_camera_start(image_distance * image_distance / (cos_camera * cos_camera * cos_camera));
     vec3 throughput = vec3(1.0);
     // Per technique: lights hit, next-event estimation, connections, merging.
@@ -194,7 +195,7 @@ void main() {
             float w = 1.0;
             int l = primitive_light(prim);
             if (segments > 1) {
-                if (u_mode == VCM_MODE_LT || u_mode == VCM_MODE_PPM) {
+                if (VCM_MODE == VCM_MODE_LT || VCM_MODE == VCM_MODE_PPM) {
                     w = specular_path ? 1.0 : 0.0;
                 } else if (l >= 0) {
                     bool triangles = int(light_texel(l, 0).x) == LIGHT_TRIANGLES;
@@ -212,12 +213,12 @@ void main() {
         vec3 nf = dot(n, d) < 0.0 ? n : -n;
         uint rng = rng_init(u_seed, px, VCM_CAMERA_STREAM | uint(segments));
         if (kind == MAT_DIFFUSE) {
-            if (u_mode == VCM_MODE_LT) break; // light tracing sees diffuse surfaces itself
+            if (VCM_MODE == VCM_MODE_LT) break; // light tracing sees diffuse surfaces itself
             vec3 a = material_texel(mat, 1).rgb;
             float q_light = continuation(a);
             float q = camera_continuation(q_light);
             vec3 brdf = a / PI;
-            if (u_mode == VCM_MODE_PPM) {
+            if (VCM_MODE == VCM_MODE_PPM) {
                 if (u_merge != 0) merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);
                 break;
             }
@@ -231,7 +232,7 @@ void main() {
                     float cos_x = dot(nf, wi);
                     if (cos_x > 0.0 && !occluded(origin, wi, dist - 2.0 * offset_scale(p + wi * dist))) {
                         float bsdf_dir = delta ? 0.0 : q * cos_x / PI;
-                        float w = u_mode == VCM_MODE_PT ? 1.0 / (bsdf_dir / direct_pdf_w + 1.0)
+                        float w = VCM_MODE == VCM_MODE_PT ? 1.0 / (bsdf_dir / direct_pdf_w + 1.0)
                                 : mis_light_sample_weight(camera, direct_pdf_w, emission_pdf_w, cos_light,
                                                           cos_x, bsdf_dir, q_light * cos_in / PI);
                         light_sample += w * throughput * brdf * radiance * (cos_x / direct_pdf_w);
@@ -240,7 +241,7 @@ void main() {
             }
             if (connections() && u_light_vertices > 0)
                 connection += throughput * connect(rng, u_light_vertices, p, nf, a, q, q_light, cos_in, camera, segments);
-            if (u_mode == VCM_MODE_VCM && u_merge != 0)
+            if (VCM_MODE == VCM_MODE_VCM && u_merge != 0)
                 merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);
             // Continue by Russian roulette and a cosine-distributed direction.
             if (rng_next(rng) >= q) break;
@@ -248,7 +249,7 @@ void main() {
             vec3 next = sample_cosine(nf, u1, u2);
             float cos_out = dot(nf, next);
             if (cos_out <= 0.0) break;
-            camera = u_mode == VCM_MODE_PT ? vec3(1.0 / (q * cos_out / PI), 0.0, 0.0)
+            camera = VCM_MODE == VCM_MODE_PT ? vec3(1.0 / (q * cos_out / PI), 0.0, 0.0)
                    : mis_scatter(camera, cos_out, q * cos_out / PI, q_light * cos_in / PI);
             throughput *= a / q;
             specular_path = false;
@@ -256,7 +257,7 @@ void main() {
             d = next;
             continue;
         }
-        if (kind != MAT_MIRROR && kind != MAT_GLASS) break;
+        if (!SCENE_HAS_SPECULAR || (kind != MAT_MIRROR && kind != MAT_GLASS)) break;
         vec3 next_origin, next;
         specular_step(u_seed, px, segments, p, n, d, prim, mat, kind, throughput, next_origin, next);
         camera = mis_scatter_specular(camera, abs(dot(n, next)));

@@ -17,7 +17,6 @@
 
 uniform isampler2D u_map_pairs;   // the map's (slot, record), compacted
 uniform int u_sorted_width;
-uniform int u_mode;
 uniform int u_max_segments;
 
 layout(location = 0) out vec4 o_contribution; // rgb
@@ -51,7 +50,7 @@ void main() {
     float camera_pdf_w = image_distance * image_distance / (cos_camera * cos_camera * cos_camera);
     float camera_pdf_a = camera_pdf_w * cos_light / (dist * dist);
     float w = 1.0;
-    if (u_mode != VCM_MODE_LT) {
+    if (VCM_MODE != VCM_MODE_LT) {
         float rev = camera_continuation(continuation(v.albedo)) * abs(dot(v.n, v.incoming)) / PI;
         w = mis_camera_connection_weight(v.partials, camera_pdf_a, rev);
     }

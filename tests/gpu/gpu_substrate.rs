@@ -235,6 +235,11 @@ fn every_glsl_file_compiles() {
             "photon/emit.frag" | "photon/trace.frag" => {
                 vec![vec![], vec![("RANDOM_TEXTURE", "1".into())]]
             }
+            // The mode is compiled in: every mode.
+            "vcm/camera_path.frag" | "vcm/light_connect.frag" => ["PT", "LT", "PPM", "BPT", "VCM"]
+                .iter()
+                .map(|m| vec![("VCM_MODE", format!("VCM_MODE_{m}"))])
+                .collect(),
             _ => vec![vec![]],
         }
     };

@@ -117,6 +117,9 @@ impl Vcm {
         plan.jitter = true;
         plan.spp = 1;
         let textures = SceneTextures::new(gpu, &scene)?;
+        // The mode is compiled in: llvmpipe runs every branch, so the
+        // techniques the mode leaves out cost nothing only if absent.
+        let mode = [("VCM_MODE", vcm.mode.code().to_string())];
         let photons = PhotonTracer::with_config(
             gpu,
             TraceConfig {
@@ -166,8 +169,8 @@ impl Vcm {
             builder: CountingBuild::new(gpu)?,
             map: None,
             partials_program: Program::fullscreen(gpu, "vcm/light_partials.frag")?,
-            camera_program: Program::fullscreen(gpu, "vcm/camera_path.frag")?,
-            connect_program: Program::fullscreen(gpu, "vcm/light_connect.frag")?,
+            camera_program: Program::fullscreen_with(gpu, "vcm/camera_path.frag", &mode)?,
+            connect_program: Program::fullscreen_with(gpu, "vcm/light_connect.frag", &mode)?,
             splat_program: Program::new(gpu, "vcm/light_splat.vert", "vcm/light_splat.frag", &[])?,
             connected: None,
             camera_image,
@@ -329,7 +332,6 @@ impl Vcm {
             self.bind_light_vertices(&mut b);
             b.texture("u_map_pairs", &map.pairs)
                 .int("u_sorted_width", w as i32)
-                .int("u_mode", self.options.mode.code() as i32)
                 .int("u_max_segments", self.options.max_segments as i32)
                 .draw_fullscreen(target, &DrawState::PLAIN)?;
         }
@@ -391,7 +393,6 @@ impl Vcm {
             }
         }
         b.uint("u_seed", seed)
-            .int("u_mode", self.options.mode.code() as i32)
             .int("u_max_segments", self.options.max_segments as i32)
             .float("u_radius2", radius * radius)
             .int("u_connections", self.options.connections as i32)

@@ -27,7 +27,7 @@ pub enum VcmMode {
 }
 
 impl VcmMode {
-    /// Its code in `glsl/vcm/` (`u_mode`).
+    /// Its code in `glsl/vcm/` (`VCM_MODE`, compiled into the programs).
     pub fn code(self) -> u32 {
         match self {
             VcmMode::Pt => VCM_MODE_PT,
