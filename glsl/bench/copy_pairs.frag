@@ -1,6 +1,7 @@
 #version 450 core
-// The bandwidth baseline for a bitonic pass: read one (key, record) texel, write it.
-// A bitonic pass reads two texels and compares; this is what it cannot beat.
+// The floor under a pass (src/bench/copy.rs): read one integer texel, write it.
+// A bitonic pass reads two (key, record) texels and compares; a stage of
+// `bench throughput` reads a record or more: this is what neither can beat.
 uniform isampler2D u_pairs;
 layout(location = 0) out ivec4 o_pair;
 void main() {

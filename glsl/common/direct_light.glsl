@@ -6,34 +6,6 @@
 #include "common/scene.glsl"
 #include "common/random.glsl"
 
-// Where shadow sample s of area light l lands: the point q, the light's
-// unit normal there, and the light's area (its pdf is 1 / area). Strata are
-// (su, sv); a LIGHT_TRIANGLES light picks its triangle with su.
-// A parallelogram light's corner, edges and normal, read once per pixel,
-// not once per sample.
-struct AreaLight { bool triangles; vec3 a, e1, e2, normal; float area; };
-
-AreaLight area_light(int l) {
-    vec4 head = light_texel(l, 0);
-    AreaLight L;
-    L.triangles = SCENE_HAS_LIGHT(LIGHT_TRIANGLES) && int(head.x) == LIGHT_TRIANGLES;
-    L.a = light_texel(l, 1).xyz;
-    L.e1 = light_texel(l, 2).xyz;
-    L.e2 = light_texel(l, 3).xyz;
-    L.normal = head.yzw;
-    L.area = L.triangles ? light_texel(l, 1).z : length(cross(L.e1, L.e2));
-    return L;
-}
-
-vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal) {
-    if (L.triangles) {
-        int prim;
-        return sample_light_triangle(l, su, sv, light_normal, prim);
-    }
-    light_normal = L.normal;
-    return L.a + su * L.e1 + sv * L.e2;
-}
-
 // The radiance an emitter (material mat, geometric normal n) sends back
 // along d: one-sided, it leaves on the side of the light's normal only
 // (.w = 1: the primitive's own front face, its geometric normal).
@@ -65,8 +37,7 @@ vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int pr
     int strata_y = shadow_rays / strata_x;
 
     for (int l = 0; l < (light_sampling ? u_light_count : 0); ++l) {
-        vec4 head = light_texel(l, 0);
-        if (SCENE_HAS_LIGHT(LIGHT_POINT) && int(head.x) == LIGHT_POINT) {
+        if (light_kind_is(light_kind(l), LIGHT_POINT)) {
             if (!point_lights) continue;
             vec3 a = light_texel(l, 1).xyz;
             vec3 emitted = light_texel(l, 4).rgb;
@@ -79,7 +50,6 @@ vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int pr
                 sum += emitted * cos_s / (dist * dist);
             continue;
         }
-        if (!SCENE_HAS_LIGHT(LIGHT_AREA) && !SCENE_HAS_LIGHT(LIGHT_TRIANGLES)) continue;
         vec3 emitted = light_texel(l, 4).rgb;
         vec3 light_sum = vec3(0.0);
         AreaLight L = area_light(l);

@@ -78,8 +78,8 @@ SceneRay scene_ray(vec3 o, vec3 d) {
     r.d = d;
     for (int i = 0; i < 3; ++i)
         r.inv[i] = abs(d[i]) < 1e-30 ? (d[i] < 0.0 ? -1e30 : 1e30) : 1.0 / d[i];
-#ifdef SCENE_KINDS
-    if (((SCENE_KINDS >> PRIM_TRIANGLE) & 1) == 0) return r; // k and s serve triangles only
+#ifdef SCENE_HAS // compiled for a scene (common/scene.glsl): k and s serve triangles only
+    if (!SCENE_HAS(PRIM_TRIANGLE)) return r;
 #endif
     vec3 a = abs(d);
     int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);

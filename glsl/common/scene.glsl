@@ -2,20 +2,6 @@
 // shadow queries over it, through a bounding volume hierarchy (src/scene/bvh.rs;
 // the paper's ray tracer used a uniform grid, and its scenes are small enough
 // for a loop over every primitive, but meshes are not).
-#include "common/intersect.glsl"
-
-uniform sampler2D u_primitives;  // PRIMITIVE_TEXELS a primitive, PRIMITIVES_PER_ROW a row
-uniform isampler2D u_bvh_nodes;  // 2 texels a node, BVH_ROW_TEXELS a row
-uniform isampler2D u_bvh_order;  // leaf position -> primitive, BVH_ROW_TEXELS a row
-uniform sampler2D u_materials;   // MATERIAL_TEXELS a material
-uniform sampler2D u_lights;      // LIGHT_TEXELS a light
-uniform sampler2D u_normals;     // NORMAL_TEXELS a triangle with vertex normals, NORMALS_PER_ROW a row
-uniform sampler2D u_light_triangles; // a texel an emissive triangle (area cdf, primitive)
-uniform int u_primitive_count;
-uniform int u_light_count;
-
-// PRIM_*, MAT_*, LIGHT_* kind codes, the *_TEXELS row lengths and the BVH
-// sizes are #defines from src/layout.rs, injected into every program.
 
 // Scene defines (src/scene/pack.rs sets them for the scene last packed):
 // - SCENE_KINDS, SCENE_MATERIALS, SCENE_LIGHTS: bit PRIM_*, MAT_*, LIGHT_*
@@ -45,6 +31,21 @@ uniform int u_light_count;
 #define SCENE_HAS_LIGHT(kind) (((SCENE_LIGHTS >> kind) & 1) != 0)
 #define SCENE_HAS_SPECULAR (SCENE_HAS_MATERIAL(MAT_MIRROR) || SCENE_HAS_MATERIAL(MAT_GLASS))
 
+#include "common/intersect.glsl"
+
+uniform sampler2D u_primitives;  // PRIMITIVE_TEXELS a primitive, PRIMITIVES_PER_ROW a row
+uniform isampler2D u_bvh_nodes;  // 2 texels a node, BVH_ROW_TEXELS a row
+uniform isampler2D u_bvh_order;  // leaf position -> primitive, BVH_ROW_TEXELS a row
+uniform sampler2D u_materials;   // MATERIAL_TEXELS a material
+uniform sampler2D u_lights;      // LIGHT_TEXELS a light
+uniform sampler2D u_normals;     // NORMAL_TEXELS a triangle with vertex normals, NORMALS_PER_ROW a row
+uniform sampler2D u_light_triangles; // a texel an emissive triangle (area cdf, primitive)
+uniform int u_primitive_count;
+uniform int u_light_count;
+
+// PRIM_*, MAT_*, LIGHT_* kind codes, the *_TEXELS row lengths and the BVH
+// sizes are #defines from src/layout.rs, injected into every program.
+
 #ifdef SCENE_PRIMITIVE_BLOCK
 layout(std140, binding = SCENE_BLOCK_BINDING) uniform ScenePrimitives {
     vec4 scene_primitives[LINEAR_SCAN_MAX * PRIMITIVE_TEXELS];
@@ -69,16 +70,20 @@ int primitive_kind(int prim) {
     return int(primitive_texel(prim, 0).x);
 }
 
+// Whether a primitive of kind `kind` (primitive_kind) is a `k`: false at
+// compile time where the scene holds no `k`, so the code it guards is left out.
+bool primitive_kind_is(int kind, int k) { return SCENE_HAS(k) && kind == k; }
+
 vec4 intersect_primitive_ray(int prim, SceneRay r) {
     int kind = primitive_kind(prim);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (SCENE_HAS(PRIM_SPHERE) && kind == PRIM_SPHERE) return intersect_sphere(r.o, r.d, a.xyz, a.w);
-    if (SCENE_HAS(PRIM_CYLINDER) && kind == PRIM_CYLINDER)
+    if (primitive_kind_is(kind, PRIM_SPHERE)) return intersect_sphere(r.o, r.d, a.xyz, a.w);
+    if (primitive_kind_is(kind, PRIM_CYLINDER))
         return intersect_cylinder(r.o, r.d, a.xyz, b.xyz, a.w, b.w);
     vec4 c = primitive_texel(prim, 3);
-    if (SCENE_HAS(PRIM_TRIANGLE) && kind == PRIM_TRIANGLE) return intersect_triangle(r, a.xyz, b.xyz, c.xyz);
-    if (SCENE_HAS(PRIM_PARALLELOGRAM)) return intersect_parallelogram(r.o, r.d, a.xyz, b.xyz, c.xyz);
+    if (primitive_kind_is(kind, PRIM_TRIANGLE)) return intersect_triangle(r, a.xyz, b.xyz, c.xyz);
+    if (primitive_kind_is(kind, PRIM_PARALLELOGRAM)) return intersect_parallelogram(r.o, r.d, a.xyz, b.xyz, c.xyz);
     return NO_HIT;
 }
 
@@ -92,13 +97,13 @@ vec3 geometric_normal(int prim, vec3 p) {
     int kind = primitive_kind(prim);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (SCENE_HAS(PRIM_SPHERE) && kind == PRIM_SPHERE) return normalize(p - a.xyz);
-    if (SCENE_HAS(PRIM_CYLINDER) && kind == PRIM_CYLINDER) {
+    if (primitive_kind_is(kind, PRIM_SPHERE)) return normalize(p - a.xyz);
+    if (primitive_kind_is(kind, PRIM_CYLINDER)) {
         vec3 r = p - a.xyz;
         return normalize(r - dot(r, b.xyz) * b.xyz);
     }
     vec3 c = primitive_texel(prim, 3).xyz;
-    if (SCENE_HAS(PRIM_TRIANGLE) && kind == PRIM_TRIANGLE) return normalize(cross(b.xyz - a.xyz, c - a.xyz));
+    if (primitive_kind_is(kind, PRIM_TRIANGLE)) return normalize(cross(b.xyz - a.xyz, c - a.xyz));
     return normalize(cross(b.xyz, c));
 }
 
@@ -109,12 +114,12 @@ vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
     int kind = primitive_kind(prim);
     vec4 a = primitive_texel(prim, 1);
     vec4 b = primitive_texel(prim, 2);
-    if (SCENE_HAS(PRIM_SPHERE) && kind == PRIM_SPHERE) {
+    if (primitive_kind_is(kind, PRIM_SPHERE)) {
         vec3 p = o + hit.x * d;
         normal = normalize(p - a.xyz);
         return a.xyz + a.w * normal;
     }
-    if (SCENE_HAS(PRIM_CYLINDER) && kind == PRIM_CYLINDER) {
+    if (primitive_kind_is(kind, PRIM_CYLINDER)) {
         vec3 p = o + hit.x * d;
         vec3 on_axis = a.xyz + hit.y * b.xyz;
         vec3 r = p - on_axis;
@@ -122,7 +127,7 @@ vec3 surface_point(int prim, vec3 o, vec3 d, vec4 hit, out vec3 normal) {
         return on_axis + a.w * normal;
     }
     vec3 c = primitive_texel(prim, 3).xyz;
-    if (SCENE_HAS(PRIM_TRIANGLE) && kind == PRIM_TRIANGLE) {
+    if (primitive_kind_is(kind, PRIM_TRIANGLE)) {
         normal = normalize(cross(b.xyz - a.xyz, c - a.xyz));
         return (1.0 - hit.y - hit.z) * a.xyz + hit.y * b.xyz + hit.z * c;
     }
@@ -321,6 +326,18 @@ vec4 material_texel(int m, int i) { return texelFetch(u_materials, ivec2(i, m), 
 int material_kind(int m) { return int(material_texel(m, 0).x); }
 vec4 light_texel(int l, int i) { return texelFetch(u_lights, ivec2(i, l), 0); }
 
+// The light's LIGHT_* kind: a constant where the scene holds one kind of light.
+int light_kind(int l) {
+    if (SCENE_LIGHTS == (1 << LIGHT_AREA)) return LIGHT_AREA;
+    if (SCENE_LIGHTS == (1 << LIGHT_POINT)) return LIGHT_POINT;
+    if (SCENE_LIGHTS == (1 << LIGHT_TRIANGLES)) return LIGHT_TRIANGLES;
+    return int(light_texel(l, 0).x);
+}
+
+// Whether a light of kind `kind` (light_kind) is a `k`: false at compile
+// time where the scene has no light of kind `k`.
+bool light_kind_is(int kind, int k) { return SCENE_HAS_LIGHT(k) && kind == k; }
+
 vec4 light_triangle_texel(int i) {
     return texelFetch(u_light_triangles, ivec2(i % LIGHT_TRIANGLE_ROW_TEXELS, i / LIGHT_TRIANGLE_ROW_TEXELS), 0);
 }
@@ -350,4 +367,32 @@ vec3 sample_light_triangle(int l, float u1, float u2, out vec3 normal, out int p
     normal = normalize(cross(b - a, c - a));
     float s = sqrt(u);
     return (1.0 - s) * a + (u2 * s) * b + (s - u2 * s) * c;
+}
+
+// An area light (a parallelogram, or a LIGHT_TRIANGLES light's emissive
+// triangles): a parallelogram's corner, edges and normal, and the light's
+// area (its pdf over area is 1 / area), read once, not once per sample.
+struct AreaLight { bool triangles; vec3 a, e1, e2, normal; float area; };
+
+AreaLight area_light(int l) {
+    vec4 head = light_texel(l, 0);
+    AreaLight L;
+    L.triangles = light_kind_is(light_kind(l), LIGHT_TRIANGLES);
+    L.a = light_texel(l, 1).xyz;
+    L.e1 = light_texel(l, 2).xyz;
+    L.e2 = light_texel(l, 3).xyz;
+    L.normal = head.yzw;
+    L.area = L.triangles ? light_texel(l, 1).z : length(cross(L.e1, L.e2));
+    return L;
+}
+
+// A point of area light l from two uniforms (su, sv), and the light's unit
+// normal there; a LIGHT_TRIANGLES light picks its triangle with su.
+vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal) {
+    if (L.triangles) {
+        int prim;
+        return sample_light_triangle(l, su, sv, light_normal, prim);
+    }
+    light_normal = L.normal;
+    return L.a + su * L.e1 + sv * L.e2;
 }

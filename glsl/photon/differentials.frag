@@ -57,10 +57,10 @@ void write_state(vec3 dp[2], vec3 dd[2], float diffuse) {
 // primitive it left, or the triangle light holding that primitive.
 int emitting_light(vec3 p, int prim) {
     for (int l = 0; l < u_light_count; ++l) {
-        int kind = int(light_texel(l, 0).x);
-        if (kind == LIGHT_POINT) {
+        int kind = light_kind(l);
+        if (light_kind_is(kind, LIGHT_POINT)) {
             if (prim < 0 && all(equal(light_texel(l, 1).xyz, p))) return l;
-        } else if (kind == LIGHT_AREA) {
+        } else if (light_kind_is(kind, LIGHT_AREA)) {
             if (prim >= 0 && int(light_texel(l, 5).z) == prim) return l;
         } else {
             vec4 range = light_texel(l, 1);

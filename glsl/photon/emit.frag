@@ -49,6 +49,7 @@ void main() {
 #endif
     vec4 choice = light_texel(l, 5); // (cdf, probability, primitive, 0)
     vec4 head = light_texel(l, 0);
+    int kind = light_kind(l);
     vec3 a = light_texel(l, 1).xyz;
     vec3 emitted = light_texel(l, 4).rgb;
     float u1 = photon_random_next(rng), u2 = photon_random_next(rng);
@@ -62,7 +63,7 @@ void main() {
         float row = floor(cell / n);
         float column = cell - row * n;
         // The direction's uniforms, moved into the kept cell.
-        if (int(head.x) == LIGHT_POINT) {
+        if (light_kind_is(kind, LIGHT_POINT)) {
             u1 = (column + u1) / n;
             u2 = (row + u2) / n;
         } else {
@@ -74,11 +75,11 @@ void main() {
 #endif
     vec3 p, d, power;
     float leaving = choice.z; // the primitive the photon leaves (-1: none)
-    if (SCENE_HAS_LIGHT(LIGHT_POINT) && int(head.x) == LIGHT_POINT) {
+    if (light_kind_is(kind, LIGHT_POINT)) {
         p = a;
         d = sample_sphere(u1, u2);
         power = 4.0 * PI * emitted;
-    } else if (SCENE_HAS_LIGHT(LIGHT_TRIANGLES) && int(head.x) == LIGHT_TRIANGLES) {
+    } else if (light_kind_is(kind, LIGHT_TRIANGLES)) {
         vec3 normal;
         int prim;
         p = sample_light_triangle(l, u1, u2, normal, prim);

@@ -54,21 +54,15 @@ bool sample_light(inout uint rng, vec3 x, out vec3 radiance, out vec3 wi, out fl
     float p = light_texel(l, 5).y;
     float u1 = rng_next(rng), u2 = rng_next(rng);
     radiance = light_texel(l, 4).rgb;
-    int kind = int(light_texel(l, 0).x);
-    delta = SCENE_HAS_LIGHT(LIGHT_POINT) && kind == LIGHT_POINT;
+    delta = light_kind_is(light_kind(l), LIGHT_POINT);
     vec3 q, normal;
     float area = 1.0;
     if (delta) {
         q = light_texel(l, 1).xyz;
-    } else if (SCENE_HAS_LIGHT(LIGHT_TRIANGLES) && kind == LIGHT_TRIANGLES) {
-        int prim;
-        q = sample_light_triangle(l, u1, u2, normal, prim);
-        area = light_texel(l, 1).z;
     } else {
-        vec3 e1 = light_texel(l, 2).xyz, e2 = light_texel(l, 3).xyz;
-        q = light_texel(l, 1).xyz + u1 * e1 + u2 * e2;
-        normal = light_texel(l, 0).yzw;
-        area = length(cross(e1, e2));
+        AreaLight L = area_light(l);
+        q = area_light_point(l, L, u1, u2, normal);
+        area = L.area;
     }
     vec3 to = q - x;
     dist = length(to);
@@ -198,11 +192,9 @@ void main() {
                 if (VCM_MODE == VCM_MODE_LT || VCM_MODE == VCM_MODE_PPM) {
                     w = specular_path ? 1.0 : 0.0;
                 } else if (l >= 0) {
-                    bool triangles = int(light_texel(l, 0).x) == LIGHT_TRIANGLES;
-                    float area = triangles ? light_texel(l, 1).z
-                               : length(cross(light_texel(l, 2).xyz, light_texel(l, 3).xyz));
-                    float direct_pdf_a = light_texel(l, 5).y / area;
-                    vec3 ln = triangles ? n : light_texel(l, 0).yzw;
+                    AreaLight L = area_light(l);
+                    float direct_pdf_a = light_texel(l, 5).y / L.area;
+                    vec3 ln = L.triangles ? n : L.normal;
                     float emission_pdf_w = direct_pdf_a * max(-dot(ln, d), 0.0) / PI;
                     w = mis_emission_weight(camera, direct_pdf_a, emission_pdf_w);
                 }

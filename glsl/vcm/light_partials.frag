@@ -26,7 +26,7 @@ layout(location = 0) out vec4 o_unused;
 int emitting_light(vec3 p, int prim) {
     if (prim >= 0) return primitive_light(prim);
     for (int l = 0; l < u_light_count; ++l)
-        if (int(light_texel(l, 0).x) == LIGHT_POINT && light_texel(l, 1).xyz == p) return l;
+        if (light_kind_is(light_kind(l), LIGHT_POINT) && light_texel(l, 1).xyz == p) return l;
     return -1;
 }
 
@@ -39,17 +39,15 @@ void main() {
     int l = emitting_light(p0.xyz, int(out0.w));
     if (l < 0) return;
     float pick = light_texel(l, 5).y;
-    bool delta = int(light_texel(l, 0).x) == LIGHT_POINT;
+    bool delta = light_kind_is(light_kind(l), LIGHT_POINT);
     vec3 partials;
     if (delta) {
         partials = mis_light_start(pick, pick / (4.0 * PI), 1.0, true);
     } else {
-        bool triangles = int(light_texel(l, 0).x) == LIGHT_TRIANGLES;
-        vec3 n = triangles ? geometric_normal(int(out0.w), p0.xyz) : light_texel(l, 0).yzw;
-        float area = triangles ? light_texel(l, 1).z
-                               : length(cross(light_texel(l, 2).xyz, light_texel(l, 3).xyz));
+        AreaLight L = area_light(l);
+        vec3 n = L.triangles ? geometric_normal(int(out0.w), p0.xyz) : L.normal;
         float cos_light = abs(dot(n, out0.xyz));
-        float direct_pdf_a = pick / area;
+        float direct_pdf_a = pick / L.area;
         partials = mis_light_start(direct_pdf_a, direct_pdf_a * cos_light / PI, cos_light, false);
     }
     vec3 last = p0.xyz;

@@ -5,7 +5,8 @@
 
 use glam::Vec3;
 
-use crate::gpu::{DrawState, Gpu, Program, Query, Result, Target, TexFormat, Texture};
+use super::copy::CopyPasses;
+use crate::gpu::{Gpu, Query, Result, TexFormat};
 use crate::photon::bitonic::BitonicBuild;
 use crate::photon::compaction::sort_texture_size;
 use crate::photon::{CountingBuild, Grid, GridStorage, PhotonFrames, StencilRouting, VertexFeed};
@@ -98,25 +99,13 @@ pub fn bench_size(gpu: &Gpu, n: u64, grid: &Grid, block: u32) -> Result<BuildBen
     // Copy passes over the same RGBA32I texture, ping-ponged like the sort (each
     // reads what the last wrote), as many as the sort has passes.
     let (w, h) = sort_texture_size(n);
-    let textures = [
-        Texture::new(gpu, w, h, TexFormat::Rg32I)?,
-        Texture::new(gpu, w, h, TexFormat::Rg32I)?,
-    ];
-    let targets = [
-        Target::new(gpu, &[&textures[0]])?,
-        Target::new(gpu, &[&textures[1]])?,
-    ];
-    let copy = Program::fullscreen(gpu, "bench/copy_pairs.frag")?;
+    let copy = CopyPasses::new(gpu, w, h, TexFormat::Rg32I)?;
     let copies = sort.passes.max(1);
     let q = Query::timer(gpu)?;
     gpu.finish();
     let wall = std::time::Instant::now();
     q.begin();
-    for i in 0..copies {
-        copy.bind()
-            .texture("u_pairs", &textures[i % 2])
-            .draw_fullscreen(&targets[1 - i % 2], &DrawState::PLAIN)?;
-    }
+    copy.run(copies)?;
     q.end();
     gpu.finish();
     let copy_wall = wall.elapsed().as_secs_f64() / copies as f64;

@@ -4,6 +4,7 @@
 //! src/cli/bench/). Nothing below this module uses it.
 
 pub mod build;
+pub mod copy;
 pub mod mask;
 pub mod ray_rates;
 pub mod regions;

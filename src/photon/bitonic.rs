@@ -311,13 +311,12 @@ impl BitonicBuild {
         clock.stop(timings, "binary search", 1);
 
         let clock = StageClock::start(&self.gpu, &query);
-        let table = (grid_first, grid_width);
         let map = gather_records(
             &self.gpu,
             &self.gather,
             frames,
             (sorted, stored),
-            table,
+            (grid_first, grid_width),
             grid,
         )?;
         clock.stop(timings, "gather", 1);

@@ -106,13 +106,12 @@ impl CountingBuild {
         clock.stop(timings, "place", 1);
 
         let clock = StageClock::start(&self.gpu, &query);
-        let table = (grid_first, grid_width);
         let map = gather_records(
             &self.gpu,
             &self.gather,
             frames,
             (sorted, Some(count)),
-            table,
+            (grid_first, grid_width),
             grid,
         )?;
         clock.stop(timings, "gather", 1);

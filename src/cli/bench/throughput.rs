@@ -81,7 +81,7 @@ pub struct StageRow {
     pub unit: &'static str,
     pub seconds: f64,
     pub per_second: f64,
-    /// One copy pass over `records` RGBA32F texels, and the stage in such passes.
+    /// One copy pass over `records` 16-byte texels, and the stage in such passes.
     pub copy_seconds: f64,
     pub copy_passes: f64,
 }
@@ -156,8 +156,7 @@ pub fn run(a: &ThroughputArgs, platform: Platform) -> Result<()> {
         progress(&format!(
             "{name}: SPPM stages ({short} and {long} iterations)"
         ));
-        let mut row = measure(&gpu, scene, a, &sppm, (short, long))?;
-        row.scene = name.clone();
+        let mut row = measure(&gpu, (name, scene), a, &sppm, (short, long))?;
         if !a.no_mitsuba {
             progress(&format!("{name}: Mitsuba direct and ptracer"));
             let dir = out.join(stem(std::path::Path::new(name)));
@@ -205,7 +204,7 @@ pub fn run(a: &ThroughputArgs, platform: Platform) -> Result<()> {
 /// photonmap's side for one scene.
 fn measure(
     gpu: &Gpu,
-    scene: &Scene,
+    (name, scene): (&str, &Scene),
     a: &ThroughputArgs,
     sppm: &SppmOptions,
     iterations: (u32, u32),
@@ -259,7 +258,7 @@ fn measure(
     let paths = pixels * u64::from(a.spp);
     let path_copy = copy_pass_seconds(gpu, paths, a.repeats)?;
     Ok(SceneThroughput {
-        scene: String::new(),
+        scene: name.to_string(),
         diffuse: scene
             .materials
             .iter()
