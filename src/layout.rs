@@ -10,10 +10,17 @@ pub const MATERIAL_TEXELS: u32 = 3;
 pub const PRIMITIVES_PER_ROW: u32 = 1024;
 /// Width of the BVH textures (nodes: 2 texels each; leaf order: 1 each).
 pub const BVH_ROW_TEXELS: u32 = 4096;
-/// Entries of the BVH traversal stack in glsl/common/scene.glsl; a deeper tree is
-/// refused. obvhs trees of 1M triangles reach depth 65; the stack's size costs
-/// nothing measurable on llvmpipe (64 and 128 time the same).
+/// Entries of the ordered BVH walk's stack in glsl/common/scene.glsl; a deeper
+/// tree is refused. obvhs trees of 1M triangles reach depth 65; the stack's
+/// size costs nothing measurable on llvmpipe (64 and 128 time the same).
 pub const BVH_STACK: usize = 128;
+/// A BVH leaf's texel packs its first position and primitive count as
+/// -(first x LEAF_COUNT_SPAN + count): above any leaf's count.
+pub const LEAF_COUNT_SPAN: i32 = 8;
+/// A hierarchy whose nodes, leaf order and primitives fit this many bytes
+/// (or the driver's GL_MAX_UNIFORM_BLOCK_SIZE, if less) is read from a
+/// uniform block by the threaded walk (SCENE_BVH_BLOCK).
+pub const BVH_BLOCK_BYTES: usize = 65536;
 /// Scenes of at most this many primitives are traced by a loop over every
 /// primitive (SCENE_LINEAR_SCAN in glsl/common/scene.glsl) instead of the
 /// BVH. Measured on llvmpipe (SPPM's eye paths, eye rays of `bench meshes`):
@@ -169,6 +176,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("PRIMITIVES_PER_ROW", u(PRIMITIVES_PER_ROW)),
         ("BVH_ROW_TEXELS", u(BVH_ROW_TEXELS)),
         ("BVH_STACK", BVH_STACK.to_string()),
+        ("LEAF_COUNT_SPAN", LEAF_COUNT_SPAN.to_string()),
         ("LINEAR_SCAN_MAX", LINEAR_SCAN_MAX.to_string()),
         ("SCENE_BLOCK_BINDING", u(SCENE_BLOCK_BINDING)),
         ("BOX_ROBUST", format!("{BOX_ROBUST:?}")),

@@ -14,6 +14,11 @@
 //   well. In the linear scan every lane reads the same primitive, which
 //   llvmpipe loads once from a uniform block but gathers lane by lane from a
 //   texture.
+// - SCENE_BVH_BLOCK (its size in texels), BVH_BLOCK_ORDER_AT,
+//   BVH_BLOCK_PRIMITIVES_AT: a mid-size scene's hierarchy, leaf order and
+//   primitives in one uniform block as well, where the threaded walk reads
+//   them. Lanes then read different texels, but a uniform block's gather
+//   is a plain load a lane, cheaper than a texel fetch's.
 #ifndef SCENE_KINDS
 #define SCENE_KINDS 15
 #endif
@@ -52,9 +57,17 @@ layout(std140, binding = SCENE_BLOCK_BINDING) uniform ScenePrimitives {
 };
 #endif
 
+#ifdef SCENE_BVH_BLOCK
+layout(std140, binding = SCENE_BLOCK_BINDING) uniform SceneHierarchy {
+    ivec4 scene_hierarchy[SCENE_BVH_BLOCK];
+};
+#endif
+
 vec4 primitive_texel(int prim, int i) {
 #ifdef SCENE_PRIMITIVE_BLOCK
     return scene_primitives[prim * PRIMITIVE_TEXELS + i];
+#elif defined(SCENE_BVH_BLOCK)
+    return intBitsToFloat(scene_hierarchy[BVH_BLOCK_PRIMITIVES_AT + prim * PRIMITIVE_TEXELS + i]);
 #else
     ivec2 at = ivec2((prim % PRIMITIVES_PER_ROW) * PRIMITIVE_TEXELS + i, prim / PRIMITIVES_PER_ROW);
     return texelFetch(u_primitives, at, 0);
@@ -188,17 +201,31 @@ vec3 offset_origin(vec3 p, vec3 n, vec3 dir) {
     return p + (dot(dir, n) >= 0.0 ? s : -s) * n;
 }
 
-// ---- BVH traversal: an ordered stack (near child first; the far one pushed
-// with its entry distance, and dropped unread once a closer hit is known);
-// with SCENE_LINEAR_SCAN, a loop over every primitive.
+// ---- BVH traversal over the threaded layout of src/scene/bvh.rs (nodes in
+// depth-first order, each with its miss link). Three walks, by where the
+// scene lives:
+// - SCENE_LINEAR_SCAN (a small scene): a loop over every primitive;
+// - SCENE_BVH_BLOCK (a hierarchy that fits a uniform block): the threaded
+//   walk, no stack: a node whose box the ray enters leads to the next node
+//   (an inner node's first child; a leaf's primitives are tested, then its
+//   miss link), a missed one to its miss link;
+// - otherwise (textures): the ordered walk with a stack, near child first.
 
 ivec4 bvh_node_texel(int node, int which) {
     int i = 2 * node + which;
+#ifdef SCENE_BVH_BLOCK
+    return scene_hierarchy[i];
+#else
     return texelFetch(u_bvh_nodes, ivec2(i % BVH_ROW_TEXELS, i / BVH_ROW_TEXELS), 0);
+#endif
 }
 
 int bvh_leaf_primitive(int position) {
+#ifdef SCENE_BVH_BLOCK
+    return scene_hierarchy[BVH_BLOCK_ORDER_AT + position / 4][position % 4];
+#else
     return texelFetch(u_bvh_order, ivec2(position % BVH_ROW_TEXELS, position / BVH_ROW_TEXELS), 0).x;
+#endif
 }
 
 // BOX_ROBUST (src/layout.rs) widens the far distance of the slab test.
@@ -237,66 +264,87 @@ vec4 leaf_hit(int prim, SceneRay r) { return intersect_primitive_ray(prim, r); }
 // The closest primitive hit before best.x (set by the caller), or -1; with
 // any_hit, the first found. best becomes its record. (With PRIMITIVE_BOXES a
 // "hit" is a box passed through, at its exit distance: for occlusion only.)
+// Tests a leaf's primitives (its texel's w: -(first x LEAF_COUNT_SPAN +
+// count)) against the ray, keeping the closest hit before best.x.
+void bvh_leaf(int leaf, SceneRay r, inout vec4 best, inout int hit) {
+    int first = (-leaf) / LEAF_COUNT_SPAN;
+    int end = first + (-leaf) % LEAF_COUNT_SPAN;
+    for (int i = first; i < end; ++i) {
+        int prim = bvh_leaf_primitive(i);
+        vec4 h = leaf_hit(prim, r);
+        if (h.w > 0.0 && h.x < best.x) {
+            best = h;
+            hit = prim;
+        }
+    }
+}
+
 int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
     if (u_primitive_count == 0) return -1;
-#ifdef SCENE_LINEAR_SCAN
+    int hit = -1;
+#if defined(SCENE_LINEAR_SCAN)
     // A small scene (LINEAR_SCAN_MAX, src/layout.rs): every primitive in
     // turn, no stack, no boxes.
-    int found = -1;
     for (int prim = 0; prim < u_primitive_count; ++prim) {
         vec4 h = leaf_hit(prim, r);
         if (h.w > 0.0 && h.x < best.x) {
             best = h;
-            found = prim;
-            if (any_hit) return found;
+            hit = prim;
+            if (any_hit) return hit;
         }
     }
-    return found;
+#elif defined(SCENE_BVH_BLOCK)
+    // The threaded walk: the next node, or the miss link; no stack.
+    int node = 0;
+    while (node >= 0) {
+        ivec4 lo = bvh_node_texel(node, 0), hi = bvh_node_texel(node, 1);
+        bool enter = box_entry(lo, hi, r, best.x) < BOX_MISS;
+        if (enter && lo.w < 0) {
+            bvh_leaf(lo.w, r, best, hit);
+            if (any_hit && hit >= 0) return hit;
+        }
+        node = enter && lo.w == 0 ? node + 1 : hi.w;
+    }
 #else
+    // The ordered walk: an inner node's children are the next node and that
+    // one's miss link; the nearer is entered first, the farther pushed with
+    // its entry distance and dropped unread once a closer hit is known.
+    // A node is (index, its leaf word).
     ivec4 lo = bvh_node_texel(0, 0), hi = bvh_node_texel(0, 1);
     if (box_entry(lo, hi, r, best.x) == BOX_MISS) return -1;
-    int hit = -1;
-    int a = lo.w, b = hi.w; // inner: children a, b; leaf: -b primitives from a
+    ivec2 node = ivec2(0, lo.w);
     ivec2 stack_node[BVH_STACK];
     float stack_entry[BVH_STACK];
     int depth = 0;
     for (;;) {
-        if (b < 0) {
-            for (int i = a; i < a - b; ++i) {
-                int prim = bvh_leaf_primitive(i);
-                vec4 h = leaf_hit(prim, r);
-                if (h.w > 0.0 && h.x < best.x) {
-                    best = h;
-                    hit = prim;
-                }
-            }
+        if (node.y < 0) {
+            bvh_leaf(node.y, r, best, hit);
             if (any_hit && hit >= 0) return hit;
         } else {
+            int a = node.x + 1;
             ivec4 l0 = bvh_node_texel(a, 0), l1 = bvh_node_texel(a, 1);
+            int b = l1.w;
             ivec4 r0 = bvh_node_texel(b, 0), r1 = bvh_node_texel(b, 1);
             float tl = box_entry(l0, l1, r, best.x);
             float tr = box_entry(r0, r1, r, best.x);
             if (min(tl, tr) < BOX_MISS) {
                 bool right_first = tr < tl;
                 if (max(tl, tr) < BOX_MISS) {
-                    stack_node[depth] = right_first ? ivec2(l0.w, l1.w) : ivec2(r0.w, r1.w);
+                    stack_node[depth] = right_first ? ivec2(a, l0.w) : ivec2(b, r0.w);
                     stack_entry[depth] = max(tl, tr);
                     ++depth; // at most the tree's depth - 1 (checked on the host)
                 }
-                ivec2 near = right_first ? ivec2(r0.w, r1.w) : ivec2(l0.w, l1.w);
-                a = near.x;
-                b = near.y;
+                node = right_first ? ivec2(b, r0.w) : ivec2(a, l0.w);
                 continue;
             }
         }
         while (depth > 0 && stack_entry[depth - 1] >= best.x) --depth;
         if (depth == 0) break;
         --depth;
-        a = stack_node[depth].x;
-        b = stack_node[depth].y;
+        node = stack_node[depth];
     }
-    return hit;
 #endif
+    return hit;
 }
 
 // Closest hit along a unit direction: returns the primitive or -1, with its record.

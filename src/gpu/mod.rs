@@ -172,6 +172,12 @@ impl Gpu {
         self.inner.max_texture_size
     }
 
+    /// GL_MAX_UNIFORM_BLOCK_SIZE, in bytes.
+    pub fn max_uniform_block_bytes(&self) -> usize {
+        // SAFETY: module doc; a query of a limit.
+        unsafe { self.gl().get_parameter_i32(glow::MAX_UNIFORM_BLOCK_SIZE) }.max(0) as usize
+    }
+
     /// Checks glGetError; a non-zero code means a bug in this program, named by `what`.
     pub fn check(&self, what: &str) -> Result<()> {
         // SAFETY: module doc.

@@ -17,8 +17,13 @@ impl UniformBlock {
     /// `texels` as the block's vec4 array (std140 lays vec4 arrays out
     /// tightly); refused beyond the driver's GL_MAX_UNIFORM_BLOCK_SIZE.
     pub fn from_texels(gpu: &Gpu, texels: &[[f32; 4]]) -> Result<Self> {
+        Self::from_words(gpu, texels.iter().flatten().map(|v| v.to_bits()).collect())
+    }
+
+    /// 32-bit words (floats as their bits, or ints) as the block's contents.
+    pub fn from_words(gpu: &Gpu, words: Vec<u32>) -> Result<Self> {
         let gl = gpu.gl();
-        let bytes_needed = std::mem::size_of_val(texels);
+        let bytes_needed = std::mem::size_of_val(&words[..]);
         // SAFETY: gpu module doc; a query of a limit.
         let max = unsafe { gl.get_parameter_i32(glow::MAX_UNIFORM_BLOCK_SIZE) } as usize;
         if bytes_needed > max {
@@ -26,15 +31,15 @@ impl UniformBlock {
                 "a uniform block of {bytes_needed} bytes: this driver's hold at most {max}"
             )));
         }
-        // SAFETY: gpu module doc; the buffer is filled from `texels`' own
-        // bytes ([f32; 4] has no padding).
+        // SAFETY: gpu module doc; the buffer is filled from a byte copy of
+        // `words`.
         unsafe {
             let raw = gl
                 .create_buffer()
                 .map_err(Error::creating("a uniform buffer"))?;
             gl.bind_buffer(glow::UNIFORM_BUFFER, Some(raw));
-            let bytes = std::slice::from_raw_parts(texels.as_ptr().cast::<u8>(), bytes_needed);
-            gl.buffer_data_u8_slice(glow::UNIFORM_BUFFER, bytes, glow::STATIC_DRAW);
+            let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_ne_bytes()).collect();
+            gl.buffer_data_u8_slice(glow::UNIFORM_BUFFER, &bytes, glow::STATIC_DRAW);
             gl.bind_buffer(glow::UNIFORM_BUFFER, None);
             gpu.check("creating a uniform buffer")?;
             Ok(Self {

@@ -2,25 +2,30 @@
 //! cylinders, parallelograms and triangles alike, so every scene takes one
 //! path), built on the CPU by the obvhs crate (PLOC, SAH reinsertion and leaf
 //! collapse: `medium_build`, at most 4 primitives a leaf) and flattened for
-//! the GPU: two integer texels a node, `(min bits, a)` and `(max bits, b)`. An
-//! inner node's children are nodes `a` and `b`; a leaf holds `-b` primitives
-//! from position `a` of `order`, which maps leaf order to primitive indices.
-//! glsl/common/scene.glsl traverses it with an ordered stack of BVH_STACK
-//! entries (near child first, the far one pushed with its entry distance), so
-//! the tree must not be deeper; src/reference/bvh.rs is the twin.
+//! the GPU, threaded (Smits 1998): the nodes in depth-first order, each with
+//! its miss link, the node that follows its subtree. A ray that enters a
+//! node's box goes on to the next node (an inner node's first child; a leaf
+//! tests its primitives and goes to its miss link); one that misses it goes
+//! to its miss link; -1 ends the walk. That walk needs no stack; the ordered
+//! walk finds an inner node's children at the next node and at that one's
+//! miss link, and enters the nearer first with a stack of BVH_STACK entries,
+//! so the tree must not be deeper. glsl/common/scene.glsl walks it either
+//! way (by where the hierarchy lives); src/twins/bvh.rs holds both walks.
 
 use glam::{Vec3, Vec3A};
 
 use super::{Geometry, Scene};
 use crate::error::{Error, Result};
+use crate::layout::LEAF_COUNT_SPAN;
 
 /// Leaves hold at most this many primitives (4 and 8 cost the same on llvmpipe; 1 is 30% slower).
 pub const MAX_LEAF_PRIMITIVES: u32 = 4;
+const _: () = assert!(MAX_LEAF_PRIMITIVES < LEAF_COUNT_SPAN as u32);
 
 /// The flattened hierarchy.
 #[derive(Clone, Debug, Default)]
 pub struct FlatBvh {
-    /// Per node: min.xyz and max.xyz as f32 bits, then a and b (see the module doc).
+    /// The nodes in depth-first order (see the module doc).
     pub nodes: Vec<FlatNode>,
     /// Leaf order -> primitive index.
     pub order: Vec<u32>,
@@ -32,29 +37,38 @@ pub struct FlatBvh {
 pub struct FlatNode {
     pub min: Vec3,
     pub max: Vec3,
-    /// Inner: the first child; leaf: the first position in `order`.
-    pub a: i32,
-    /// Inner: the second child; leaf: minus the primitive count.
-    pub b: i32,
+    /// A leaf's first position in `order` (0 for an inner node).
+    pub first: u32,
+    /// A leaf's primitives; 0: an inner node, whose first child is the next node.
+    pub count: u32,
+    /// The node after this one's subtree in depth-first order; -1: none.
+    pub miss: i32,
 }
 
 impl FlatNode {
     pub fn is_leaf(&self) -> bool {
-        self.b < 0
+        self.count > 0
     }
 
-    /// The two texels of the node, as the GPU reads them (RGBA32I).
+    /// The two texels of the node, as the GPU reads them (RGBA32I):
+    /// `(min bits, leaf)` and `(max bits, miss)`, where leaf is
+    /// -(first x LEAF_COUNT_SPAN + count) for a leaf and 0 for an inner node.
     pub fn texels(&self) -> [i32; 8] {
         let bits = |v: f32| v.to_bits() as i32;
+        let leaf = if self.is_leaf() {
+            -(self.first as i32 * LEAF_COUNT_SPAN + self.count as i32)
+        } else {
+            0
+        };
         [
             bits(self.min.x),
             bits(self.min.y),
             bits(self.min.z),
-            self.a,
+            leaf,
             bits(self.max.x),
             bits(self.max.y),
             bits(self.max.z),
-            self.b,
+            self.miss,
         ]
     }
 }
@@ -94,17 +108,17 @@ pub fn bounds(g: &Geometry) -> (Vec3, Vec3) {
     }
 }
 
-/// Builds and flattens the hierarchy over the scene's primitives; refuses a
-/// tree deeper than the GPU's traversal stack.
+/// Builds the hierarchy over the scene's primitives and threads it.
 pub fn build(scene: &Scene) -> Result<FlatBvh> {
     if scene.shapes.is_empty() {
-        // One empty leaf whose box nothing meets.
+        // One node whose box nothing meets.
         return Ok(FlatBvh {
             nodes: vec![FlatNode {
                 min: Vec3::splat(f32::INFINITY),
                 max: Vec3::splat(f32::NEG_INFINITY),
-                a: 0,
-                b: 0,
+                first: 0,
+                count: 0,
+                miss: -1,
             }],
             order: Vec::new(),
             depth: 1,
@@ -124,28 +138,18 @@ pub fn build(scene: &Scene) -> Result<FlatBvh> {
     let mut params = obvhs::BvhBuildParams::medium_build();
     params.max_prims_per_leaf = MAX_LEAF_PRIMITIVES;
     let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut Default::default());
-    let nodes: Vec<FlatNode> = bvh
-        .nodes
-        .iter()
-        .map(|n| {
-            let (a, b) = if n.prim_count > 0 {
-                (n.first_index as i32, -(n.prim_count as i32))
-            } else {
-                (n.first_index as i32, n.first_index as i32 + 1)
-            };
-            FlatNode {
-                min: Vec3::from(n.aabb.min),
-                max: Vec3::from(n.aabb.max),
-                a,
-                b,
-            }
-        })
-        .collect();
-    let depth = depth_of(&nodes);
+    let (nodes, depth) = thread(&bvh.nodes);
     let stack = crate::layout::BVH_STACK as u32;
     if depth > stack {
         return Err(Error::TooLarge(format!(
             "the scene's bounding volume hierarchy is {depth} levels deep; the GPU's traversal stack holds {stack}"
+        )));
+    }
+    if nodes.len() >= (i32::MAX / LEAF_COUNT_SPAN) as usize {
+        return Err(Error::TooLarge(format!(
+            "{} hierarchy nodes: the GPU's node links hold at most {}",
+            nodes.len(),
+            i32::MAX / LEAF_COUNT_SPAN
         )));
     }
     Ok(FlatBvh {
@@ -155,19 +159,55 @@ pub fn build(scene: &Scene) -> Result<FlatBvh> {
     })
 }
 
-/// Levels of the tree from node 0.
-fn depth_of(nodes: &[FlatNode]) -> u32 {
-    let mut deepest = 0;
-    let mut pending = vec![(0usize, 1u32)];
-    while let Some((i, d)) = pending.pop() {
-        deepest = deepest.max(d);
-        let n = nodes[i];
-        if !n.is_leaf() {
-            pending.push((n.a as usize, d + 1));
-            pending.push((n.b as usize, d + 1));
+/// obvhs's nodes (an inner node's children at `first_index` and the one
+/// after) in depth-first order with their miss links, and the tree's depth.
+fn thread(tree: &[obvhs::bvh2::node::Bvh2Node]) -> (Vec<FlatNode>, u32) {
+    // Pre-order, first child first: a node's subtree is the run of `size`
+    // nodes from its place, so its miss link is place + size.
+    let mut preorder = Vec::with_capacity(tree.len());
+    let mut level = vec![0u32; tree.len()];
+    level[0] = 1;
+    let mut stack = vec![0usize];
+    while let Some(i) = stack.pop() {
+        preorder.push(i);
+        let n = &tree[i];
+        if n.prim_count == 0 {
+            let first = n.first_index as usize;
+            level[first] = level[i] + 1;
+            level[first + 1] = level[i] + 1;
+            stack.push(first + 1);
+            stack.push(first);
         }
     }
-    deepest
+    let mut size = vec![1usize; tree.len()];
+    for &i in preorder.iter().rev() {
+        let n = &tree[i];
+        if n.prim_count == 0 {
+            let first = n.first_index as usize;
+            size[i] = 1 + size[first] + size[first + 1];
+        }
+    }
+    let nodes = preorder
+        .iter()
+        .enumerate()
+        .map(|(place, &i)| {
+            let n = &tree[i];
+            let after = place + size[i];
+            FlatNode {
+                min: Vec3::from(n.aabb.min),
+                max: Vec3::from(n.aabb.max),
+                first: if n.prim_count > 0 { n.first_index } else { 0 },
+                count: n.prim_count,
+                miss: if after < preorder.len() {
+                    after as i32
+                } else {
+                    -1
+                },
+            }
+        })
+        .collect();
+    let depth = preorder.iter().map(|&i| level[i]).max().unwrap_or(1);
+    (nodes, depth)
 }
 
 #[cfg(test)]

@@ -266,6 +266,10 @@ pub struct SceneTextures {
     pub offset_floor: f32,
     /// A small scene's primitives again, for the linear scan (see `bind`).
     primitive_block: Option<UniformBlock>,
+    /// A mid-size scene's hierarchy, leaf order and primitives again, for
+    /// the threaded walk, with the defines that place them (SCENE_BVH_BLOCK).
+    bvh_block: Option<UniformBlock>,
+    bvh_block_defines: Vec<(&'static str, String)>,
     /// The scene's kind masks as `scene_masks` gives them.
     masks: Vec<(&'static str, u32)>,
 }
@@ -292,6 +296,29 @@ fn scene_masks(scene: &Scene, p: &PackedScene) -> Vec<(&'static str, u32)> {
         ("SCENE_LIGHTS", lights),
         ("SCENE_SHADING_NORMALS", normals),
     ]
+}
+
+/// The words of SCENE_BVH_BLOCK: the nodes' texels, the leaf order four to
+/// a texel, the primitives' texels; with the texel where the order and the
+/// primitives start. None where they exceed `limit` bytes.
+fn bvh_block_words(
+    bvh: &FlatBvh,
+    p: &PackedScene,
+    limit: usize,
+) -> Option<(Vec<u32>, usize, usize)> {
+    let mut words: Vec<u32> = bvh
+        .nodes
+        .iter()
+        .flat_map(|n| n.texels())
+        .map(|v| v as u32)
+        .collect();
+    let order_at = words.len() / 4;
+    words.extend(bvh.order.iter().copied());
+    words.resize(words.len().div_ceil(4) * 4, 0);
+    let primitives_at = words.len() / 4;
+    words.extend(p.primitives.iter().flatten().map(|v| v.to_bits()));
+    words.resize(words.len().div_ceil(4) * 4, 0);
+    (words.len() * 4 <= limit).then_some((words, order_at, primitives_at))
 }
 
 fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture> {
@@ -356,6 +383,28 @@ impl SceneTextures {
             defines.push(("SCENE_LINEAR_SCAN", "1".to_string()));
             defines.push(("SCENE_PRIMITIVE_BLOCK", "1".to_string()));
         }
+        let bvh_block = if small {
+            None
+        } else {
+            let limit = crate::layout::BVH_BLOCK_BYTES.min(gpu.max_uniform_block_bytes());
+            match bvh_block_words(bvh, &p, limit) {
+                Some((words, order_at, primitives_at)) => {
+                    let texels = words.len() / 4;
+                    defines.push(("SCENE_BVH_BLOCK", texels.to_string()));
+                    defines.push(("BVH_BLOCK_ORDER_AT", order_at.to_string()));
+                    defines.push(("BVH_BLOCK_PRIMITIVES_AT", primitives_at.to_string()));
+                    Some(UniformBlock::from_words(gpu, words)?)
+                }
+                None => None,
+            }
+        };
+        let block_defines = defines
+            .iter()
+            .filter(|(name, _)| {
+                name.starts_with("SCENE_BVH_BLOCK") || name.starts_with("BVH_BLOCK_")
+            })
+            .cloned()
+            .collect();
         gpu.set_scene_defines(defines);
         let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
         let order: Vec<i32> = bvh.order.iter().map(|&i| i as i32).collect();
@@ -373,6 +422,8 @@ impl SceneTextures {
             light_count: p.light_count,
             offset_floor: p.offset_floor,
             primitive_block,
+            bvh_block,
+            bvh_block_defines: block_defines,
             masks,
         })
     }
@@ -389,7 +440,26 @@ impl SceneTextures {
                 .is_some_and(|program| mask & !program == 0)
         });
         let block = value("SCENE_PRIMITIVE_BLOCK").is_some();
-        covered && (!block || self.primitive_block.is_some())
+        // A program that walks a hierarchy block was laid out for this one
+        // (one that reads textures traces any scene).
+        let hierarchy = value("SCENE_BVH_BLOCK").is_none()
+            || (self.bvh_block.is_some()
+                && self
+                    .bvh_block_defines
+                    .iter()
+                    .all(|(name, v)| value(name) == Some(v)));
+        covered && (!block || self.primitive_block.is_some()) && hierarchy
+    }
+
+    /// Which walk traces this scene (glsl/common/scene.glsl's bvh_trace).
+    pub fn walk(&self) -> &'static str {
+        if self.primitive_block.is_some() {
+            "a loop over every primitive, from a uniform block"
+        } else if self.bvh_block.is_some() {
+            "the threaded BVH walk, from a uniform block"
+        } else {
+            "the ordered BVH walk, from textures"
+        }
     }
 
     /// Binds the textures and counts that glsl/common/scene.glsl declares.
@@ -398,6 +468,9 @@ impl SceneTextures {
             b.fail(Error::SceneMismatch(b.program_name().to_string()));
         }
         if let Some(block) = &self.primitive_block {
+            b.uniform_block(crate::layout::SCENE_BLOCK_BINDING, block);
+        }
+        if let Some(block) = &self.bvh_block {
             b.uniform_block(crate::layout::SCENE_BLOCK_BINDING, block);
         }
         b.texture("u_primitives", &self.primitives)

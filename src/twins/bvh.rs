@@ -1,12 +1,14 @@
 //! The BVH traversal of glsl/common/scene.glsl in Rust, step for step: the
-//! same ordered stack, the same conservative box test and the same primitive
-//! tests, so its answers are the GPU's (tests/gpu/bvh.rs compares both with a loop
-//! over every primitive).
+//! same two walks over the threaded layout (the ordered one with its stack,
+//! and the threaded one of a hierarchy in a uniform block), the same
+//! conservative box test and the same primitive tests, so its answers are
+//! the GPU's (tests/gpu/bvh.rs compares them with a loop over every
+//! primitive).
 
 use glam::Vec3;
 
 use crate::layout::BOX_ROBUST;
-use crate::scene::bvh::FlatBvh;
+use crate::scene::bvh::{FlatBvh, FlatNode};
 use crate::scene::Scene;
 
 use super::intersect::{intersect_geometry_ray, ShearedRay};
@@ -24,54 +26,102 @@ pub fn box_entry(lo: Vec3, hi: Vec3, r: &ShearedRay, t_max: f32) -> Option<f32> 
 /// What `bvh_trace` returns: the primitive and its (t, u, v).
 pub type BvhHit = Option<(usize, (f32, f32, f32))>;
 
-/// The closest hit before `t_max` (with `any_hit`, the first found).
+/// Tests a leaf's primitives, keeping the closest hit before `best_t`.
+fn leaf(
+    scene: &Scene,
+    bvh: &FlatBvh,
+    n: &FlatNode,
+    r: &ShearedRay,
+    best_t: &mut f32,
+    hit: &mut BvhHit,
+) {
+    for i in n.first..n.first + n.count {
+        let prim = bvh.order[i as usize] as usize;
+        if let Some(h) = intersect_geometry_ray(&scene.shapes[prim].geometry, r) {
+            if h.0 < *best_t {
+                *best_t = h.0;
+                *hit = Some((prim, h));
+            }
+        }
+    }
+}
+
+/// The closest hit before `t_max` (with `any_hit`, the first found) by the
+/// ordered walk: an inner node's children are the next node and its miss
+/// link, the nearer entered first, the farther stacked with its entry.
 pub fn trace(scene: &Scene, bvh: &FlatBvh, r: &ShearedRay, t_max: f32, any_hit: bool) -> BvhHit {
     let root = bvh.nodes.first()?;
     box_entry(root.min, root.max, r, t_max)?;
     let mut best_t = t_max;
     let mut hit: BvhHit = None;
-    let (mut a, mut b) = (root.a, root.b);
-    let mut stack: Vec<((i32, i32), f32)> = Vec::new();
+    let mut node = 0usize;
+    let mut stack: Vec<(usize, f32)> = Vec::new();
     loop {
-        if b < 0 {
-            for i in a..a - b {
-                let prim = bvh.order[i as usize] as usize;
-                if let Some(h) = intersect_geometry_ray(&scene.shapes[prim].geometry, r) {
-                    if h.0 < best_t {
-                        best_t = h.0;
-                        hit = Some((prim, h));
-                    }
-                }
-            }
+        let n = bvh.nodes[node];
+        if n.is_leaf() {
+            leaf(scene, bvh, &n, r, &mut best_t, &mut hit);
             if any_hit && hit.is_some() {
                 return hit;
             }
         } else {
-            let (l, rr) = (bvh.nodes[a as usize], bvh.nodes[b as usize]);
+            let a = node + 1;
+            let b = bvh.nodes[a].miss as usize;
+            let (l, rr) = (bvh.nodes[a], bvh.nodes[b]);
             let tl = box_entry(l.min, l.max, r, best_t);
             let tr = box_entry(rr.min, rr.max, r, best_t);
             let first = match (tl, tr) {
                 (Some(tl), Some(tr)) => {
-                    let (near, far, t_far) = if tr < tl { (rr, l, tl) } else { (l, rr, tr) };
-                    stack.push(((far.a, far.b), t_far));
+                    let (near, far, t_far) = if tr < tl { (b, a, tl) } else { (a, b, tr) };
+                    stack.push((far, t_far));
                     Some(near)
                 }
-                (Some(_), None) => Some(l),
-                (None, Some(_)) => Some(rr),
+                (Some(_), None) => Some(a),
+                (None, Some(_)) => Some(b),
                 (None, None) => None,
             };
-            if let Some(n) = first {
-                (a, b) = (n.a, n.b);
+            if let Some(next) = first {
+                node = next;
                 continue;
             }
         }
         while stack.last().is_some_and(|e| e.1 >= best_t) {
             stack.pop();
         }
-        let Some(((na, nb), _)) = stack.pop() else {
+        let Some((next, _)) = stack.pop() else {
             break;
         };
-        (a, b) = (na, nb);
+        node = next;
+    }
+    hit
+}
+
+/// The same by the threaded walk (SCENE_BVH_BLOCK): a node whose box the
+/// ray enters leads to the next node (a leaf after testing its primitives,
+/// to its miss link), a missed one to its miss link.
+pub fn trace_threaded(
+    scene: &Scene,
+    bvh: &FlatBvh,
+    r: &ShearedRay,
+    t_max: f32,
+    any_hit: bool,
+) -> BvhHit {
+    let mut best_t = t_max;
+    let mut hit: BvhHit = None;
+    let mut node = if bvh.nodes.is_empty() { -1 } else { 0 };
+    while node >= 0 {
+        let n = bvh.nodes[node as usize];
+        let enter = box_entry(n.min, n.max, r, best_t).is_some();
+        if enter && n.is_leaf() {
+            leaf(scene, bvh, &n, r, &mut best_t, &mut hit);
+            if any_hit && hit.is_some() {
+                return hit;
+            }
+        }
+        node = if enter && !n.is_leaf() {
+            node + 1
+        } else {
+            n.miss
+        };
     }
     hit
 }

@@ -15,7 +15,7 @@ use photonmap::scene::generate::{displaced_sphere, IndexedMesh};
 use photonmap::scene::pack::SceneTextures;
 use photonmap::scene::{Geometry, Light, Material, Scene, Shape};
 use photonmap::twins::bvh as twin;
-use photonmap::twins::intersect::{boundary_margin, intersect_geometry};
+use photonmap::twins::intersect::{boundary_margin, intersect_geometry, ShearedRay};
 
 /// Runs glsl/test/intersect_twin.frag in `mode` (2: closest hit, w = the
 /// primitive; 3: occluded up to the direction's w) over the scene's BVH.
@@ -179,7 +179,9 @@ fn explained(
 fn bvh_closest_hits_equal_a_loop_over_every_primitive() {
     let gpu = common::gpu();
     let mut rng = Rng(0x5eed_b4a5);
-    let mut cases: Vec<(String, Scene)> = [1, 10, 1000, 100_000]
+    // 1 and 10: the linear scan; 200: the threaded walk of a hierarchy in a
+    // uniform block; 1000 and 100,000: the ordered walk of textures.
+    let mut cases: Vec<(String, Scene)> = [1, 10, 200, 1000, 100_000]
         .into_iter()
         .map(|n| {
             let analytic = n == 1000;
@@ -198,6 +200,13 @@ fn bvh_closest_hits_equal_a_loop_over_every_primitive() {
     }
     for (name, scene) in &cases {
         let tree = bvh::build(scene).unwrap();
+        let walk = SceneTextures::with_bvh(&gpu, scene, &tree).unwrap().walk();
+        let expected = match scene.shapes.len() {
+            0..=16 => "loop",
+            200 => "threaded",
+            _ => "ordered",
+        };
+        assert!(walk.contains(expected), "{name}: {walk}");
         let (origins, dirs) = rays(scene, &mut rng, 4096);
         let dir4: Vec<[f32; 4]> = dirs.iter().map(|d| [d.x, d.y, d.z, 0.0]).collect();
         let on_gpu = gpu_rays(&gpu, scene, &tree, &origins, &dir4, 2);
@@ -208,6 +217,12 @@ fn bvh_closest_hits_equal_a_loop_over_every_primitive() {
             hits += truth.is_some() as usize;
             // The twin runs the same tests in the same f32 operations: exactly the loop's t.
             let cpu = twin::closest_hit(scene, &tree, o, d).map(|(p, h)| (p, h.0));
+            let threaded = twin::trace_threaded(scene, &tree, &ShearedRay::new(o, d), 1e30, false);
+            assert_eq!(
+                threaded.map(|(_, h)| h.0),
+                truth.map(|t| t.1),
+                "{name}: the threaded twin, ray {k}"
+            );
             assert_eq!(
                 cpu.map(|c| c.1),
                 truth.map(|t| t.1),
@@ -261,9 +276,16 @@ fn bvh_closest_hits_equal_a_loop_over_every_primitive() {
 fn shadow_rays_stop_at_the_first_blocker_before_their_end() {
     let gpu = common::gpu();
     let mut rng = Rng(0x0cc1_0de5);
-    let scene = diffuse_scene(soup(5000, &mut rng, true));
+    // 300: a hierarchy in a uniform block (the threaded walk); 5000: in textures.
+    for n in [300, 5000] {
+        shadow_rays_stop_at_the_first_blocker(&gpu, &mut rng, n);
+    }
+}
+
+fn shadow_rays_stop_at_the_first_blocker(gpu: &Gpu, rng: &mut Rng, n: usize) {
+    let scene = diffuse_scene(soup(n, rng, true));
     let tree = bvh::build(&scene).unwrap();
-    let (origins, dirs) = rays(&scene, &mut rng, 4096);
+    let (origins, dirs) = rays(&scene, rng, 4096);
     // Ends drawn around the closest hit, so both answers occur often.
     let ends: Vec<f32> = (0..origins.len())
         .map(|k| match brute_force(&scene, origins[k], dirs[k]) {
@@ -276,7 +298,7 @@ fn shadow_rays_stop_at_the_first_blocker_before_their_end() {
         .zip(&ends)
         .map(|(d, &e)| [d.x, d.y, d.z, e])
         .collect();
-    let on_gpu = gpu_rays(&gpu, &scene, &tree, &origins, &dir4, 3);
+    let on_gpu = gpu_rays(gpu, &scene, &tree, &origins, &dir4, 3);
     let (mut blocked, mut bad) = (0, Vec::new());
     for k in 0..origins.len() {
         let (o, d) = (origins[k], dirs[k]);
@@ -285,7 +307,13 @@ fn shadow_rays_stop_at_the_first_blocker_before_their_end() {
         assert_eq!(
             twin::occluded(&scene, &tree, o, d, ends[k]),
             truth,
-            "twin, ray {k}"
+            "{n} triangles: twin, ray {k}"
+        );
+        let threaded = twin::trace_threaded(&scene, &tree, &ShearedRay::new(o, d), ends[k], true);
+        assert_eq!(
+            threaded.is_some(),
+            truth,
+            "{n} triangles: threaded twin, ray {k}"
         );
         if (on_gpu[k][0] > 0.5) != truth {
             // Only a hit within rounding of the segment's end may go either way.
@@ -297,9 +325,12 @@ fn shadow_rays_stop_at_the_first_blocker_before_their_end() {
     }
     assert!(
         blocked > 1000 && blocked < 3500,
-        "{blocked} blocked: the test needs both answers"
+        "{n} triangles: {blocked} blocked: the test needs both answers"
     );
-    assert!(bad.is_empty(), "GPU occlusion differs on rays {bad:?}");
+    assert!(
+        bad.is_empty(),
+        "{n} triangles: GPU occlusion differs on rays {bad:?}"
+    );
 }
 
 /// Rays from inside a closed mesh aimed exactly at its vertices and at points
@@ -466,4 +497,28 @@ fn a_program_specialised_to_one_scene_refuses_another() {
         other => panic!("a sphere-only program traced triangles: {other:?}"),
     }
     draw(&packed_spheres).expect("the program's own scene");
+
+    // A program that walks one scene's hierarchy block refuses another's,
+    // whose nodes and primitives lie elsewhere in its block.
+    let mesh = |n| diffuse_scene(soup(n, &mut Rng(0x5eed_b10c), false));
+    let (small, larger) = (mesh(200), mesh(300));
+    let packed_larger = SceneTextures::new(&gpu, &larger).unwrap();
+    let packed_small = SceneTextures::new(&gpu, &small).unwrap();
+    assert!(packed_small.walk().contains("threaded") && packed_larger.walk().contains("threaded"));
+    let for_small = Program::fullscreen(&gpu, "test/intersect_twin.frag").unwrap();
+    let draw = |textures: &SceneTextures| {
+        let mut b = for_small.bind();
+        textures.bind(&mut b);
+        b.texture("u_ray_origin", &out)
+            .texture("u_ray_direction", &out)
+            .texture("u_ray_normal", &out)
+            .int("u_primitive", 0)
+            .int("u_mode", 2)
+            .draw_fullscreen(&target, &DrawState::PLAIN)
+    };
+    match draw(&packed_larger) {
+        Err(Error::SceneMismatch(_)) => {}
+        other => panic!("a program laid out for one block traced another: {other:?}"),
+    }
+    draw(&packed_small).expect("the program's own scene");
 }
