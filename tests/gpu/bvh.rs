@@ -482,8 +482,9 @@ fn a_program_specialised_to_one_scene_refuses_another() {
     let packed_triangles = SceneTextures::new(&gpu, &triangles).unwrap();
     let out = Texture::new(&gpu, 4, 4, TexFormat::Rgba32F).unwrap();
     let target = Target::new(&gpu, &[&out]).unwrap();
-    let draw = |textures: &SceneTextures| {
-        let mut b = for_spheres.bind();
+    // One closest-hit pass of `program` over `textures`.
+    let draw_with = |program: &Program, textures: &SceneTextures| {
+        let mut b = program.bind();
         textures.bind(&mut b);
         b.texture("u_ray_origin", &out)
             .texture("u_ray_direction", &out)
@@ -492,6 +493,7 @@ fn a_program_specialised_to_one_scene_refuses_another() {
             .int("u_mode", 2)
             .draw_fullscreen(&target, &DrawState::PLAIN)
     };
+    let draw = |textures: &SceneTextures| draw_with(&for_spheres, textures);
     match draw(&packed_triangles) {
         Err(Error::SceneMismatch(program)) => assert!(program.contains("intersect_twin")),
         other => panic!("a sphere-only program traced triangles: {other:?}"),
@@ -506,16 +508,7 @@ fn a_program_specialised_to_one_scene_refuses_another() {
     let packed_small = SceneTextures::new(&gpu, &small).unwrap();
     assert!(packed_small.walk().contains("threaded") && packed_larger.walk().contains("threaded"));
     let for_small = Program::fullscreen(&gpu, "test/intersect_twin.frag").unwrap();
-    let draw = |textures: &SceneTextures| {
-        let mut b = for_small.bind();
-        textures.bind(&mut b);
-        b.texture("u_ray_origin", &out)
-            .texture("u_ray_direction", &out)
-            .texture("u_ray_normal", &out)
-            .int("u_primitive", 0)
-            .int("u_mode", 2)
-            .draw_fullscreen(&target, &DrawState::PLAIN)
-    };
+    let draw = |textures: &SceneTextures| draw_with(&for_small, textures);
     match draw(&packed_larger) {
         Err(Error::SceneMismatch(_)) => {}
         other => panic!("a program laid out for one block traced another: {other:?}"),
