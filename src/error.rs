@@ -66,8 +66,8 @@ pub enum Error {
     #[error("GL: framebuffer incomplete: 0x{0:04x}")]
     IncompleteFramebuffer(u32),
     /// A program compiled for another scene (its kinds of primitive,
-    /// material or light, its vertex normals, or the small-scene uniform
-    /// block) bound to this scene: a bug in this program.
+    /// material or light, its vertex normals, or a scene uniform block laid
+    /// out another way) bound to this scene: a bug in this program.
     #[error("glsl/{0}: compiled for another scene's kinds; compile it after packing this scene")]
     SceneMismatch(String),
     /// A uniform set from Rust that the program does not declare (a misspelled

@@ -434,13 +434,18 @@ AreaLight area_light(int l) {
     return L;
 }
 
-// A point of area light l from two uniforms (su, sv), and the light's unit
-// normal there; a LIGHT_TRIANGLES light picks its triangle with su.
-vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal) {
-    if (L.triangles) {
-        int prim;
-        return sample_light_triangle(l, su, sv, light_normal, prim);
-    }
+// A point of area light l from two uniforms (su, sv), the light's unit
+// normal there and the primitive it lies on (a LIGHT_TRIANGLES light's
+// triangle, picked with su; -1 for a parallelogram light).
+vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal,
+                      out int prim) {
+    if (L.triangles) return sample_light_triangle(l, su, sv, light_normal, prim);
+    prim = -1;
     light_normal = L.normal;
     return L.a + su * L.e1 + sv * L.e2;
+}
+
+vec3 area_light_point(int l, AreaLight L, float su, float sv, out vec3 light_normal) {
+    int prim;
+    return area_light_point(l, L, su, sv, light_normal, prim);
 }

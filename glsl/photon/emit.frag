@@ -48,9 +48,7 @@ void main() {
     float probability = light_texel(l, 5).y;
 #endif
     vec4 choice = light_texel(l, 5); // (cdf, probability, primitive, 0)
-    vec4 head = light_texel(l, 0);
     int kind = light_kind(l);
-    vec3 a = light_texel(l, 1).xyz;
     vec3 emitted = light_texel(l, 4).rgb;
     float u1 = photon_random_next(rng), u2 = photon_random_next(rng);
     float u3 = photon_random_next(rng), u4 = photon_random_next(rng);
@@ -76,22 +74,17 @@ void main() {
     vec3 p, d, power;
     float leaving = choice.z; // the primitive the photon leaves (-1: none)
     if (light_kind_is(kind, LIGHT_POINT)) {
-        p = a;
+        p = light_texel(l, 1).xyz;
         d = sample_sphere(u1, u2);
         power = 4.0 * PI * emitted;
-    } else if (light_kind_is(kind, LIGHT_TRIANGLES)) {
+    } else {
+        AreaLight L = area_light(l);
         vec3 normal;
         int prim;
-        p = sample_light_triangle(l, u1, u2, normal, prim);
+        p = area_light_point(l, L, u1, u2, normal, prim);
         d = sample_cosine(normal, u3, u4);
-        power = PI * light_texel(l, 1).z * emitted;
-        leaving = float(prim);
-    } else {
-        vec3 e1 = light_texel(l, 2).xyz;
-        vec3 e2 = light_texel(l, 3).xyz;
-        p = a + u1 * e1 + u2 * e2;
-        d = sample_cosine(head.yzw, u3, u4);
-        power = PI * length(cross(e1, e2)) * emitted;
+        power = PI * L.area * emitted;
+        if (L.triangles) leaving = float(prim);
     }
     o_position = vec4(p, -1.0);
     o_power = vec4(power / (float(u_emitted) * probability), 0.0);

@@ -7,25 +7,21 @@ use glow::HasContext;
 
 use super::{Error, Gpu, Result};
 
-/// A buffer of vec4s for a `layout(std140, binding = N) uniform` block.
+/// A buffer of 16-byte texels (vec4 or ivec4) for a `layout(std140,
+/// binding = N) uniform` block.
 pub struct UniformBlock {
     gpu: Gpu,
     pub(crate) raw: glow::Buffer,
 }
 
 impl UniformBlock {
-    /// `texels` as the block's vec4 array (std140 lays vec4 arrays out
-    /// tightly); refused beyond the driver's GL_MAX_UNIFORM_BLOCK_SIZE.
-    pub fn from_texels(gpu: &Gpu, texels: &[[f32; 4]]) -> Result<Self> {
-        Self::from_words(gpu, texels.iter().flatten().map(|v| v.to_bits()).collect())
-    }
-
-    /// 32-bit words (floats as their bits, or ints) as the block's contents.
+    /// 32-bit words (floats as their bits, or ints), four a texel, as the
+    /// block's array (std140 lays vec4 and ivec4 arrays out tightly);
+    /// refused beyond the driver's GL_MAX_UNIFORM_BLOCK_SIZE.
     pub fn from_words(gpu: &Gpu, words: Vec<u32>) -> Result<Self> {
         let gl = gpu.gl();
         let bytes_needed = std::mem::size_of_val(&words[..]);
-        // SAFETY: gpu module doc; a query of a limit.
-        let max = unsafe { gl.get_parameter_i32(glow::MAX_UNIFORM_BLOCK_SIZE) } as usize;
+        let max = gpu.max_uniform_block_bytes();
         if bytes_needed > max {
             return Err(Error::TooLarge(format!(
                 "a uniform block of {bytes_needed} bytes: this driver's hold at most {max}"

@@ -264,12 +264,8 @@ pub struct SceneTextures {
     pub primitive_count: usize,
     pub light_count: usize,
     pub offset_floor: f32,
-    /// A small scene's primitives again, for the linear scan (see `bind`).
-    primitive_block: Option<UniformBlock>,
-    /// A mid-size scene's hierarchy, leaf order and primitives again, for
-    /// the threaded walk, with the defines that place them (SCENE_BVH_BLOCK).
-    bvh_block: Option<UniformBlock>,
-    bvh_block_defines: Vec<(&'static str, String)>,
+    /// The scene's uniform block, if it has one (see `SceneBlock`).
+    block: Option<SceneBlock>,
     /// The scene's kind masks as `scene_masks` gives them.
     masks: Vec<(&'static str, u32)>,
 }
@@ -298,27 +294,81 @@ fn scene_masks(scene: &Scene, p: &PackedScene) -> Vec<(&'static str, u32)> {
     ]
 }
 
-/// The words of SCENE_BVH_BLOCK: the nodes' texels, the leaf order four to
-/// a texel, the primitives' texels; with the texel where the order and the
-/// primitives start. None where they exceed `limit` bytes.
-fn bvh_block_words(
-    bvh: &FlatBvh,
-    p: &PackedScene,
-    limit: usize,
-) -> Option<(Vec<u32>, usize, usize)> {
-    let mut words: Vec<u32> = bvh
-        .nodes
-        .iter()
-        .flat_map(|n| n.texels())
-        .map(|v| v as u32)
-        .collect();
-    let order_at = words.len() / 4;
-    words.extend(bvh.order.iter().copied());
-    words.resize(words.len().div_ceil(4) * 4, 0);
-    let primitives_at = words.len() / 4;
-    words.extend(p.primitives.iter().flatten().map(|v| v.to_bits()));
-    words.resize(words.len().div_ceil(4) * 4, 0);
-    (words.len() * 4 <= limit).then_some((words, order_at, primitives_at))
+/// A scene's data again in a uniform block (SCENE_BLOCK_BINDING), read
+/// there by the walk it is laid out for, with the defines that place it:
+/// a small scene's primitives (SCENE_PRIMITIVE_BLOCK, the linear scan) or a
+/// mid-size scene's hierarchy, leaf order and primitives (SCENE_BVH_BLOCK,
+/// the threaded walk).
+struct SceneBlock {
+    buffer: UniformBlock,
+    defines: Vec<(&'static str, String)>,
+}
+
+/// Every define that places a scene block: a program compiled with any of
+/// them reads a block laid out as they say.
+const BLOCK_DEFINES: [&str; 4] = [
+    "SCENE_PRIMITIVE_BLOCK",
+    "SCENE_BVH_BLOCK",
+    "BVH_BLOCK_ORDER_AT",
+    "BVH_BLOCK_PRIMITIVES_AT",
+];
+
+impl SceneBlock {
+    /// The block of a small scene (`small`), or of a hierarchy whose words
+    /// (its `node_words`, the leaf order four to a texel, the primitives'
+    /// texels) fit BVH_BLOCK_BYTES and the driver's limit; else None.
+    fn new(
+        gpu: &Gpu,
+        small: bool,
+        node_words: &[i32],
+        bvh: &FlatBvh,
+        p: &PackedScene,
+    ) -> Result<Option<Self>> {
+        let bits = |texels: &[[f32; 4]]| -> Vec<u32> {
+            texels.iter().flatten().map(|v| v.to_bits()).collect()
+        };
+        if small {
+            // The block's whole declared size (GL reads none past the buffer).
+            let mut words = bits(&p.primitives);
+            words.resize(
+                crate::layout::LINEAR_SCAN_MAX * PRIMITIVE_TEXELS as usize * 4,
+                0,
+            );
+            return Ok(Some(Self {
+                buffer: UniformBlock::from_words(gpu, words)?,
+                defines: vec![
+                    ("SCENE_LINEAR_SCAN", "1".to_string()),
+                    ("SCENE_PRIMITIVE_BLOCK", "1".to_string()),
+                ],
+            }));
+        }
+        let mut words: Vec<u32> = node_words.iter().map(|&v| v as u32).collect();
+        let order_at = words.len() / 4;
+        words.extend(bvh.order.iter().copied());
+        words.resize(words.len().div_ceil(4) * 4, 0);
+        let primitives_at = words.len() / 4;
+        words.extend(bits(&p.primitives));
+        let limit = crate::layout::BVH_BLOCK_BYTES.min(gpu.max_uniform_block_bytes());
+        if words.len() * 4 > limit {
+            return Ok(None);
+        }
+        let defines = vec![
+            ("SCENE_BVH_BLOCK", (words.len() / 4).to_string()),
+            ("BVH_BLOCK_ORDER_AT", order_at.to_string()),
+            ("BVH_BLOCK_PRIMITIVES_AT", primitives_at.to_string()),
+        ];
+        Ok(Some(Self {
+            buffer: UniformBlock::from_words(gpu, words)?,
+            defines,
+        }))
+    }
+
+    fn value(&self, name: &str) -> Option<&String> {
+        self.defines
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| v)
+    }
 }
 
 fn upload(gpu: &Gpu, rows: &[[f32; 4]], width: u32) -> Result<Texture> {
@@ -363,50 +413,15 @@ impl SceneTextures {
         // A small scene is traced by a loop over its primitives (both ways
         // find the same hits; the loop is faster), read from a uniform block.
         let small = scene.shapes.len() <= crate::layout::LINEAR_SCAN_MAX;
-        let primitive_block = if small {
-            // The block's whole declared size (GL reads none past the buffer).
-            let mut texels = p.primitives.clone();
-            texels.resize(
-                crate::layout::LINEAR_SCAN_MAX * PRIMITIVE_TEXELS as usize,
-                [0.0; 4],
-            );
-            Some(UniformBlock::from_texels(gpu, &texels)?)
-        } else {
-            None
-        };
+        let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
+        let block = SceneBlock::new(gpu, small, &nodes, bvh, &p)?;
         // Programs compiled from here on are specialised to this scene.
         let mut defines: Vec<(&'static str, String)> = masks
             .iter()
             .map(|&(name, mask)| (name, mask.to_string()))
             .collect();
-        if small {
-            defines.push(("SCENE_LINEAR_SCAN", "1".to_string()));
-            defines.push(("SCENE_PRIMITIVE_BLOCK", "1".to_string()));
-        }
-        let bvh_block = if small {
-            None
-        } else {
-            let limit = crate::layout::BVH_BLOCK_BYTES.min(gpu.max_uniform_block_bytes());
-            match bvh_block_words(bvh, &p, limit) {
-                Some((words, order_at, primitives_at)) => {
-                    let texels = words.len() / 4;
-                    defines.push(("SCENE_BVH_BLOCK", texels.to_string()));
-                    defines.push(("BVH_BLOCK_ORDER_AT", order_at.to_string()));
-                    defines.push(("BVH_BLOCK_PRIMITIVES_AT", primitives_at.to_string()));
-                    Some(UniformBlock::from_words(gpu, words)?)
-                }
-                None => None,
-            }
-        };
-        let block_defines = defines
-            .iter()
-            .filter(|(name, _)| {
-                name.starts_with("SCENE_BVH_BLOCK") || name.starts_with("BVH_BLOCK_")
-            })
-            .cloned()
-            .collect();
+        defines.extend(block.iter().flat_map(|b| b.defines.iter().cloned()));
         gpu.set_scene_defines(defines);
-        let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
         let order: Vec<i32> = bvh.order.iter().map(|&i| i as i32).collect();
         Ok(Self {
             primitives: upload(gpu, &p.primitives, PRIMITIVE_TEXELS * PRIMITIVES_PER_ROW)?,
@@ -421,17 +436,16 @@ impl SceneTextures {
             primitive_count: p.primitive_count,
             light_count: p.light_count,
             offset_floor: p.offset_floor,
-            primitive_block,
-            bvh_block,
-            bvh_block_defines: block_defines,
+            block,
             masks,
         })
     }
 
     /// Whether a program compiled with these scene defines traces this
     /// scene: its masks cover every kind of primitive, material and light
-    /// the scene holds (and its shading normals), and it reads primitives
-    /// from a uniform block only if this scene has one.
+    /// the scene holds (and its shading normals), and every define of a
+    /// uniform block it reads is this scene's block's (one that reads
+    /// textures traces any scene).
     fn traced_by(&self, defines: &[(&'static str, String)]) -> bool {
         let value = |name: &str| defines.iter().find(|(n, _)| *n == name).map(|(_, v)| v);
         let covered = self.masks.iter().all(|&(name, mask)| {
@@ -439,26 +453,20 @@ impl SceneTextures {
                 .map_or(Some(u32::MAX), |v| v.parse::<u32>().ok())
                 .is_some_and(|program| mask & !program == 0)
         });
-        let block = value("SCENE_PRIMITIVE_BLOCK").is_some();
-        // A program that walks a hierarchy block was laid out for this one
-        // (one that reads textures traces any scene).
-        let hierarchy = value("SCENE_BVH_BLOCK").is_none()
-            || (self.bvh_block.is_some()
-                && self
-                    .bvh_block_defines
-                    .iter()
-                    .all(|(name, v)| value(name) == Some(v)));
-        covered && (!block || self.primitive_block.is_some()) && hierarchy
+        let block = BLOCK_DEFINES.iter().all(|&name| {
+            value(name).is_none_or(|v| self.block.as_ref().and_then(|b| b.value(name)) == Some(v))
+        });
+        covered && block
     }
 
     /// Which walk traces this scene (glsl/common/scene.glsl's bvh_trace).
     pub fn walk(&self) -> &'static str {
-        if self.primitive_block.is_some() {
-            "a loop over every primitive, from a uniform block"
-        } else if self.bvh_block.is_some() {
-            "the threaded BVH walk, from a uniform block"
-        } else {
-            "the ordered BVH walk, from textures"
+        match &self.block {
+            Some(b) if b.value("SCENE_PRIMITIVE_BLOCK").is_some() => {
+                "a loop over every primitive, from a uniform block"
+            }
+            Some(_) => "the threaded BVH walk, from a uniform block",
+            None => "the ordered BVH walk, from textures",
         }
     }
 
@@ -467,11 +475,8 @@ impl SceneTextures {
         if !self.traced_by(b.scene_defines()) {
             b.fail(Error::SceneMismatch(b.program_name().to_string()));
         }
-        if let Some(block) = &self.primitive_block {
-            b.uniform_block(crate::layout::SCENE_BLOCK_BINDING, block);
-        }
-        if let Some(block) = &self.bvh_block {
-            b.uniform_block(crate::layout::SCENE_BLOCK_BINDING, block);
+        if let Some(block) = &self.block {
+            b.uniform_block(crate::layout::SCENE_BLOCK_BINDING, &block.buffer);
         }
         b.texture("u_primitives", &self.primitives)
             .texture("u_bvh_nodes", &self.bvh_nodes)
