@@ -21,14 +21,13 @@ pub const LEAF_COUNT_SPAN: i32 = 8;
 /// (or the driver's GL_MAX_UNIFORM_BLOCK_SIZE, if less) is read from a
 /// uniform block by the threaded walk (SCENE_BVH_BLOCK).
 pub const BVH_BLOCK_BYTES: usize = 65536;
-/// Scenes of at most this many primitives are traced by a loop over every
-/// primitive (SCENE_LINEAR_SCAN in glsl/common/scene.glsl) instead of the
-/// BVH. Measured on llvmpipe (SPPM's eye paths, eye rays of `bench meshes`):
-/// the paper scenes (2 to 8 primitives) and GLASS TANK (16) trace 1.6 to 2.3
-/// times as fast by the loop; the measured Cornell box (38) 1.1 times; a
-/// 24-triangle ball on a floor, most of whose triangles the BVH's boxes cull,
-/// 0.57 times (eye rays).
-pub const LINEAR_SCAN_MAX: usize = 16;
+/// A scene may be traced by a loop over every primitive (SCENE_LINEAR_SCAN
+/// in glsl/common/scene.glsl) instead of the BVH where the loop costs less
+/// than the walk (`FlatBvh::loses_to_a_loop`) and its primitives fit a
+/// uniform block of 16 KiB, the least GL_MAX_UNIFORM_BLOCK_SIZE that GL 4.5
+/// allows: at most this many.
+pub const LINEAR_SCAN_MAX: usize = 256;
+const _: () = assert!(LINEAR_SCAN_MAX * PRIMITIVE_TEXELS as usize * 16 <= 16384);
 /// The uniform-block binding point of a small scene's primitives
 /// (SCENE_PRIMITIVE_BLOCK in glsl/common/scene.glsl).
 pub const SCENE_BLOCK_BINDING: u32 = 0;

@@ -283,8 +283,8 @@ int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
     if (u_primitive_count == 0) return -1;
     int hit = -1;
 #if defined(SCENE_LINEAR_SCAN)
-    // A small scene (LINEAR_SCAN_MAX, src/layout.rs): every primitive in
-    // turn, no stack, no boxes.
+    // A scene whose walk costs more than a loop (FlatBvh::loses_to_a_loop,
+    // src/scene/bvh.rs): every primitive in turn, no stack, no boxes.
     for (int prim = 0; prim < u_primitive_count; ++prim) {
         vec4 h = leaf_hit(prim, r);
         if (h.w > 0.0 && h.x < best.x) {

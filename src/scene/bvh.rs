@@ -22,6 +22,13 @@ use crate::layout::LEAF_COUNT_SPAN;
 pub const MAX_LEAF_PRIMITIVES: u32 = 4;
 const _: () = assert!(MAX_LEAF_PRIMITIVES < LEAF_COUNT_SPAN as u32);
 
+/// What one ray's box test costs, in tests of one primitive, and what a walk
+/// costs before its first test (the loop it runs, its node fetches): fitted
+/// on llvmpipe to three scenes whose two ways were timed against each other
+/// (`results/llvmpipe/meshes/linear_scan.md`).
+const BOX_TEST_COST: f32 = 1.8;
+const WALK_FIXED_COST: f32 = 5.0;
+
 /// The flattened hierarchy.
 #[derive(Clone, Debug, Default)]
 pub struct FlatBvh {
@@ -70,6 +77,44 @@ impl FlatNode {
             bits(self.max.z),
             self.miss,
         ]
+    }
+}
+
+impl FlatBvh {
+    /// One ray's expected work in the walk, in primitive tests, by the
+    /// surface area heuristic (MacDonald and Booth 1990): a node's box is
+    /// tested by the rays that enter its parent, a leaf's primitives by the
+    /// rays that enter the leaf, and a ray enters a box with the chance of
+    /// its surface area over the root's.
+    pub fn walk_cost(&self) -> f32 {
+        let area = |n: &FlatNode| {
+            let d = (n.max - n.min).max(Vec3::ZERO);
+            2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+        };
+        let root = area(&self.nodes[0]);
+        // An empty scene's box is inverted; a flat one has no area.
+        if root.is_nan() || root <= 0.0 {
+            return WALK_FIXED_COST;
+        }
+        let mut cost = WALK_FIXED_COST + BOX_TEST_COST;
+        for n in &self.nodes {
+            let entered = area(n) / root;
+            if n.is_leaf() {
+                cost += entered * n.count as f32;
+            } else {
+                cost += entered * 2.0 * BOX_TEST_COST;
+            }
+        }
+        cost
+    }
+
+    /// Whether a loop over every one of the scene's `primitives` traces
+    /// faster than this hierarchy's walk (and the primitives fit the loop's
+    /// uniform block, `LINEAR_SCAN_MAX`). A closed room's walls fill their
+    /// boxes, so a box culls little there; a small mesh in a large room is
+    /// culled whole by one.
+    pub fn loses_to_a_loop(&self, primitives: usize) -> bool {
+        primitives <= crate::layout::LINEAR_SCAN_MAX && (primitives as f32) < self.walk_cost()
     }
 }
 
@@ -213,6 +258,38 @@ fn thread(tree: &[obvhs::bvh2::node::Bvh2Node]) -> (Vec<FlatNode>, u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_closed_room_takes_the_loop_and_a_small_mesh_in_the_open_the_walk() {
+        // Two of the scenes the costs were fitted on, timed both ways
+        // (results/llvmpipe/meshes/linear_scan.md).
+        let room = crate::scene::embedded::load("cornell_box_obj").unwrap();
+        assert_eq!(room.shapes.len(), 38);
+        assert!(build(&room).unwrap().loses_to_a_loop(room.shapes.len()));
+        let mut stage = crate::scene::embedded::load("variants/mesh_stage").unwrap();
+        let at = stage
+            .shapes
+            .iter()
+            .position(|s| matches!(s.geometry, Geometry::Sphere { .. }))
+            .unwrap();
+        let ball = stage.shapes.remove(at);
+        let Geometry::Sphere { center, radius } = ball.geometry else {
+            unreachable!()
+        };
+        let mesh = crate::scene::generate::uv_sphere(48, 0.0);
+        stage
+            .shapes
+            .extend(mesh.shapes(ball.material, radius, center));
+        assert_eq!(stage.shapes.len(), 27);
+        let tree = build(&stage).unwrap();
+        assert!(
+            !tree.loses_to_a_loop(stage.shapes.len()),
+            "{}",
+            tree.walk_cost()
+        );
+        // Past the uniform block's room the loop is never taken.
+        assert!(!tree.loses_to_a_loop(crate::layout::LINEAR_SCAN_MAX + 1));
+    }
 
     #[test]
     fn a_cylinders_box_holds_its_rims() {

@@ -410,9 +410,10 @@ impl SceneTextures {
     pub fn with_bvh(gpu: &Gpu, scene: &Scene, bvh: &FlatBvh) -> Result<Self> {
         let p = PackedScene::new(scene);
         let masks = scene_masks(scene, &p);
-        // A small scene is traced by a loop over its primitives (both ways
-        // find the same hits; the loop is faster), read from a uniform block.
-        let small = scene.shapes.len() <= crate::layout::LINEAR_SCAN_MAX;
+        // A scene whose boxes cull too little to pay for the walk is traced by
+        // a loop over its primitives (both ways find the same hits), read from
+        // a uniform block.
+        let small = bvh.loses_to_a_loop(scene.shapes.len());
         let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
         let block = SceneBlock::new(gpu, small, &nodes, bvh, &p)?;
         // Programs compiled from here on are specialised to this scene.

@@ -201,6 +201,8 @@ fn bvh_closest_hits_equal_a_loop_over_every_primitive() {
     for (name, scene) in &cases {
         let tree = bvh::build(scene).unwrap();
         let walk = SceneTextures::with_bvh(&gpu, scene, &tree).unwrap().walk();
+        // Random triangles overlap: a box culls little, and the loop wins
+        // while they are few (FlatBvh::loses_to_a_loop).
         let expected = match scene.shapes.len() {
             0..=16 => "loop",
             200 => "threaded",
