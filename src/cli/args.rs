@@ -46,7 +46,8 @@ pub struct PhotonMapArgs {
     #[arg(long, value_enum, default_value_t = VertexFeed::VertexFetch)]
     pub feed: VertexFeed,
     /// The paper's 2003 constraints: a texture of random numbers, read-back
-    /// before routing, float addressing, no compaction.
+    /// before routing, float addressing, no compaction, and the ray tracer's
+    /// pass per bounce (else each eye path is one fused pass; the same image).
     #[arg(long)]
     pub faithful: bool,
     /// Scenes that store caustics only: emit photons in every direction

@@ -351,6 +351,29 @@ impl RenderOutput {
         let p = &self.plan;
         let views = (self.estimates().len() as u32 / p.spp).max(1);
         let runs = (p.spp * views) as usize;
+        if p.fused {
+            return vec![line(
+                "eye paths (fused)",
+                runs,
+                true,
+                format!(
+                    "a pixel's whole eye path in one pass a sample: the eye ray, {}, and {} at its first diffuse hit (`--faithful`: a pass per bounce)",
+                    if p.specular {
+                        format!(
+                            "the mirror and glass chain to specular depth {}",
+                            scene.render.max_specular_depth
+                        )
+                    } else {
+                        "no specular chain (the scene has no mirror or glass)".into()
+                    },
+                    if p.has_area {
+                        format!("{} shadow samples per area light", p.shadow_rays)
+                    } else {
+                        "one shadow ray per point light".into()
+                    }
+                ),
+            )];
+        }
         vec![
             line(
                 "eye rays",

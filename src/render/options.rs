@@ -32,6 +32,10 @@ pub struct RenderOptions {
     /// image is the crop. Pixel and photon streams stay the frame's, so
     /// tiles stitch into the full render bit for bit.
     pub pixel_bounds: Option<PixelBounds>,
+    /// Eye paths by the paper's pass per bounce (eye rays, then per specular
+    /// depth closest hits, shadow rays and the specular step) instead of one
+    /// fused pass a path (`--faithful`); both give the same image.
+    pub pass_per_bounce: bool,
 }
 
 /// A rectangle of the frame's pixels, half-open: columns x0..x1, rows
@@ -191,6 +195,7 @@ impl RenderOptions {
             spp: 1,
             method: Method::PhotonMap(PhotonMapOptions::default()),
             pixel_bounds: None,
+            pass_per_bounce: false,
         }
     }
 
@@ -245,6 +250,7 @@ impl From<&RenderOptions> for FrameSize {
             height: o.height,
             spp: o.spp,
             shadow_batch: o.shadow_batch,
+            fused: !o.pass_per_bounce,
         }
     }
 }

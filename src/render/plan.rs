@@ -40,6 +40,8 @@ pub struct FrameSize {
     pub spp: u32,
     /// Shadow samples per area light a pass (0: chosen by image size).
     pub shadow_batch: u32,
+    /// Each eye path in one fused pass.
+    pub fused: bool,
 }
 
 /// Shadow rays one pass draws at most, when the batch is chosen by image size.
@@ -86,7 +88,7 @@ impl PassPlan {
                 1
             },
             light_sampling: true,
-            fused: false,
+            fused: options.fused,
         }
     }
 

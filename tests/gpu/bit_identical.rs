@@ -112,9 +112,11 @@ fn render_case(gpu: &photonmap::gpu::Gpu, c: &Case) -> Image {
     o.height = scene.camera.height / 4;
     o.seed = 7;
     o.spp = c.spp;
-    // The stored images were drawn 8 shadow samples a pass; the default
-    // batch adds the same samples in another order (the test below).
+    // The stored images were drawn pass by pass, 8 shadow samples a pass;
+    // the default batch and the fused eye path add the same samples in
+    // another order (the test below, and tests/gpu/fused_eye_path.rs).
     o.shadow_batch = 8;
+    o.pass_per_bounce = true;
     let gi = o.photon_map_mut().unwrap();
     gi.photons.build = c.build;
     gi.photons.faithful = c.faithful;
@@ -174,6 +176,7 @@ fn the_shadow_batch_changes_only_the_order_of_the_sum() {
     let mut o = RenderOptions::for_scene(&scene);
     (o.width, o.height, o.seed) = (scene.camera.width / 4, scene.camera.height / 4, 7);
     assert_eq!(o.shadow_batch, 0, "the default batch is chosen by size");
+    o.pass_per_bounce = true; // batches are the pass per bounce's
     let whole = render(&gpu, &scene, &o, &mut ()).unwrap().image;
     let mut changed = 0;
     for (a, b) in whole

@@ -116,7 +116,8 @@ fn rows(paths: u32) -> Vec<(&'static str, IgiOptions)> {
 
 fn component(stage: &str) -> usize {
     match stage {
-        "eye rays" | "intersect" | "shadow rays" => 0,
+        // The fused eye path holds the specular chain too.
+        "eye rays" | "intersect" | "shadow rays" | "eye paths (fused)" => 0,
         "specular" => 1,
         "VPL paths"
         | "VPLs"

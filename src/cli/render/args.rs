@@ -399,6 +399,7 @@ impl RenderArgs {
         options.spp = self.spp;
         options.width = self.width.unwrap_or(options.width);
         options.height = self.height.unwrap_or(options.height);
+        options.pass_per_bounce = self.photons.faithful;
         options
     }
 

@@ -54,6 +54,7 @@ pub(crate) fn table1_options(
 ) -> RenderOptions {
     let mut o = RenderOptions::for_scene(scene);
     (o.width, o.height) = scaled_size(scene, scale);
+    o.pass_per_bounce = faithful;
     let mut gi = PhotonMapOptions {
         photons: PhotonConfig {
             build,
@@ -316,7 +317,13 @@ fn srgb_to_linear(v: f32) -> f32 {
 
 fn stage_seconds(t: &Timings, stage: &str) -> (f64, f64) {
     let names: &[&str] = match stage {
-        "trace rays" => &["eye rays", "intersect", "shadow rays", "specular"],
+        "trace rays" => &[
+            "eye rays",
+            "intersect",
+            "shadow rays",
+            "specular",
+            "eye paths (fused)",
+        ],
         other => std::slice::from_ref(match other {
             "trace photons" => &"trace photons",
             "build map" => &"build map",
