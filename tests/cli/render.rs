@@ -273,3 +273,30 @@ fn threads_do_not_change_the_image() {
         );
     }
 }
+
+/// Eye paths are one fused pass by default and the paper's pass per bounce
+/// under `--faithful`; `--explain` names which, and the image is the same.
+#[test]
+fn faithful_keeps_the_pass_per_bounce_and_the_image() {
+    let d = TempDir::new("faithful_eye");
+    let render = |faithful: bool, out: &std::path::Path| {
+        let mut run = Run::new(["render", "--width", "48", "--height", "36", "--spp", "2"])
+            .arg("--direct-only")
+            .arg("--explain");
+        if faithful {
+            run = run.arg("--faithful");
+        }
+        run.scene("glass_ball").output_to(out).stderr()
+    };
+    let (fused_png, passes_png) = (d.join("fused.png"), d.join("passes.png"));
+    let fused = render(false, &fused_png);
+    let passes = render(true, &passes_png);
+    assert!(fused.contains("run  eye paths (fused)"), "{fused}");
+    assert!(!fused.contains("run  intersect"), "{fused}");
+    assert!(passes.contains("run  intersect"), "{passes}");
+    assert!(!passes.contains("eye paths (fused)"), "{passes}");
+    assert_eq!(
+        std::fs::read(&fused_png).unwrap(),
+        std::fs::read(&passes_png).unwrap()
+    );
+}
