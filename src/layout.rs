@@ -95,6 +95,13 @@ pub const VCM_MODE_LT: u32 = 1;
 pub const VCM_MODE_PPM: u32 = 2;
 pub const VCM_MODE_BPT: u32 = 3;
 pub const VCM_MODE_VCM: u32 = 4;
+/// Path tracing alone (`--vcm-mode pt`) plays Russian roulette from a camera
+/// path's hit of this index on (the eye ray's hit is 1); before it every
+/// path goes on. The other modes cannot wait: their MIS weights need the
+/// camera's continuation at a vertex to be the vertex's alone, whatever the
+/// path's length. Measured at equal time against roulette from the first
+/// hit: `results/llvmpipe/vcm_pt_roulette.md`.
+pub const VCM_PT_ROULETTE_FROM: u32 = 4;
 
 /// Adaptive sampling interpolates a pixel only from corners whose first-hit
 /// normal is within this cosine of its own (about 18 degrees) and whose
@@ -212,6 +219,7 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("VCM_MODE_PPM", u(VCM_MODE_PPM)),
         ("VCM_MODE_BPT", u(VCM_MODE_BPT)),
         ("VCM_MODE_VCM", u(VCM_MODE_VCM)),
+        ("VCM_PT_ROULETTE_FROM", u(VCM_PT_ROULETTE_FROM)),
         ("ADAPTIVE_NORMAL_COS", format!("{ADAPTIVE_NORMAL_COS:?}")),
         ("PRIMITIVE_BOX_ROW", u(PRIMITIVE_BOX_ROW)),
         ("VPL_NORMAL_COS", format!("{VPL_NORMAL_COS:?}")),

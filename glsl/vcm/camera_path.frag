@@ -208,7 +208,11 @@ void main() {
             if (VCM_MODE == VCM_MODE_LT) break; // light tracing sees diffuse surfaces itself
             vec3 a = material_texel(mat, 1).rgb;
             float q_light = continuation(a);
-            float q = camera_continuation(q_light);
+            // Path tracing alone waits before its roulette (a long path is
+            // cheaper than its variance); with connections the camera's
+            // continuation must be the vertex's alone (src/layout.rs).
+            float q = VCM_MODE == VCM_MODE_PT && segments < VCM_PT_ROULETTE_FROM
+                    ? 1.0 : camera_continuation(q_light);
             vec3 brdf = a / PI;
             if (VCM_MODE == VCM_MODE_PPM) {
                 if (u_merge != 0) merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);

@@ -8,7 +8,7 @@ use crate::layout::{VCM_MODE_BPT, VCM_MODE_LT, VCM_MODE_PPM, VCM_MODE_PT, VCM_MO
 #[serde(rename_all = "lowercase")]
 pub enum VcmMode {
     /// Path tracing: next-event estimation and paths that hit a light,
-    /// weighted between the two.
+    /// weighted between the two; Russian roulette from the fourth hit on.
     Pt,
     /// Light tracing: every light vertex connected to the camera (and
     /// lights seen directly or through mirrors and glass).
