@@ -28,8 +28,9 @@ pub const BVH_BLOCK_BYTES: usize = 65536;
 /// allows: at most this many.
 pub const LINEAR_SCAN_MAX: usize = 256;
 const _: () = assert!(LINEAR_SCAN_MAX * PRIMITIVE_TEXELS as usize * 16 <= 16384);
-/// The uniform-block binding point of a small scene's primitives
-/// (SCENE_PRIMITIVE_BLOCK in glsl/common/scene.glsl).
+/// The uniform-block binding point of a scene's block: the loop's primitives
+/// or a hierarchy's (SCENE_PRIMITIVE_BLOCK, SCENE_BVH_BLOCK in
+/// glsl/common/scene.glsl).
 pub const SCENE_BLOCK_BINDING: u32 = 0;
 /// 1 + 2 gamma(3) in f32: the slab test's far distance widened by its worst
 /// rounding, so a box never culls a ray its primitives would hit (pbrt-v4 6.1).

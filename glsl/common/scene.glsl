@@ -10,7 +10,7 @@
 //   normals. The code of what the scene lacks is left out: llvmpipe runs
 //   both sides of every branch under a lane mask, so code no lane takes
 //   still costs its time.
-// - SCENE_PRIMITIVE_BLOCK: a small scene's primitives in a uniform block as
+// - SCENE_PRIMITIVE_BLOCK: the linear scan's primitives in a uniform block as
 //   well. In the linear scan every lane reads the same primitive, which
 //   llvmpipe loads once from a uniform block but gathers lane by lane from a
 //   texture.
@@ -204,7 +204,8 @@ vec3 offset_origin(vec3 p, vec3 n, vec3 dir) {
 // ---- BVH traversal over the threaded layout of src/scene/bvh.rs (nodes in
 // depth-first order, each with its miss link). Three walks, by where the
 // scene lives:
-// - SCENE_LINEAR_SCAN (a small scene): a loop over every primitive;
+// - SCENE_LINEAR_SCAN (a scene whose walk would cost more): a loop over
+//   every primitive;
 // - SCENE_BVH_BLOCK (a hierarchy that fits a uniform block): the threaded
 //   walk, no stack: a node whose box the ray enters leads to the next node
 //   (an inner node's first child; a leaf's primitives are tested, then its
@@ -261,9 +262,6 @@ vec4 leaf_hit(int prim, SceneRay r) {
 vec4 leaf_hit(int prim, SceneRay r) { return intersect_primitive_ray(prim, r); }
 #endif
 
-// The closest primitive hit before best.x (set by the caller), or -1; with
-// any_hit, the first found. best becomes its record. (With PRIMITIVE_BOXES a
-// "hit" is a box passed through, at its exit distance: for occlusion only.)
 // Tests a leaf's primitives (its texel's w: -(first x LEAF_COUNT_SPAN +
 // count)) against the ray, keeping the closest hit before best.x.
 void bvh_leaf(int leaf, SceneRay r, inout vec4 best, inout int hit) {
@@ -279,6 +277,9 @@ void bvh_leaf(int leaf, SceneRay r, inout vec4 best, inout int hit) {
     }
 }
 
+// The closest primitive hit before best.x (set by the caller), or -1; with
+// any_hit, the first found. best becomes its record. (With PRIMITIVE_BOXES a
+// "hit" is a box passed through, at its exit distance: for occlusion only.)
 int bvh_trace(SceneRay r, bool any_hit, inout vec4 best) {
     if (u_primitive_count == 0) return -1;
     int hit = -1;

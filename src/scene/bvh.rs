@@ -88,12 +88,15 @@ impl FlatBvh {
     /// its surface area over the root's.
     pub fn walk_cost(&self) -> f32 {
         let area = |n: &FlatNode| {
-            let d = (n.max - n.min).max(Vec3::ZERO);
-            2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+            obvhs::aabb::Aabb {
+                min: Vec3A::from(n.min),
+                max: Vec3A::from(n.max),
+            }
+            .half_area()
         };
         let root = area(&self.nodes[0]);
-        // An empty scene's box is inverted; a flat one has no area.
-        if root.is_nan() || root <= 0.0 {
+        // An empty scene's box is inverted; a degenerate one has no area.
+        if !(root.is_finite() && root > 0.0) {
             return WALK_FIXED_COST;
         }
         let mut cost = WALK_FIXED_COST + BOX_TEST_COST;

@@ -296,7 +296,7 @@ fn scene_masks(scene: &Scene, p: &PackedScene) -> Vec<(&'static str, u32)> {
 
 /// A scene's data again in a uniform block (SCENE_BLOCK_BINDING), read
 /// there by the walk it is laid out for, with the defines that place it:
-/// a small scene's primitives (SCENE_PRIMITIVE_BLOCK, the linear scan) or a
+/// the primitives of a scene traced by the loop (SCENE_PRIMITIVE_BLOCK) or a
 /// mid-size scene's hierarchy, leaf order and primitives (SCENE_BVH_BLOCK,
 /// the threaded walk).
 struct SceneBlock {
@@ -314,12 +314,12 @@ const BLOCK_DEFINES: [&str; 4] = [
 ];
 
 impl SceneBlock {
-    /// The block of a small scene (`small`), or of a hierarchy whose words
+    /// The block of a scene traced by the loop (`looped`), or of a hierarchy whose words
     /// (its `node_words`, the leaf order four to a texel, the primitives'
     /// texels) fit BVH_BLOCK_BYTES and the driver's limit; else None.
     fn new(
         gpu: &Gpu,
-        small: bool,
+        looped: bool,
         node_words: &[i32],
         bvh: &FlatBvh,
         p: &PackedScene,
@@ -327,7 +327,7 @@ impl SceneBlock {
         let bits = |texels: &[[f32; 4]]| -> Vec<u32> {
             texels.iter().flatten().map(|v| v.to_bits()).collect()
         };
-        if small {
+        if looped {
             // The block's whole declared size (GL reads none past the buffer).
             let mut words = bits(&p.primitives);
             words.resize(
@@ -413,9 +413,9 @@ impl SceneTextures {
         // A scene whose boxes cull too little to pay for the walk is traced by
         // a loop over its primitives (both ways find the same hits), read from
         // a uniform block.
-        let small = bvh.loses_to_a_loop(scene.shapes.len());
+        let looped = bvh.loses_to_a_loop(scene.shapes.len());
         let nodes: Vec<i32> = bvh.nodes.iter().flat_map(|n| n.texels()).collect();
-        let block = SceneBlock::new(gpu, small, &nodes, bvh, &p)?;
+        let block = SceneBlock::new(gpu, looped, &nodes, bvh, &p)?;
         // Programs compiled from here on are specialised to this scene.
         let mut defines: Vec<(&'static str, String)> = masks
             .iter()

@@ -126,14 +126,12 @@ impl Sppm {
         plan.jitter = true;
         plan.spp = 1;
         plan.light_sampling = sppm.direct == DirectLighting::ShadowRays;
-        // `--faithful` keeps the paper's pass per bounce.
-        plan.fused = !config.faithful;
         let textures = SceneTextures::new(gpu, &scene)?;
         let photons = PhotonTracer::with_config(
             gpu,
             TraceConfig {
                 stop_when_dead: true,
-                // `--faithful` keeps the paper's pass per bounce.
+                // `--faithful` keeps the paper's pass per photon bounce.
                 fused: !config.faithful,
                 ..config.trace()
             },
