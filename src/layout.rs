@@ -57,6 +57,15 @@ pub const MAT_DIFFUSE: u32 = 0;
 pub const MAT_MIRROR: u32 = 1;
 pub const MAT_GLASS: u32 = 2;
 pub const MAT_EMITTER: u32 = 3;
+/// A metal: complex Fresnel from eta + i k, smooth or rough (Trowbridge-Reitz).
+pub const MAT_CONDUCTOR: u32 = 4;
+
+/// The lobes of glsl/common/bsdf.glsl: a diffuse lobe (visible points,
+/// stored photons), a delta lobe (mirror, glass, smooth conductor: the path
+/// goes on in one direction), a glossy lobe (sampled and evaluated).
+pub const BSDF_DIFFUSE: u32 = 1;
+pub const BSDF_DELTA: u32 = 2;
+pub const BSDF_GLOSSY: u32 = 4;
 
 /// Light kinds, the first float of a light's head texel.
 pub const LIGHT_AREA: u32 = 0;
@@ -195,6 +204,10 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("MAT_MIRROR", u(MAT_MIRROR)),
         ("MAT_GLASS", u(MAT_GLASS)),
         ("MAT_EMITTER", u(MAT_EMITTER)),
+        ("MAT_CONDUCTOR", u(MAT_CONDUCTOR)),
+        ("BSDF_DIFFUSE", u(BSDF_DIFFUSE)),
+        ("BSDF_DELTA", u(BSDF_DELTA)),
+        ("BSDF_GLOSSY", u(BSDF_GLOSSY)),
         ("LIGHT_AREA", u(LIGHT_AREA)),
         ("LIGHT_POINT", u(LIGHT_POINT)),
         ("LIGHT_TRIANGLES", u(LIGHT_TRIANGLES)),

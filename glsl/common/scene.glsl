@@ -23,7 +23,7 @@
 #define SCENE_KINDS 15
 #endif
 #ifndef SCENE_MATERIALS
-#define SCENE_MATERIALS 15
+#define SCENE_MATERIALS 31
 #endif
 #ifndef SCENE_LIGHTS
 #define SCENE_LIGHTS 7
@@ -34,7 +34,8 @@
 #define SCENE_HAS(kind) (((SCENE_KINDS >> kind) & 1) != 0)
 #define SCENE_HAS_MATERIAL(kind) (((SCENE_MATERIALS >> kind) & 1) != 0)
 #define SCENE_HAS_LIGHT(kind) (((SCENE_LIGHTS >> kind) & 1) != 0)
-#define SCENE_HAS_SPECULAR (SCENE_HAS_MATERIAL(MAT_MIRROR) || SCENE_HAS_MATERIAL(MAT_GLASS))
+// Whether any surface reflects other than diffusely (mirror, glass, metal).
+#define SCENE_HAS_SPECULAR (SCENE_HAS_MATERIAL(MAT_MIRROR) || SCENE_HAS_MATERIAL(MAT_GLASS) || SCENE_HAS_MATERIAL(MAT_CONDUCTOR))
 
 #include "common/intersect.glsl"
 

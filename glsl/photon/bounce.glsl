@@ -6,14 +6,15 @@
 // shadow rays' job) and, when only specular-last photons are stored, a hit
 // reached straight from another diffuse one; they continue by Russian
 // roulette (or end, when the scene stores caustics only: every photon alive
-// at a diffuse hit then came by specular bounces alone); mirrors reflect; glass
-// reflects or refracts by exact Fresnel. On triangles with vertex normals,
+// at a diffuse hit then came by specular bounces alone); delta lobes
+// (common/bsdf.glsl) send it on: mirrors and metals reflect, glass reflects
+// or refracts by exact Fresnel. On triangles with vertex normals,
 // mirror and glass directions are taken about the shading normal, and the
 // power takes the adjoint's shading-normal correction (below).
 #include "common/scene.glsl"
 #include "common/photon_random.glsl"
 #include "common/sampling.glsl"
-#include "common/specular.glsl"
+#include "common/bsdf.glsl"
 
 uniform uint u_seed;
 uniform int u_store_direct;  // 1: store first hits too (tests of the flux)
@@ -33,13 +34,15 @@ PhotonRecord dead_photon() {
     return PhotonRecord(vec4(0.0, 0.0, 0.0, -1.0), vec4(0.0), vec4(0.0), vec4(0.0, 0.0, 0.0, -1.0));
 }
 
-// What the previous interaction multiplies the power by on the way out.
+// What the previous interaction multiplies the power by on the way out: a
+// diffuse lobe's albedo over the roulette's survival, a mirror's colour.
+// (A metal's Fresnel depends on the angle and is taken at the bounce.)
 vec3 leaving_factor(int mat) {
     if (mat < 0) return vec3(1.0); // emission
-    int kind = material_kind(mat);
-    vec3 color = material_texel(mat, 1).rgb;
-    if (kind == MAT_DIFFUSE) return color / max(color.r, max(color.g, color.b)); // roulette kept it
-    if (kind == MAT_MIRROR) return color;
+    Bsdf b = material_bsdf(mat);
+    vec3 color = b.color;
+    if (bsdf_is_diffuse(b)) return color / max(color.r, max(color.g, color.b)); // roulette kept it
+    if (b.kind == MAT_MIRROR) return color;
     return vec3(1.0);
 }
 
@@ -59,8 +62,8 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
     int prim = closest_hit(origin, d, hit);
     if (prim < 0) return r; // left the scene
     int mat = primitive_material(prim);
-    int kind = material_kind(mat);
-    if (kind == MAT_EMITTER) return r; // lights reflect nothing
+    Bsdf b = material_bsdf(mat);
+    if (b.kind == MAT_EMITTER) return r; // lights reflect nothing
     vec3 n;
     vec3 p = surface_point(prim, origin, d, hit, n);
     vec3 nf = dot(n, d) < 0.0 ? n : -n;
@@ -73,14 +76,14 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
     bool shaded = has_shading_normal(prim);
     vec3 ms = nf;
     if (shaded) ms = shading_normal(prim, p, n) * (dot(n, d) < 0.0 ? 1.0 : -1.0);
-    if (kind == MAT_DIFFUSE) {
+    if (bsdf_is_diffuse(b)) {
         stored = bounce >= 2 || u_store_direct != 0;
         int last_mat = int(last.position.w);
-        bool after_specular = last_mat >= 0 && material_kind(last_mat) != MAT_DIFFUSE;
+        bool after_specular = last_mat >= 0 && !bsdf_is_diffuse(material_bsdf(last_mat));
         if (u_specular_last_only != 0) stored = stored && after_specular;
-        vec3 albedo = material_texel(mat, 1).rgb;
+        vec3 albedo = b.color;
         alive = u_caustics_only == 0 && u0 < max(albedo.r, max(albedo.g, albedo.b));
-        next = sample_cosine(nf, u1, u2);
+        next = bsdf_sample(b, frame_around(nf), -d, vec2(u1, u2)).wi;
         // The adjoint BSDF with a shading normal (Veach 1997, 5.3): the
         // photon's power, stored here and carried on (its direction is
         // cosine-distributed about the geometric normal), is weighted by
@@ -93,17 +96,16 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
         }
     } else if (SCENE_HAS_SPECULAR) { // else no lane is here: only diffuse surfaces reflect
         bool entering = dot(n, d) < 0.0;
-        float ior = kind == MAT_MIRROR ? 0.0 : material_texel(mat, 0).y;
-        if (shaded) {
-            bool used;
-            next = specular_shaded(d, nf, ms, ior, entering, u0, used);
-            // The adjoint's correction for a specular bounce about n_s:
-            // |w_in . n_s| |w_out . n_g| / (|w_in . n_g| |w_out . n_s|).
+        vec3 factor;
+        bool used;
+        next = bsdf_delta_direction(b, d, nf, ms, shaded, entering, u0, false, factor, used);
+        // The adjoint's correction for a specular bounce about n_s:
+        // |w_in . n_s| |w_out . n_g| / (|w_in . n_g| |w_out . n_s|).
+        if (used) {
             float den = -dot(d, nf) * abs(dot(next, ms));
-            if (used) power *= den > 0.0 ? (-dot(d, ms) * abs(dot(next, nf))) / den : 0.0;
-        } else {
-            next = specular_about(d, nf, ior, entering, u0);
+            power *= den > 0.0 ? (-dot(d, ms) * abs(dot(next, nf))) / den : 0.0;
         }
+        if (b.kind == MAT_CONDUCTOR) power *= factor;
     }
     r.position = vec4(p, float(mat));
     r.power = vec4(power, stored ? 1.0 : 0.0);

@@ -26,6 +26,7 @@
 #include "common/scene.glsl"
 #include "common/sampling.glsl"
 #include "common/specular.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_position;
 uniform sampler2D u_power;
@@ -138,12 +139,12 @@ void main() {
         return; // absorbed here: nothing leaves
     }
     int mat = int(position.w);
-    int kind = material_kind(mat);
+    Bsdf b = material_bsdf(mat);
     vec3 next = outgoing.xyz;
-    if (kind == MAT_DIFFUSE) {
+    if (bsdf_is_diffuse(b)) {
         // Re-emission from a virtual origin v behind p (equation 13), the
         // old footprint first widened by the roulette (area / q).
-        vec3 albedo = material_texel(mat, 1).rgb;
+        vec3 albedo = b.color;
         float q = max(albedo.r, max(albedo.g, albedo.b));
         float v = sqrt(length(cross(dp[0], dp[1])) / q);
         vec3 t2[2];
@@ -159,7 +160,7 @@ void main() {
     // direction it gives is the one taken), reflected or refracted.
     vec3 m = nf;
     bool entering = dot(n, d) < 0.0;
-    float ior = kind == MAT_MIRROR ? 0.0 : material_texel(mat, 0).y;
+    float ior = b.kind == MAT_GLASS ? b.ior : 0.0; // mirrors and metals reflect
     bool reflected = dot(next, nf) > 0.0;
     if (has_shading_normal(prim)) {
         vec3 ms = shading_normal(prim, p, n) * side;

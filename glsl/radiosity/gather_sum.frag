@@ -4,6 +4,7 @@
 // back L_j = B / pi at its hit (lookup.frag, u_gathered at its texel).
 // src/twins/radiosity.rs (gathered_sum) is the twin.
 #include "common/scene.glsl"
+#include "common/bsdf.glsl"
 #include "common/gather_pixel.glsl"
 
 uniform sampler2D u_gathered;            // each ray's radiance from its hit

@@ -5,6 +5,7 @@
 // maximum radius held fewer) the whole search disc of the maximum radius.
 // Works on the running state too: the progressive image of section 3.4.
 #include "common/scene.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_direct;
 uniform sampler2D u_diffuse_normal;      // w = material + 1
@@ -27,7 +28,7 @@ void main() {
         vec4 flux = texelFetch(u_state_flux, px, 0);
         int accepted = texelFetch(u_state_cursor, px, 0).x;
         float r2 = accepted >= u_k ? flux.w : u_max_radius * u_max_radius;
-        vec3 albedo = material_texel(mat, 1).rgb;
+        vec3 albedo = material_bsdf(mat).color; // a diffuse lobe's albedo
         vec3 throughput = texelFetch(u_diffuse_throughput, px, 0).rgb;
         if (r2 > 0.0) l += throughput * albedo / PI * flux.rgb / (PI * r2);
     }

@@ -7,6 +7,7 @@
 // pixel's record is written once and the blend onto zero copies it. Later
 // batches of a depth draw into the radiance target alone.
 #include "common/direct_light.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_hit_position;
 uniform sampler2D u_hit_normal;
@@ -37,23 +38,23 @@ void main() {
     // blend's read and write of every target.
     if (hp.w < 0.0 || ht.w == 0.0) discard;
     int mat = int(hp.w);
-    int kind = material_kind(mat);
+    Bsdf b = material_bsdf(mat);
     vec3 d = texelFetch(u_hit_direction, px, 0).xyz;
     vec4 hn = texelFetch(u_hit_normal, px, 0);
     bool first_batch = u_sample_begin == 0;
 
-    if (kind == MAT_EMITTER) {
+    if (b.kind == MAT_EMITTER) {
         if (!first_batch) discard;
         o_radiance = vec4(ht.rgb * emitter_seen(mat, hn.xyz, d), 0.0);
         return;
     }
-    if (kind != MAT_DIFFUSE) discard;
+    if (!bsdf_is_diffuse(b)) discard;
     int prim = int(hn.w);
     vec3 nf;
     vec3 sum = direct_light(u_seed, uvec2(px), u_depth, hp.xyz, hn.xyz, d, prim, mat,
                               first_batch, u_sample_begin, u_sample_end, u_shadow_rays,
                               u_strata_x, u_light_sampling != 0, nf);
-    o_radiance = vec4(ht.rgb * (material_texel(mat, 1).rgb / PI) * sum, 0.0);
+    o_radiance = vec4(ht.rgb * bsdf_lambert(b) * sum, 0.0);
     if (first_batch) {
         o_diffuse_position = vec4(hp.xyz, 1.0);
         o_diffuse_normal = vec4(nf, float(mat + 1));

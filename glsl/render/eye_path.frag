@@ -1,6 +1,6 @@
 #version 450 core
-// A pixel's whole eye path in one pass: the eye ray, the stochastic mirror and
-// glass chain, emitters seen along it, and at its first diffuse hit every
+// A pixel's whole eye path in one pass: the eye ray, the stochastic chain of
+// delta lobes (mirror, glass, smooth metal; common/bsdf.glsl), emitters seen along it, and at its first diffuse hit every
 // shadow ray and the visible point's record. It computes what the pass per
 // bounce does (eye_rays, then per depth intersect, direct and specular), with
 // the same functions and random streams, so the two give the same image to
@@ -43,18 +43,18 @@ void main() {
         if (prim < 0) return; // background radiance is zero
         p = surface_point(prim, o, d, hit, n);
         mat = primitive_material(prim);
-        int kind = material_kind(mat);
-        if (kind == MAT_EMITTER) {
+        Bsdf b = material_bsdf(mat);
+        if (b.kind == MAT_EMITTER) {
             o_radiance = vec4(throughput * emitter_seen(mat, n, d), 0.0);
             return;
         }
-        if (kind == MAT_DIFFUSE) {
+        if (bsdf_is_diffuse(b)) {
             diffuse = true;
             break;
         }
-        if (!SCENE_HAS_SPECULAR || (kind != MAT_MIRROR && kind != MAT_GLASS)) return;
+        if (!SCENE_HAS_SPECULAR || !bsdf_is_delta(b)) return;
         vec3 next_origin, next;
-        specular_step(u_seed, px, depth, p, n, d, prim, mat, kind, throughput, next_origin, next);
+        specular_step(u_seed, px, depth, p, n, d, prim, b, throughput, next_origin, next);
         o = next_origin;
         d = next;
     }
@@ -63,7 +63,7 @@ void main() {
     vec3 sum = direct_light(u_seed, px, depth, p, n, d, prim, mat, true, 0,
                             u_shadow_rays, u_shadow_rays, u_strata_x,
                             u_light_sampling != 0, nf);
-    o_radiance = vec4(throughput * (material_texel(mat, 1).rgb / PI) * sum, 0.0);
+    o_radiance = vec4(throughput * bsdf_lambert(material_bsdf(mat)) * sum, 0.0);
     o_diffuse_position = vec4(p, 1.0);
     o_diffuse_normal = vec4(nf, float(mat + 1));
     o_diffuse_throughput = vec4(throughput, float(prim));

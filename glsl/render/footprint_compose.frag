@@ -2,6 +2,7 @@
 // Reflected indirect light from the footprint estimate:
 // L = throughput x albedo / pi x sum (the irradiance the footprints give).
 #include "common/scene.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_state_sum;
 uniform sampler2D u_diffuse_normal;      // w = material + 1
@@ -14,7 +15,7 @@ void main() {
     int mat = int(texelFetch(u_diffuse_normal, px, 0).w) - 1;
     vec3 l = vec3(0.0);
     if (mat >= 0) {
-        vec3 albedo = material_texel(mat, 1).rgb;
+        vec3 albedo = material_bsdf(mat).color; // a diffuse lobe's albedo
         l = texelFetch(u_diffuse_throughput, px, 0).rgb * albedo / PI * texelFetch(u_state_sum, px, 0).rgb;
     }
     o_radiance = vec4(l, 0.0);

@@ -6,6 +6,7 @@
 // indirect light is throughput_1 * albedo_1 * mean(L) over all its rays, so
 // each adds throughput_1 * albedo_1 * L / u_total_rays.
 #include "common/scene.glsl"
+#include "common/bsdf.glsl"
 #include "common/gather_pixel.glsl"
 
 uniform sampler2D u_gather_normal;       // the gather hits, w = material + 1
@@ -31,7 +32,7 @@ void main() {
         int accepted = texelFetch(u_state_cursor, g, 0).x;
         float r2 = accepted >= u_k ? flux.w : u_max_radius * u_max_radius;
         if (r2 <= 0.0) continue;
-        vec3 albedo = material_texel(mat, 1).rgb;
+        vec3 albedo = material_bsdf(mat).color; // a diffuse lobe's albedo
         vec3 throughput = texelFetch(u_gather_throughput, g, 0).rgb;
         sum += throughput * albedo / PI * flux.rgb / (PI * r2);
     }

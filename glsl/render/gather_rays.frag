@@ -23,6 +23,7 @@
 #include "common/specular.glsl"
 #include "common/addressing.glsl"
 #include "common/vpl_bound.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_diffuse_position;   // the pixel's first diffuse hit, w = 1 where one exists
 uniform sampler2D u_diffuse_normal;     // facing the viewer, w = material + 1
@@ -63,42 +64,34 @@ void main() {
         int prim = closest_hit(o, d, hit);
         if (prim < 0) return;
         int mat = primitive_material(prim);
-        int kind = material_kind(mat);
-        if (kind == MAT_EMITTER) return;
+        Bsdf b = material_bsdf(mat);
+        if (b.kind == MAT_EMITTER) return;
         vec3 n;
         vec3 p = surface_point(prim, o, d, hit, n);
         bool entering = dot(n, d) < 0.0;
         vec3 nf = entering ? n : -n;
         if (u_fade_distance > 0.0) {
-            if (kind != MAT_DIFFUSE) return;
+            if (!bsdf_is_diffuse(b)) return;
             float left_out = 1.0 - vpl_bound(length(p - first.xyz), u_fade_distance);
             if (left_out <= 0.0) return;
             throughput = vec3(left_out);
         }
-        if (kind == MAT_DIFFUSE) {
+        if (bsdf_is_diffuse(b)) {
             o_position = vec4(p, 1.0);
             o_normal = vec4(nf, float(mat + 1));
             o_throughput = vec4(throughput, float(prim));
             return;
         }
-        float ior = 0.0;
-        float u = 0.0;
-        if (kind == MAT_MIRROR) {
-            throughput *= material_texel(mat, 1).rgb;
-        } else {
-            ior = material_texel(mat, 0).y;
-            u = rng_next(rng);
-        }
-        vec3 next;
-        if (has_shading_normal(prim)) {
-            vec3 ms = shading_normal(prim, p, n) * (entering ? 1.0 : -1.0);
-            bool used;
-            next = specular_shaded(d, nf, ms, ior, entering, u, used);
-        } else {
-            next = specular_about(d, nf, ior, entering, u);
-        }
+        if (!bsdf_is_delta(b)) return;
+        float u = b.kind == MAT_GLASS ? rng_next(rng) : 0.0;
+        bool shaded = has_shading_normal(prim);
+        vec3 ms = nf;
+        if (shaded) ms = shading_normal(prim, p, n) * (entering ? 1.0 : -1.0);
         // A gather ray carries radiance back to the pixel, as an eye path does.
-        throughput *= radiance_refraction_scale(next, nf, ior, entering);
+        vec3 factor;
+        bool used;
+        vec3 next = bsdf_delta_direction(b, d, nf, ms, shaded, entering, u, true, factor, used);
+        throughput *= factor;
         d = normalize(next);
         o = offset_origin(p, nf, d);
     }

@@ -12,6 +12,7 @@
 // throughput x albedo / pi x E (with u_scale = 1 this is all the pass does).
 #include "common/scene.glsl"
 #include "render/igi_shading.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_incident;            // low (or full) resolution
 uniform sampler2D u_diffuse_position;    // full resolution, w = 1 where a hit
@@ -66,6 +67,6 @@ void main() {
             e = texelFetch(u_incident, q, 0).rgb;
         }
     }
-    vec3 albedo = material_texel(mat, 1).rgb;
+    vec3 albedo = material_bsdf(mat).color; // a diffuse lobe's albedo
     o_radiance = vec4(texelFetch(u_diffuse_throughput, px, 0).rgb * albedo / PI * e, 0.0);
 }

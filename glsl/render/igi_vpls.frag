@@ -10,6 +10,7 @@
 // I cos(theta_y) cos(theta_x) / d^2 (times the albedo at x over pi).
 #include "common/scene.glsl"
 #include "common/addressing.glsl"
+#include "common/bsdf.glsl"
 
 uniform isampler2D u_pairs;       // (cell, record) of each stored record, compacted
 uniform isampler2D u_order;       // VPL slot -> its pair (a random permutation)
@@ -40,7 +41,7 @@ void main() {
     // (its stored power already carries the shading normal's adjoint weight).
     vec3 n = geometric_normal(prim, p.xyz);
     if (dot(n, texelFetch(u_incoming, r, 0).xyz) > 0.0) n = -n;
-    vec3 albedo = material_texel(int(p.w), 1).rgb;
+    vec3 albedo = material_bsdf(int(p.w)).color; // a diffuse lobe's albedo
     o_position = vec4(p.xyz, 1.0);
     o_normal = vec4(n, 0.0);
     o_intensity = vec4(texelFetch(u_power, r, 0).rgb * albedo / PI, 0.0);

@@ -1,5 +1,6 @@
 #version 450 core
-// The next ray of each eye path at a mirror or glass hit of this depth
+// The next ray of each eye path at a hit of this depth whose BSDF has a
+// delta lobe (mirror, glass, smooth metal)
 // (common/specular_step.glsl).
 #include "common/specular_step.glsl"
 
@@ -22,15 +23,14 @@ void main() {
     vec4 hp = texelFetch(u_hit_position, px, 0);
     vec4 ht = texelFetch(u_hit_throughput, px, 0);
     if (hp.w < 0.0 || ht.w == 0.0) return;
-    int mat = int(hp.w);
-    int kind = material_kind(mat);
-    if (kind != MAT_MIRROR && kind != MAT_GLASS) return;
+    Bsdf b = material_bsdf(int(hp.w));
+    if (!bsdf_is_delta(b)) return;
     vec3 d = texelFetch(u_hit_direction, px, 0).xyz;
     vec4 hn = texelFetch(u_hit_normal, px, 0);
     vec3 throughput = ht.rgb;
     vec3 origin, next;
-    specular_step(u_seed, uvec2(px), u_depth, hp.xyz, hn.xyz, d, int(hn.w), mat, kind,
-                  throughput, origin, next);
+    specular_step(u_seed, uvec2(px), u_depth, hp.xyz, hn.xyz, d, int(hn.w), b, throughput,
+                  origin, next);
     o_ray_origin = vec4(origin, 1.0);
     o_ray_direction = vec4(next, 0.0);
     o_ray_throughput = vec4(throughput, 0.0);

@@ -16,6 +16,7 @@
 // (VISIBILITY_TEST, DISC_TEST) may restrict the gather too; as R shrinks to
 // zero they change nothing, so SPPM stays consistent with them.
 #include "render/sppm_gather.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_state_flux;         // tau.rgb, R^2
 uniform sampler2D u_state_direct;       // direct-light sum .rgb, N
@@ -51,7 +52,7 @@ void main() {
     float m;
     sppm_gather(vp.xyz, nm.xyz, r2, gathered, m);
     if (m > 0.0) {
-        vec3 albedo = material_texel(mat, 1).rgb;
+        vec3 albedo = material_bsdf(mat).color; // a diffuse lobe's albedo
         vec3 phi = texelFetch(u_diffuse_throughput, px, 0).rgb * (albedo / PI) * gathered;
         float g = (n_count + u_alpha * m) / (n_count + m);
         flux.rgb = (flux.rgb + phi) * g;

@@ -182,8 +182,8 @@ void main() {
         float cos_in = abs(dot(n, d));
         camera = mis_arrive(camera, distance(o, p), cos_in, true);
         int mat = primitive_material(prim);
-        int kind = material_kind(mat);
-        if (kind == MAT_EMITTER) {
+        Bsdf bsdf = material_bsdf(mat);
+        if (bsdf.kind == MAT_EMITTER) {
             // Seen directly, a light is this technique's alone; light tracing
             // and photon mapping see it only through mirrors and glass.
             float w = 1.0;
@@ -204,16 +204,16 @@ void main() {
         }
         vec3 nf = dot(n, d) < 0.0 ? n : -n;
         uint rng = rng_init(u_seed, px, VCM_CAMERA_STREAM | uint(segments));
-        if (kind == MAT_DIFFUSE) {
+        if (bsdf_is_diffuse(bsdf)) {
             if (VCM_MODE == VCM_MODE_LT) break; // light tracing sees diffuse surfaces itself
-            vec3 a = material_texel(mat, 1).rgb;
+            vec3 a = bsdf.color;
             float q_light = continuation(a);
             // Path tracing alone waits before its roulette (a long path is
             // cheaper than its variance); with connections the camera's
             // continuation must be the vertex's alone (src/layout.rs).
             float q = VCM_MODE == VCM_MODE_PT && segments < VCM_PT_ROULETTE_FROM
                     ? 1.0 : camera_continuation(q_light);
-            vec3 brdf = a / PI;
+            vec3 brdf = bsdf_lambert(bsdf);
             if (VCM_MODE == VCM_MODE_PPM) {
                 if (u_merge != 0) merging += throughput * merge(p, nf, a, q, q_light, cos_in, camera, segments);
                 break;
@@ -242,7 +242,7 @@ void main() {
             // Continue by Russian roulette and a cosine-distributed direction.
             if (rng_next(rng) >= q) break;
             float u1 = rng_next(rng), u2 = rng_next(rng);
-            vec3 next = sample_cosine(nf, u1, u2);
+            vec3 next = bsdf_sample(bsdf, frame_around(nf), -d, vec2(u1, u2)).wi;
             float cos_out = dot(nf, next);
             if (cos_out <= 0.0) break;
             camera = VCM_MODE == VCM_MODE_PT ? vec3(1.0 / (q * cos_out / PI), 0.0, 0.0)
@@ -253,9 +253,9 @@ void main() {
             d = next;
             continue;
         }
-        if (!SCENE_HAS_SPECULAR || (kind != MAT_MIRROR && kind != MAT_GLASS)) break;
+        if (!SCENE_HAS_SPECULAR || !bsdf_is_delta(bsdf)) break;
         vec3 next_origin, next;
-        specular_step(u_seed, px, segments, p, n, d, prim, mat, kind, throughput, next_origin, next);
+        specular_step(u_seed, px, segments, p, n, d, prim, bsdf, throughput, next_origin, next);
         camera = mis_scatter_specular(camera, abs(dot(n, next)));
         o = next_origin;
         d = next;

@@ -10,6 +10,7 @@
 // recurrences.
 #include "common/scene.glsl"
 #include "vcm/mis.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_position;
 uniform sampler2D u_power;
@@ -66,8 +67,9 @@ void main() {
         if (incoming.w == 0.0) return; // absorbed
         int mat = int(position.w);
         float cos_out = abs(dot(n, outgoing.xyz));
-        if (material_kind(mat) == MAT_DIFFUSE) {
-            vec3 albedo = material_texel(mat, 1).rgb;
+        Bsdf bsdf = material_bsdf(mat);
+        if (bsdf_is_diffuse(bsdf)) {
+            vec3 albedo = bsdf.color;
             float q = max(albedo.r, max(albedo.g, albedo.b));
             partials = mis_scatter(partials, cos_out, q * cos_out / PI,
                                    camera_continuation(q) * cos_in / PI);

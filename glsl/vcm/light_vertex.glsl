@@ -6,6 +6,7 @@
 // vcm/camera_path.frag and vcm/light_connect.frag read them.
 #include "common/scene.glsl"
 #include "common/addressing.glsl"
+#include "common/bsdf.glsl"
 
 uniform sampler2D u_lv_position;  // xyz, w = material (-1: on the light)
 uniform sampler2D u_lv_power;     // rgb arriving, w = 1 stored (a diffuse hit)
@@ -41,7 +42,7 @@ bool light_vertex(ivec2 texel, out LightVertex v) {
     v.incoming = texelFetch(u_lv_incoming, texel, 0).xyz;
     v.power = power.rgb * u_lv_power_scale;
     v.partials = partials.xyz;
-    v.albedo = material_texel(int(position.w), 1).rgb;
+    v.albedo = material_bsdf(int(position.w)).color; // a diffuse lobe's albedo
     v.segments = int(partials.w);
     return true;
 }

@@ -2,6 +2,7 @@
 //! compiled only with the `twins` feature (the package's own tests enable it).
 
 pub mod adaptive;
+pub mod bsdf;
 pub mod bvh;
 pub mod differentials;
 pub mod final_gather;

@@ -9,6 +9,7 @@ mod common;
 mod adaptive;
 mod bias_compensation;
 mod bit_identical;
+mod bsdf;
 mod bvh;
 mod caustic_footprints;
 mod differentials;
