@@ -4,7 +4,7 @@
 
 /// Texels per row of each packed-scene texture (src/scene/pack.rs).
 pub const PRIMITIVE_TEXELS: u32 = 4;
-pub const MATERIAL_TEXELS: u32 = 3;
+pub const MATERIAL_TEXELS: u32 = 4;
 /// Primitive records in one row of the primitive texture (so its width is
 /// PRIMITIVE_TEXELS x this, and its height grows by one per this many).
 pub const PRIMITIVES_PER_ROW: u32 = 1024;

@@ -36,6 +36,8 @@
 #define SCENE_HAS_LIGHT(kind) (((SCENE_LIGHTS >> kind) & 1) != 0)
 // Whether any surface reflects other than diffusely (mirror, glass, metal).
 #define SCENE_HAS_SPECULAR (SCENE_HAS_MATERIAL(MAT_MIRROR) || SCENE_HAS_MATERIAL(MAT_GLASS) || SCENE_HAS_MATERIAL(MAT_CONDUCTOR))
+// Whether a surface may have a glossy lobe (a metal, if rough).
+#define SCENE_HAS_GLOSSY SCENE_HAS_MATERIAL(MAT_CONDUCTOR)
 
 #include "common/intersect.glsl"
 

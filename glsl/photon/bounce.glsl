@@ -94,6 +94,19 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
             float cos_g = -dot(nf, d);
             power *= cos_g > 0.0 ? max(-dot(ms, d), 0.0) / cos_g : 0.0;
         }
+    } else if (SCENE_HAS_GLOSSY && bsdf_lobes(b) == BSDF_GLOSSY) {
+        // A rough metal: not stored; on along a sample of the lobe about the
+        // shading normal, the power times its weight (a reflection-only
+        // microfacet BRDF is symmetric, so the adjoint is itself), with the
+        // adjoint's shading-normal correction as at a specular bounce.
+        BsdfSample s = bsdf_sample(b, frame_around(ms), -d, vec2(u1, u2));
+        alive = s.lobe != 0 && dot(s.wi, nf) > 0.0;
+        next = alive ? s.wi : d;
+        power *= alive ? s.weight : vec3(0.0);
+        if (shaded && alive) {
+            float den = -dot(d, nf) * abs(dot(next, ms));
+            power *= den > 0.0 ? (-dot(d, ms) * abs(dot(next, nf))) / den : 0.0;
+        }
     } else if (SCENE_HAS_SPECULAR) { // else no lane is here: only diffuse surfaces reflect
         bool entering = dot(n, d) < 0.0;
         vec3 factor;

@@ -360,7 +360,8 @@ impl RenderOutput {
                     "a pixel's whole eye path in one pass a sample: the eye ray, {}, and {} at its first diffuse hit (`--faithful`: a pass per bounce)",
                     if p.specular {
                         format!(
-                            "the mirror and glass chain to specular depth {}",
+                            "the chain of {} to specular depth {}",
+                            surfaces_followed(scene),
                             scene.render.max_specular_depth
                         )
                     } else {
@@ -549,4 +550,30 @@ fn caustic_map(paths: CausticPaths) -> &'static str {
         CausticPaths::All => "the photon map above, if any, is a caustic map of every path onto a diffuse surface from a mirror or glass (L (S|D)* S D), including light a diffuse surface sends through them (L D+ S+ D)",
         CausticPaths::FromLights => "the photon map above, if any, is Jensen's caustic map, light straight from an emitter through mirrors and glass (L S+ D); light from a diffuse surface through a mirror or glass onto another (L D+ S+ D) is missing (--caustic-paths all carries it)",
     }
+}
+
+/// What the fused eye path does at each kind of non-diffuse surface the
+/// scene holds (common/bsdf.glsl's lobes).
+fn surfaces_followed(scene: &Scene) -> String {
+    use crate::scene::Material;
+    let has = |f: &dyn Fn(&Material) -> bool| {
+        scene.shapes.iter().any(|s| f(&scene.materials[s.material]))
+    };
+    let mut kinds = vec![];
+    if has(&|m| matches!(m, Material::Mirror { .. })) {
+        kinds.push("mirrors (reflected)");
+    }
+    if has(&|m| matches!(m, Material::Glass { .. })) {
+        kinds.push("glass (reflected or refracted by Fresnel)");
+    }
+    if has(&|m| matches!(m, Material::Conductor { .. }) && !m.is_glossy()) {
+        kinds.push("smooth metals (reflected, times their Fresnel)");
+    }
+    if has(&|m| m.is_glossy()) {
+        kinds.push(
+            "rough metals (shadow rays weighted by the BSDF, then a sample of the lobe, \
+             combined by the balance heuristic)",
+        );
+    }
+    kinds.join(", ")
 }

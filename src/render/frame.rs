@@ -53,6 +53,7 @@ pub fn render_views(
     observer: &mut dyn RenderObserver,
 ) -> Result<RenderOutput> {
     check_request(gpu, options, cameras)?;
+    options.check_materials(scene)?;
     let observer = &mut Cropped {
         inner: observer,
         options,

@@ -71,6 +71,14 @@ pub const MIN_PROJECTION_RESOLUTION: u32 = 4;
 pub const MAX_PROJECTION_RESOLUTION: u32 = 128;
 /// A glass material's `ior`, inclusive.
 pub const IOR_RANGE: (f32, f32) = (1.0, 10.0);
+/// A conductor's Trowbridge-Reitz `alpha`, inclusive; below
+/// `SMOOTH_ALPHA` the surface is smooth (a delta lobe), as pbrt-v4 treats
+/// an alpha under 1e-3 ("effectively smooth").
+pub const ALPHA_RANGE: (f32, f32) = (0.0, 1.0);
+pub const SMOOTH_ALPHA: f32 = 1e-3;
+/// A conductor's `eta` and `k` per channel, inclusive (measured metals lie
+/// well inside: Mitsuba's tables run from eta 0.03 to 5 and k 0 to 10).
+pub const CONDUCTOR_INDEX_RANGE: (f32, f32) = (0.0, 100.0);
 /// Every coordinate stays within this magnitude.
 pub const MAX_COORDINATE: f32 = 1e15;
 

@@ -9,6 +9,7 @@ pub mod file;
 pub mod generate;
 pub mod import;
 pub mod load;
+pub mod metals;
 pub mod obj;
 pub mod pack;
 pub mod rebase;
@@ -50,6 +51,16 @@ pub enum Material {
     Mirror { reflectance: Vec3 },
     /// Smooth dielectric in air, exact unpolarised Fresnel, no absorption.
     Glass { ior: f32 },
+    /// A metal, both sides: exact unpolarised Fresnel of the complex index
+    /// eta + i k (per channel), times `tint`. `alpha` 0: smooth (a delta
+    /// lobe, as a mirror); above 0: rough, an isotropic Trowbridge-Reitz
+    /// (GGX) microfacet lobe of that alpha (glsl/common/bsdf.glsl).
+    Conductor {
+        eta: Vec3,
+        k: Vec3,
+        tint: Vec3,
+        alpha: f32,
+    },
     /// An area light's surface: emits `radiance` on the side of `normal`, reflects
     /// nothing. `normal` None: each primitive's front face, the side of its
     /// geometric normal (e1 x e2; counter-clockwise winding), as for the
@@ -61,8 +72,32 @@ pub enum Material {
 }
 
 impl Material {
+    /// Whether it reflects or refracts other than diffusely: mirrors,
+    /// glass and metals, smooth or rough. Photons that leave it make
+    /// caustics, and projection maps aim at it.
     pub fn is_specular(&self) -> bool {
-        matches!(self, Material::Mirror { .. } | Material::Glass { .. })
+        matches!(
+            self,
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Conductor { .. }
+        )
+    }
+
+    /// Whether it has a glossy lobe (a rough metal): sampled and evaluated,
+    /// neither a visible point nor one direction.
+    pub fn is_glossy(&self) -> bool {
+        matches!(self, Material::Conductor { alpha, .. } if *alpha > 0.0)
+    }
+
+    /// Its name in the scene format (`type = ...`), for messages.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Material::Diffuse { .. } => "diffuse",
+            Material::Mirror { .. } => "mirror",
+            Material::Glass { .. } => "glass",
+            Material::Conductor { alpha, .. } if *alpha > 0.0 => "rough conductor",
+            Material::Conductor { .. } => "conductor",
+            Material::Emitter { .. } => "emitter",
+        }
     }
 }
 
@@ -341,6 +376,14 @@ impl Scene {
         let mut s = self.clone();
         s.photon_map.max_bounces = bounces;
         s
+    }
+
+    /// The first shape's material with a glossy lobe (a rough metal).
+    pub fn glossy_material(&self) -> Option<&Material> {
+        self.shapes
+            .iter()
+            .map(|s| &self.materials[s.material])
+            .find(|m| m.is_glossy())
     }
 
     pub fn has_specular(&self) -> bool {

@@ -4,9 +4,9 @@ use crate::error::Error;
 use crate::gpu::{Gpu, Result, TexFormat, Texture, UniformBlock};
 use crate::layout::{
     BVH_ROW_TEXELS, LIGHT_AREA, LIGHT_POINT, LIGHT_TEXELS, LIGHT_TRIANGLES,
-    LIGHT_TRIANGLE_ROW_TEXELS, MATERIAL_TEXELS, MAT_DIFFUSE, MAT_EMITTER, MAT_GLASS, MAT_MIRROR,
-    NORMALS_PER_ROW, NORMAL_TEXELS, PRIMITIVES_PER_ROW, PRIMITIVE_TEXELS, PRIM_CYLINDER,
-    PRIM_PARALLELOGRAM, PRIM_SPHERE, PRIM_TRIANGLE,
+    LIGHT_TRIANGLE_ROW_TEXELS, MATERIAL_TEXELS, MAT_CONDUCTOR, MAT_DIFFUSE, MAT_EMITTER, MAT_GLASS,
+    MAT_MIRROR, NORMALS_PER_ROW, NORMAL_TEXELS, PRIMITIVES_PER_ROW, PRIMITIVE_TEXELS,
+    PRIM_CYLINDER, PRIM_PARALLELOGRAM, PRIM_SPHERE, PRIM_TRIANGLE,
 };
 
 use super::bvh::FlatBvh;
@@ -204,26 +204,38 @@ impl PackedScene {
     }
 }
 
-/// A material's MATERIAL_TEXELS texels: (kind, ior), colour, and an
-/// emitter's normal (.w = 1: each primitive's front face instead).
-fn pack_material(m: &Material) -> [[f32; 4]; 3] {
+/// A material's MATERIAL_TEXELS texels, as glsl/common/bsdf.glsl's
+/// `material_bsdf` and direct light read them: (kind, ior, alpha, alpha),
+/// colour (albedo, reflectance, a metal's tint or an emitter's radiance),
+/// then a metal's eta and k, or an emitter's normal (.w = 1: each
+/// primitive's front face instead).
+fn pack_material(m: &Material) -> [[f32; 4]; MATERIAL_TEXELS as usize] {
     let z = glam::Vec3::ZERO;
-    let (kind, ior, color, normal, own_face) = match *m {
-        Material::Diffuse { albedo } => (MAT_DIFFUSE, 1.0, albedo, z, 0.0),
-        Material::Mirror { reflectance } => (MAT_MIRROR, 1.0, reflectance, z, 0.0),
-        Material::Glass { ior } => (MAT_GLASS, ior, glam::Vec3::ONE, z, 0.0),
+    let (kind, ior, alpha, color, third, fourth, own_face) = match *m {
+        Material::Diffuse { albedo } => (MAT_DIFFUSE, 1.0, 0.0, albedo, z, z, 0.0),
+        Material::Mirror { reflectance } => (MAT_MIRROR, 1.0, 0.0, reflectance, z, z, 0.0),
+        Material::Glass { ior } => (MAT_GLASS, ior, 0.0, glam::Vec3::ONE, z, z, 0.0),
+        Material::Conductor {
+            eta,
+            k,
+            tint,
+            alpha,
+        } => (MAT_CONDUCTOR, 1.0, alpha, tint, eta, k, 0.0),
         Material::Emitter { radiance, normal } => (
             MAT_EMITTER,
             1.0,
+            0.0,
             radiance,
             normal.unwrap_or(z),
+            z,
             f32::from(normal.is_none()),
         ),
     };
     [
-        [kind as f32, ior, 0.0, 0.0],
+        [kind as f32, ior, alpha, alpha],
         [color.x, color.y, color.z, 0.0],
-        [normal.x, normal.y, normal.z, own_face],
+        [third.x, third.y, third.z, own_face],
+        [fourth.x, fourth.y, fourth.z, 0.0],
     ]
 }
 

@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use crate::scene::{Material, Scene};
 
+use super::bsdf::fresnel_conductor;
 use super::knn::{knn_grid, CpuPhotonMap};
 use super::random::{rng_init, rng_next};
 use super::ray_trace::{closest_hit, offset_scale};
@@ -81,14 +82,21 @@ pub fn gather_ray(
                 0.0
             }
             Material::Glass { ior } => ior,
+            // A rough metal ends the ray (final gather refuses such scenes).
+            Material::Conductor { alpha, .. } if alpha > 0.0 => return None,
+            Material::Conductor { .. } => 0.0,
         };
         let u = if ior > 0.0 { rng_next(&mut rng) } else { 0.0 };
-        let next = if scene.shapes[shape].normals.is_some() {
-            let ms = facing_shading_normal(&scene.shapes[shape], p, n, d);
-            specular_shaded(d, nf, ms, ior, entering, u).0
+        let ms = facing_shading_normal(&scene.shapes[shape], p, n, d);
+        let (next, used) = if scene.shapes[shape].normals.is_some() {
+            specular_shaded(d, nf, ms, ior, entering, u)
         } else {
-            specular_about(d, nf, ior, entering, u)
+            (specular_about(d, nf, ior, entering, u), false)
         };
+        if let Material::Conductor { eta, k, tint, .. } = scene.materials[material] {
+            let m = if used { ms } else { nf };
+            throughput *= tint * fresnel_conductor((-d.dot(m)).min(1.0), eta, k);
+        }
         throughput *= radiance_refraction_scale(next, nf, ior, entering);
         let next = next.normalize();
         d = next;

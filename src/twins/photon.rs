@@ -2,12 +2,13 @@
 //! numbers (the same hash of the same streams), and stencil routing simulated
 //! in draw order.
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::photon::projection::{ProjectionMaps, ProjectionTexels};
 use crate::scene::pack::PackedScene;
 use crate::scene::{Material, Scene};
 
+use super::bsdf::{fresnel_conductor, sample as bsdf_sample, Bsdf, Frame};
 use super::intersect::intersect_geometry;
 use super::light::sample_light_triangle;
 use super::random::{rng_init, rng_next};
@@ -193,21 +194,42 @@ pub fn bounce(
             }
             sample_cosine(nf, u1, u2)
         }
-        Material::Mirror { .. } | Material::Glass { .. } => {
+        Material::Conductor {
+            eta,
+            k,
+            tint,
+            alpha,
+        } if alpha > 0.0 => {
+            let b = Bsdf::conductor(tint, eta, k, Vec2::splat(alpha));
+            let s = bsdf_sample(&b, &Frame::around(ms), -d, Vec2::new(u1, u2));
+            alive = s.lobe != 0 && s.wi.dot(nf) > 0.0;
+            let next = if alive { s.wi } else { d };
+            power *= if alive { s.weight } else { Vec3::ZERO };
+            if shaded && alive {
+                power *= specular_adjoint(d, next, nf, ms);
+            }
+            next
+        }
+        Material::Mirror { .. } | Material::Glass { .. } | Material::Conductor { .. } => {
             let ior = match material {
                 Material::Glass { ior } => ior,
                 _ => 0.0,
             };
             let entering = n.dot(d) < 0.0;
-            if shaded {
+            let (next, used) = if shaded {
                 let (next, used) = specular_shaded(d, nf, ms, ior, entering, u0);
                 if used {
                     power *= specular_adjoint(d, next, nf, ms);
                 }
-                next
+                (next, used)
             } else {
-                specular_about(d, nf, ior, entering, u0)
+                (specular_about(d, nf, ior, entering, u0), false)
+            };
+            if let Material::Conductor { eta, k, tint, .. } = material {
+                let m = if used { ms } else { nf };
+                power *= tint * fresnel_conductor((-d.dot(m)).min(1.0), eta, k);
             }
+            next
         }
         Material::Emitter { .. } => unreachable!(),
     };

@@ -300,3 +300,37 @@ fn faithful_keeps_the_pass_per_bounce_and_the_image() {
         std::fs::read(&passes_png).unwrap()
     );
 }
+
+/// A rough metal renders where the fused eye paths follow it (the explain
+/// line says how), and every other method refuses it by name, writing
+/// nothing.
+#[test]
+fn a_rough_metal_renders_by_the_fused_eye_paths_and_is_refused_elsewhere() {
+    let d = TempDir::new("rough_metal");
+    let explained = Run::new(["render", "--width", "32", "--height", "32", "--explain"])
+        .scene("tests/metal_box")
+        .output_to(d.join("paper.png"))
+        .stderr();
+    assert!(
+        explained.contains("rough metals (shadow rays weighted by the BSDF"),
+        "{explained}"
+    );
+    assert!(
+        explained.contains("smooth metals (reflected, times their Fresnel)"),
+        "{explained}"
+    );
+    for refused in [
+        vec!["--method", "vcm"],
+        vec!["--method", "igi"],
+        vec!["--final-gather", "4"],
+        vec!["--faithful"],
+    ] {
+        let out = d.join("refused.png");
+        let said = Run::new(["render", "--width", "32", "--height", "32"])
+            .args(refused.clone())
+            .scene("tests/metal_box")
+            .output_to(&out)
+            .refused_with("cannot render a rough conductor (alpha 0.2)");
+        assert!(!out.exists(), "{refused:?} wrote {}: {said}", out.display());
+    }
+}

@@ -131,6 +131,32 @@ fn stochastic_fresnel_choice_converges_to_the_split_tree() {
     );
 }
 
+/// GLASS BALL's geometry under a point light with the ball a smooth metal
+/// (`metal` of src/scene/metals.rs): every path is deterministic.
+fn metal_scene(metal: &str) -> Scene {
+    let text = common::replace_once(
+        &common::fixture_text("glass_point"),
+        "glass = { type = \"glass\", ior = 1.5 }",
+        &format!("glass = {{ type = \"conductor\", metal = \"{metal}\" }}"),
+    );
+    load_scene_str(&text, &common::fixture_file("glass_point")).unwrap()
+}
+
+/// A smooth metal reflects by its exact complex Fresnel (the BSDF layer's
+/// delta lobe): the GPU image meets the twin's expectation in every
+/// well-conditioned pixel, and is told apart from another metal's.
+#[test]
+fn a_smooth_metal_reflects_by_its_fresnel() {
+    let scene = metal_scene("Au");
+    let images = direct_renders(&scene, 1..3);
+    assert_converges_to_split_tree(
+        &images,
+        (&scene, "gold's Fresnel"),
+        (&metal_scene("Cu"), "copper's"),
+        0.9,
+    );
+}
+
 /// A surface seen only through glass (a diffuse square and a point light
 /// sealed in a glass ball) is dimmer by radiance's 1 / ior^2 where the eye
 /// path enters: the GPU's mean over seeds meets the twin's split tree with

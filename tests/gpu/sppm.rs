@@ -368,6 +368,54 @@ fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
     );
 }
 
+/// CORNELL BOX with a rough gold sphere (Trowbridge-Reitz alpha 0.2) and a
+/// smooth aluminium one (`scenes/tests/metal_box.toml` at 32 x 32, a quarter
+/// of its size) against Mitsuba 3's path tracer (`roughconductor`, GGX;
+/// `conductor`): the reference is two independent 90 s runs
+/// (`reference_images/metal_box/`). The gold sphere is seen by the eye
+/// paths' glossy step (shadow rays weighted by the BSDF and a sample of the
+/// lobe, by the balance heuristic), and lights the floor by photons that
+/// left it by sampling. Block by block (4 x 4 pixels), SPPM's mean over 8
+/// seeds must meet the reference within the bound `block_chi2` derives from
+/// the seeds' spread, and the image's energy must lie within 1% and within
+/// 4 standard errors.
+#[test]
+fn rough_and_smooth_metals_meet_mitsubas_path_tracer() {
+    let scene = common::paper_scene("tests/metal_box");
+    let run = |k: u32| {
+        let path = common::root().join(format!("reference_images/metal_box/reference_run{k}.exr"));
+        Image::read_exr(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    };
+    let runs = [run(1), run(2)];
+    let (w, h) = (runs[0].width, runs[0].height);
+    let sppm = SppmOptions {
+        iterations: 32,
+        photons_per_iteration: 1 << 13,
+        initial_radius: Some(0.03),
+        ..SppmOptions::default()
+    };
+    let t0 = std::time::Instant::now();
+    let images: Vec<Image> = (1..=8)
+        .map(|seed| sppm_image(&scene, w, h, seed, &sppm))
+        .collect();
+    let seconds = t0.elapsed().as_secs_f64();
+    let (chi2, blocks, bound) = common::block_chi2_against_runs(&images, [&runs[0], &runs[1]], 4);
+    let reference = 0.5 * (mean_of(&runs[0]) + mean_of(&runs[1]));
+    let ratios: Vec<f64> = images.iter().map(|i| mean_of(i) / reference).collect();
+    let (energy, se) = mean_and_standard_error(&ratios);
+    eprintln!(
+        "metal box {w} x {h}: {blocks} blocks, chi^2/n = {chi2:.2} (bound {bound:.2}); energy {energy:.4} +- {se:.4} of Mitsuba's (8 x 32 SPPM iterations in {seconds:.1} s)"
+    );
+    assert!(
+        chi2 < bound,
+        "chi^2/n = {chi2} over {blocks} blocks, bound {bound}"
+    );
+    assert!(
+        (energy - 1.0).abs() < 0.01 && (energy - 1.0).abs() < 4.0 * se.max(1e-4),
+        "energy {energy} +- {se} of the reference's"
+    );
+}
+
 /// Energy: inside a closed diffuse sphere (radius 1, albedo rho) with a point
 /// light of intensity I off its centre, the radiance integrated over the
 /// sphere is rho 4 pi I / (pi (1 - rho)) = 4 for rho = 1/2, I = 1, wherever

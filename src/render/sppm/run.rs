@@ -44,6 +44,7 @@ pub fn render_sppm(
     // A crop renders the whole frame and keeps its pixels: each iteration's
     // grid follows the largest radius over every pixel.
     options.check_pixel_bounds()?;
+    options.check_materials(scene)?;
     let mut run = Sppm::new(gpu, scene, options, sppm)?;
     let Progressed {
         image,

@@ -42,6 +42,7 @@ pub fn render_vcm(
     observer: &mut dyn RenderObserver,
 ) -> Result<VcmOutput> {
     options.check_pixel_bounds()?;
+    options.check_materials(scene)?;
     let mut run = Vcm::new(gpu, scene, options, vcm)?;
     let Progressed {
         image,

@@ -19,6 +19,14 @@ pub enum Mat {
     Diffuse([f64; 3]),
     Mirror([f64; 3]),
     Glass(f64),
+    /// A metal: eta, k, tint, alpha (0: smooth), as the scene format's
+    /// `conductor`.
+    Conductor {
+        eta: [f64; 3],
+        k: [f64; 3],
+        tint: [f64; 3],
+        alpha: f64,
+    },
 }
 
 /// A surface, in world space; `material` indexes `Model::materials`.
@@ -421,6 +429,19 @@ pub fn to_toml(model: &Model) -> String {
                 fmt_c(c)
             ),
             Mat::Glass(ior) => writeln!(w, "{name} = {{ type = \"glass\", ior = {} }}", fmt(ior)),
+            Mat::Conductor {
+                eta,
+                k,
+                tint,
+                alpha,
+            } => writeln!(
+                w,
+                "{name} = {{ type = \"conductor\", eta = {}, k = {}, tint = {}, alpha = {} }}",
+                fmt_c(eta),
+                fmt_c(k),
+                fmt_c(tint),
+                fmt(alpha)
+            ),
         };
     }
     write_shapes(w, model, &p, &d);

@@ -9,10 +9,11 @@ use toml::de::DeTable;
 use toml::Spanned;
 
 use super::super::defaults::{
-    default_max_radius, DEFAULT_UP, IOR_RANGE, MAX_BOUNCES, MAX_GRID_SIDE, MAX_IMAGE_SIDE, MAX_K,
-    MAX_PHOTONS_STORED, MAX_PROJECTION_RESOLUTION, MAX_SHADOW_RAYS, MAX_SPECULAR_DEPTH,
-    MIN_PROJECTION_RESOLUTION, VFOV_RANGE,
+    default_max_radius, ALPHA_RANGE, CONDUCTOR_INDEX_RANGE, DEFAULT_UP, IOR_RANGE, MAX_BOUNCES,
+    MAX_GRID_SIDE, MAX_IMAGE_SIDE, MAX_K, MAX_PHOTONS_STORED, MAX_PROJECTION_RESOLUTION,
+    MAX_SHADOW_RAYS, MAX_SPECULAR_DEPTH, MIN_PROJECTION_RESOLUTION, SMOOTH_ALPHA, VFOV_RANGE,
 };
+use super::super::metals;
 use super::super::rebase::Coord;
 use super::super::{
     Camera, Geometry, Light, Material, PhotonMapParams, RenderParams, Scene, Shape,
@@ -53,12 +54,18 @@ enum MaterialKind {
     Diffuse,
     Mirror,
     Glass,
+    Conductor,
 }
 
 const MATERIAL_KINDS: &Kinds<MaterialKind> = &[
     ("diffuse", MaterialKind::Diffuse, &["albedo"]),
     ("mirror", MaterialKind::Mirror, &["reflectance"]),
     ("glass", MaterialKind::Glass, &["ior"]),
+    (
+        "conductor",
+        MaterialKind::Conductor,
+        &["metal", "eta", "k", "tint", "alpha"],
+    ),
 ];
 
 #[derive(Clone, Copy)]
@@ -393,6 +400,78 @@ fn read_material(t: &Table) -> Result<Material, SceneError> {
             }
             Material::Glass { ior }
         }
+        MaterialKind::Conductor => read_conductor(t)?,
+    })
+}
+
+/// A metal: `metal` (a name of src/scene/metals.rs) or `eta` and `k`
+/// together; `tint` (default white); `alpha` (default 0, smooth).
+fn read_conductor(t: &Table) -> Result<Material, SceneError> {
+    let index = |key: &str| -> Result<Option<Vec3>, SceneError> {
+        let Some(at) = t.get::<[f32; 3]>(key)? else {
+            return Ok(None);
+        };
+        let c = t.cx.vec3(at.span(), &t.field(key), *at.get_ref())?;
+        let (lo, hi) = CONDUCTOR_INDEX_RANGE;
+        if c.min_element() < lo || c.max_element() > hi || (key == "eta" && c.min_element() <= 0.0)
+        {
+            let low = if key == "eta" { "(0" } else { "[0" };
+            return Err(t.cx.err(
+                at.span(),
+                &t.field(key),
+                format!("{:?}: each channel must be in {low}, {hi}]", at.get_ref()),
+            ));
+        }
+        Ok(Some(c))
+    };
+    let (eta, k) = match (t.get::<String>("metal")?, index("eta")?, index("k")?) {
+        (Some(name), None, None) => metals::metal(name.get_ref()).ok_or_else(|| {
+            t.cx.err(
+                name.span(),
+                &t.field("metal"),
+                format!(
+                    "unknown metal `{}`, expected one of {}",
+                    name.get_ref(),
+                    metals::metal_names()
+                ),
+            )
+        })?,
+        (None, Some(eta), Some(k)) => (eta, k),
+        (Some(name), _, _) => {
+            return Err(t.cx.err(
+                name.span(),
+                &t.field("metal"),
+                "give `metal` or `eta` and `k`, not both".into(),
+            ))
+        }
+        _ => {
+            return Err(t.cx.err(
+                t.span.clone(),
+                &t.field("eta"),
+                "a conductor needs `metal`, or `eta` and `k` together".into(),
+            ))
+        }
+    };
+    let tint = match t.get::<[f32; 3]>("tint")? {
+        Some(at) => t.cx.unit_rgb(at.span(), &t.field("tint"), *at.get_ref())?,
+        None => Vec3::ONE,
+    };
+    let at = t.or::<f32>("alpha", 0.0)?;
+    let alpha = t.cx.finite(at.span(), &t.field("alpha"), *at.get_ref())?;
+    let (lo, hi) = ALPHA_RANGE;
+    if !(lo..=hi).contains(&alpha) {
+        return Err(t.cx.err(
+            at.span(),
+            &t.field("alpha"),
+            format!("{alpha} is outside the allowed range [{lo}, {hi}]"),
+        ));
+    }
+    let alpha = if alpha < SMOOTH_ALPHA { 0.0 } else { alpha };
+    Ok(Material::Conductor {
+        eta,
+        k,
+        tint,
+        alpha,
     })
 }
 

@@ -50,6 +50,12 @@ def bsdf(m):
     if m["type"] == "mirror":
         return {"type": "twosided", "bsdf": {"type": "conductor", "material": "none",
                                               "specular_reflectance": rgb(m["reflectance"])}}
+    if m["type"] == "conductor":
+        metal = {"type": "conductor", "eta": rgb(m["eta"]), "k": rgb(m["k"]),
+                 "specular_reflectance": rgb(m["tint"])}
+        if m["alpha"] > 0.0:
+            metal.update({"type": "roughconductor", "distribution": "ggx", "alpha": m["alpha"]})
+        return {"type": "twosided", "bsdf": metal}
     if m["type"] == "glass":
         return {"type": "dielectric", "int_ior": m["ior"], "ext_ior": 1.0}
     # An emitter reflects nothing.

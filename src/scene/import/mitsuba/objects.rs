@@ -13,6 +13,8 @@ use super::super::model::{CameraSpec, Emitter, Mat};
 use super::state::Reader;
 use super::values::{At, Props};
 use crate::error::SceneError;
+use crate::scene::defaults::ALPHA_RANGE;
+use crate::scene::metals;
 
 fn int(p: &Props, at: &At, name: &str, default: i64, lo: i64, hi: i64) -> Result<i64, SceneError> {
     let v = p.float(at, name, default as f64)?;
@@ -188,15 +190,6 @@ const IORS: &[(&str, f64)] = &[
     ("pet", 1.575),
     ("diamond", 2.419),
 ];
-/// Conductors Mitsuba names, as their normal-incidence reflectance in sRGB.
-const METALS: &[(&str, [f64; 3])] = &[
-    ("none", [1.0, 1.0, 1.0]),
-    ("Cu", [0.955, 0.638, 0.538]),
-    ("Au", [1.0, 0.782, 0.344]),
-    ("Ag", [0.972, 0.960, 0.915]),
-    ("Al", [0.913, 0.922, 0.924]),
-    ("Cr", [0.549, 0.556, 0.554]),
-];
 
 fn ior(at: &At, p: &Props, name: &str, default: f64) -> Result<f64, SceneError> {
     let named = match p.get(name).map(|x| &x.value) {
@@ -239,30 +232,88 @@ fn unit(c: [f64; 3]) -> [f64; 3] {
     c.map(|v| v.clamp(0.0, 1.0))
 }
 
-fn conductor(r: &mut Reader, at: &At, p: &Props) -> Result<[f64; 3], SceneError> {
-    let scale = colour(r, at, p, "specular_reflectance", [1.0; 3])?;
-    let base = match (p.colour(at, "eta")?, p.colour(at, "k")?) {
-        (Some(Ok(e)), Some(Ok(k))) => std::array::from_fn(|i| {
-            ((e[i] - 1.0).powi(2) + k[i] * k[i]) / ((e[i] + 1.0).powi(2) + k[i] * k[i])
-        }),
+/// A `conductor` or `roughconductor`: eta and k by `material` (Mitsuba's
+/// named metals, src/scene/metals.rs, reduced to RGB as its RGB variants
+/// reduce them; `none`, its default, a perfect mirror) or as colours, times
+/// `specular_reflectance`; rough by `alpha` (or equal `alpha_u`/`alpha_v`)
+/// with the GGX distribution.
+fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, SceneError> {
+    let tint = unit(colour(r, at, p, "specular_reflectance", [1.0; 3])?);
+    let index = |(eta, k): (glam::Vec3, glam::Vec3)| {
+        (eta.to_array().map(f64::from), k.to_array().map(f64::from))
+    };
+    let (eta, k) = match (p.colour(at, "eta")?, p.colour(at, "k")?) {
+        (Some(Ok(e)), Some(Ok(k))) => (e, k),
         (None, None) => {
             let name = p.string(at, "material")?.unwrap_or_else(|| "none".into());
-            match METALS.iter().find(|(m, _)| *m == name) {
-                Some((_, c)) => *c,
+            match metals::metal(&name) {
+                Some(m) => index(m),
+                None if name == "none" && !rough => return Ok(Mat::Mirror(tint)),
+                None if name == "none" => index((glam::Vec3::ZERO, glam::Vec3::splat(1e3))),
                 None => {
                     let what = format!("{} material `{name}`", p.what);
-                    grey_mirror(r, at, p.line_of(at, "material"), &what)?
+                    return Ok(Mat::Mirror(grey_mirror(
+                        r,
+                        at,
+                        p.line_of(at, "material"),
+                        &what,
+                    )?));
                 }
             }
         }
-        _ => grey_mirror(
-            r,
-            at,
-            p.line_of(at, "eta"),
-            &format!("{} eta and k", p.what),
-        )?,
+        _ => {
+            let what = format!("{} eta and k", p.what);
+            return Ok(Mat::Mirror(grey_mirror(
+                r,
+                at,
+                p.line_of(at, "eta"),
+                &what,
+            )?));
+        }
     };
-    Ok(unit(std::array::from_fn(|i| base[i] * scale[i])))
+    let mut alpha = 0.0;
+    if rough {
+        let distribution = p
+            .string(at, "distribution")?
+            .unwrap_or_else(|| "beckmann".into());
+        p.ignore(&["sample_visible"]);
+        let a = p.float(at, "alpha", 0.1)?;
+        let (u, v) = (p.float(at, "alpha_u", a)?, p.float(at, "alpha_v", a)?);
+        alpha = u.max(v);
+        if distribution != "ggx" {
+            r.cx.unsupported(
+                at.file,
+                p.line_of(at, "distribution"),
+                &format!("{} with the {distribution} distribution", p.what),
+                &format!("GGX of alpha {alpha}"),
+            )?;
+        }
+        if (u - v).abs() > 1e-6 * alpha {
+            r.cx.unsupported(
+                at.file,
+                p.line_of(at, "alpha_u"),
+                &format!("{} with anisotropic alpha", p.what),
+                &format!("isotropic alpha {alpha}"),
+            )?;
+        }
+        let (lo, hi) = ALPHA_RANGE;
+        if !(f64::from(lo)..=f64::from(hi)).contains(&alpha) {
+            let instead = alpha.clamp(f64::from(lo), f64::from(hi));
+            r.cx.unsupported(
+                at.file,
+                p.line_of(at, "alpha"),
+                &format!("{} alpha {alpha} (outside [{lo}, {hi}])", p.what),
+                &format!("alpha {instead}"),
+            )?;
+            alpha = instead;
+        }
+    }
+    Ok(Mat::Conductor {
+        eta: eta.map(|x| x.clamp(1e-4, 100.0)),
+        k: k.map(|x| x.clamp(0.0, 100.0)),
+        tint,
+        alpha,
+    })
 }
 
 /// What a conductor it cannot colour becomes (`what`, at `line`, unsupported).
@@ -317,19 +368,7 @@ pub fn bsdf(r: &mut Reader, at: &At, n: Node) -> Result<Mat, SceneError> {
                 Mat::Glass(eta)
             }
         }
-        "conductor" | "roughconductor" => {
-            if kind != "conductor" {
-                p.ignore(&[
-                    "alpha",
-                    "alpha_u",
-                    "alpha_v",
-                    "distribution",
-                    "sample_visible",
-                ]);
-                r.cx.unsupported(at.file, at.line(n), &p.what, "a mirror")?;
-            }
-            Mat::Mirror(conductor(r, at, &p)?)
-        }
+        "conductor" | "roughconductor" => conductor(r, at, &p, kind == "roughconductor")?,
         _ => {
             let fallback = match kind {
                 "plastic" | "roughplastic" => {

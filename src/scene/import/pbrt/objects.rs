@@ -10,6 +10,8 @@ use super::super::model::{Emitter, Mat};
 use super::params::{blackbody_rgb, Colour, Params};
 use super::state::{AreaLight, PbrtCamera, PendingShape, Reader};
 use crate::error::SceneError;
+use crate::scene::defaults::ALPHA_RANGE;
+use crate::scene::metals;
 
 /// pbrt's LookAt: the camera-from-world transform.
 pub fn look_at(v: &[f64]) -> Result<DMat4, String> {
@@ -171,13 +173,6 @@ fn unit(c: [f64; 3]) -> [f64; 3] {
     c.map(|v| v.clamp(0.0, 1.0))
 }
 
-/// Normal-incidence reflectance of a conductor of index eta + i k.
-fn fresnel0(eta: [f64; 3], k: [f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| {
-        ((eta[i] - 1.0).powi(2) + k[i] * k[i]) / ((eta[i] + 1.0).powi(2) + k[i] * k[i])
-    })
-}
-
 /// Named metal spectra, as their normal-incidence reflectance in sRGB.
 const METALS: &[(&str, [f64; 3])] = &[
     ("Cu", [0.955, 0.638, 0.538]),
@@ -197,39 +192,103 @@ const GLASSES: &[(&str, f64)] = &[
     ("glass-F11", 1.6200),
 ];
 
-fn conductor(r: &mut Reader, p: &Params) -> Result<[f64; 3], SceneError> {
-    if p.has("reflectance") {
-        return rgb(r, p, "reflectance", [0.9; 3]).map(unit);
-    }
-    let named = |name: &str| -> Result<Option<[f64; 3]>, SceneError> {
-        let Some(q) = p.find(name, &["spectrum", "rgb", "float"])? else {
-            return Ok(None);
-        };
-        Ok(match q.values.as_slice() {
-            [super::lexer::Val::Str(s)] => METALS
-                .iter()
-                .find(|(m, _)| s == &format!("metal-{m}-{name}"))
-                .map(|(_, c)| *c),
-            _ => None,
-        })
+/// A `conductor`: its eta and k from `reflectance` (pbrt's eta = 1,
+/// k = 2 sqrt(r) / sqrt(1 - r)), a named `metal-*-eta`/`-k` pair (Mitsuba's
+/// RGB reduction of the same metal's measurements, src/scene/metals.rs), or
+/// RGB values; pbrt's default, copper, without any; rough by `roughness`
+/// (remapped as pbrt-v4 remaps it, alpha = sqrt(roughness), unless
+/// `remaproughness` is false).
+fn conductor(r: &mut Reader, p: &Params) -> Result<Mat, SceneError> {
+    let index = |(eta, k): (glam::Vec3, glam::Vec3)| {
+        (eta.to_array().map(f64::from), k.to_array().map(f64::from))
     };
-    if let Some(c) = named("eta")? {
-        p.has("k");
-        return Ok(c);
-    }
-    match (p.colour("eta")?, p.colour("k")?) {
-        (None, None) => Ok(METALS[0].1),
-        (Some(Colour::Rgb(e)), Some(Colour::Rgb(k))) => Ok(unit(fresnel0(e, k))),
-        _ => {
-            r.cx.unsupported(
-                p.file,
-                p.line_of("eta"),
-                &format!("{} eta and k", p.what),
-                "a grey mirror of 0.9",
-            )?;
-            Ok([0.9; 3])
+    let (eta, k) = if p.has("reflectance") {
+        let c = rgb(r, p, "reflectance", [0.9; 3]).map(unit)?;
+        index(metals::from_reflectance(glam::DVec3::from(c).as_vec3()))
+    } else {
+        let named = |name: &str| -> Result<Option<String>, SceneError> {
+            let Some(q) = p.find(name, &["spectrum", "rgb", "float"])? else {
+                return Ok(None);
+            };
+            Ok(match q.values.as_slice() {
+                [super::lexer::Val::Str(s)] => Some(s.clone()),
+                _ => None,
+            })
+        };
+        match (named("eta")?, p.has("k")) {
+            (Some(spectrum), _) => {
+                p.has("k");
+                let metal = spectrum
+                    .strip_prefix("metal-")
+                    .and_then(|m| m.strip_suffix("-eta"))
+                    .unwrap_or("");
+                match (
+                    metals::metal(metal),
+                    METALS.iter().find(|(m, _)| *m == metal),
+                ) {
+                    (Some(m), _) => index(m),
+                    // Brass is not in Mitsuba's tables: its normal-incidence
+                    // reflectance, as pbrt's `reflectance` would give it.
+                    (None, Some((_, f0))) => {
+                        index(metals::from_reflectance(glam::DVec3::from(*f0).as_vec3()))
+                    }
+                    (None, None) => {
+                        r.cx.unsupported(
+                            p.file,
+                            p.line_of("eta"),
+                            &format!("{} spectrum \"{spectrum}\"", p.what),
+                            "a grey mirror of 0.9",
+                        )?;
+                        return Ok(Mat::Mirror([0.9; 3]));
+                    }
+                }
+            }
+            (None, _) => match (p.colour("eta")?, p.colour("k")?) {
+                (None, None) => index(metals::metal("Cu").expect("copper is in the table")),
+                (Some(Colour::Rgb(e)), Some(Colour::Rgb(k))) => (e, k),
+                _ => {
+                    r.cx.unsupported(
+                        p.file,
+                        p.line_of("eta"),
+                        &format!("{} eta and k", p.what),
+                        "a grey mirror of 0.9",
+                    )?;
+                    return Ok(Mat::Mirror([0.9; 3]));
+                }
+            },
         }
+    };
+    let rough = p.float("roughness", 0.0)?;
+    let (u, v) = (p.float("uroughness", rough)?, p.float("vroughness", rough)?);
+    let remap = p.bool("remaproughness", true)?;
+    let alpha_of = |x: f64| if remap { x.max(0.0).sqrt() } else { x };
+    let (au, av) = (alpha_of(u), alpha_of(v));
+    let mut alpha = au.max(av);
+    if (au - av).abs() > 1e-6 * alpha {
+        r.cx.unsupported(
+            p.file,
+            p.line_of("uroughness"),
+            &format!("{} with anisotropic roughness", p.what),
+            &format!("isotropic alpha {alpha}"),
+        )?;
     }
+    let (lo, hi) = ALPHA_RANGE;
+    if !(f64::from(lo)..=f64::from(hi)).contains(&alpha) {
+        let instead = alpha.clamp(f64::from(lo), f64::from(hi));
+        r.cx.unsupported(
+            p.file,
+            p.line_of("roughness"),
+            &format!("{} alpha {alpha} (outside [{lo}, {hi}])", p.what),
+            &format!("alpha {instead}"),
+        )?;
+        alpha = instead;
+    }
+    Ok(Mat::Conductor {
+        eta: eta.map(|x| x.clamp(1e-4, 100.0)),
+        k: k.map(|x| x.clamp(0.0, 100.0)),
+        tint: [1.0; 3],
+        alpha,
+    })
 }
 
 fn roughness(p: &Params) -> Result<f64, SceneError> {
@@ -254,10 +313,7 @@ pub fn material(r: &mut Reader, kind: &str, p: &Params) -> Result<Option<Mat>, S
     };
     Ok(Some(match kind {
         "diffuse" => Mat::Diffuse(unit(rgb(r, p, "reflectance", [0.5; 3])?)),
-        "conductor" => {
-            rough(r, p, "a rough conductor", "a mirror")?;
-            Mat::Mirror(conductor(r, p)?)
-        }
+        "conductor" => conductor(r, p)?,
         "dielectric" | "thindielectric" => {
             if kind == "thindielectric" {
                 r.cx.unsupported(p.file, p.line, &p.what, "solid glass")?;

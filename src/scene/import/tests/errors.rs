@@ -92,7 +92,7 @@ fn a_missing_or_truncated_ply_names_its_file_and_line() {
 fn what_photonmap_cannot_render_is_refused_or_mapped_with_a_note() {
     let cases = [
         ("Material \"coateddiffuse\" \"rgb reflectance\" [0.2 0.3 0.4]\nShape \"sphere\"\n", "Material \"coateddiffuse\""),
-        ("Material \"conductor\" \"float roughness\" 0.2\nShape \"sphere\"\n", "a rough conductor"),
+        ("Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.1\nShape \"sphere\"\n", "anisotropic roughness"),
         ("Material \"diffuse\" \"texture reflectance\" \"checks\"\nShape \"sphere\"\n", "\"texture reflectance\""),
         ("LightSource \"infinite\" \"rgb L\" [1 1 1]\nShape \"sphere\"\n", "LightSource \"infinite\""),
         ("MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "participating media"),

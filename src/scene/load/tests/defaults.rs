@@ -132,6 +132,7 @@ fn absent_parameters_take_the_defaults_that_with_shapes_and_the_readme_use() {
         ("max_bounces", format!("1..={MAX_BOUNCES}, default {DEFAULT_MAX_BOUNCES}")),
         ("projection_resolution", format!("{MIN_PROJECTION_RESOLUTION}..={MAX_PROJECTION_RESOLUTION}, default {DEFAULT_PROJECTION_RESOLUTION}")),
         ("glass", format!("ior in [{}, {}]", IOR_RANGE.0, IOR_RANGE.1)),
+        ("metal", format!("alpha in [{}, {}]", ALPHA_RANGE.0, ALPHA_RANGE.1)),
     ] {
         assert!(line(key).contains(&says), "README: {:?} should say {says:?}", line(key));
     }

@@ -304,3 +304,84 @@ fn arrays_longer_than_their_field_are_refused() {
         "invalid length 4",
     );
 }
+
+/// The good scene's material made a conductor with `fields`.
+fn metal(fields: &str) -> String {
+    good().replacen(
+        "{ type = \"diffuse\", albedo = [0.5, 0.5, 0.5] }",
+        &format!("{{ type = \"conductor\", {fields} }}"),
+        1,
+    )
+}
+
+#[test]
+fn conductors_load_by_name_or_index() {
+    use crate::scene::Material;
+    let gold = load(&metal("metal = \"Au\", alpha = 0.2")).unwrap();
+    let Material::Conductor {
+        eta,
+        k,
+        tint,
+        alpha,
+    } = gold.materials[0]
+    else {
+        panic!("{:?}", gold.materials[0]);
+    };
+    assert_eq!(
+        (eta.x, k.x, tint, alpha),
+        (0.143, 3.983, glam::Vec3::ONE, 0.2)
+    );
+    let own = load(&metal(
+        "eta = [1.5, 1.0, 0.5], k = [3.0, 2.0, 1.0], tint = [0.5, 0.5, 0.5]",
+    ))
+    .unwrap();
+    assert!(matches!(own.materials[0], Material::Conductor { alpha, .. } if alpha == 0.0));
+    // Below 1e-3 a metal is smooth, as pbrt-v4 treats it.
+    let nearly = load(&metal("metal = \"Ag\", alpha = 0.0005")).unwrap();
+    assert!(!nearly.materials[0].is_glossy());
+}
+
+#[test]
+fn bad_conductors_name_their_field() {
+    let e = error_at(
+        &metal("metal = \"Unobtainium\""),
+        10,
+        "materials.white.metal",
+    );
+    assert!(
+        e.message.contains("unknown metal") && e.message.contains("Au"),
+        "{e}"
+    );
+    let e = error_at(
+        &metal("metal = \"Au\", alpha = 1.5"),
+        10,
+        "materials.white.alpha",
+    );
+    assert!(e.message.contains("[0, 1]"), "{e}");
+    let e = error_at(
+        &metal("eta = [0.0, 1.0, 1.0], k = [1.0, 1.0, 1.0]"),
+        10,
+        "materials.white.eta",
+    );
+    assert!(e.message.contains("(0, 100]"), "{e}");
+    let e = error_at(
+        &metal("eta = [1.0, 1.0, 1.0], k = [1.0, -1.0, 1.0]"),
+        10,
+        "materials.white.k",
+    );
+    assert!(e.message.contains("[0, 100]"), "{e}");
+    let e = error_at(&metal("eta = [1.0, 1.0, 1.0]"), 10, "materials.white.eta");
+    assert!(e.message.contains("`eta` and `k` together"), "{e}");
+    let e = error_at(
+        &metal("metal = \"Au\", k = [1.0, 1.0, 1.0]"),
+        10,
+        "materials.white.metal",
+    );
+    assert!(e.message.contains("not both"), "{e}");
+    let e = error_at(
+        &metal("metal = \"Au\", tint = [1.0, 2.0, 1.0]"),
+        10,
+        "materials.white.tint",
+    );
+    assert!(e.message.contains("[0, 1]"), "{e}");
+}
