@@ -67,6 +67,13 @@ pub const BSDF_DIFFUSE: u32 = 1;
 pub const BSDF_DELTA: u32 = 2;
 pub const BSDF_GLOSSY: u32 = 4;
 
+/// A rough lobe's microfacet model (a material's colour texel .w, bits):
+/// Beckmann's distribution instead of Trowbridge-Reitz (GGX), and the
+/// masking-shadowing term as the product of the two directions' G1
+/// (Mitsuba) instead of height-correlated (pbrt).
+pub const MICROFACET_BECKMANN: u32 = 1;
+pub const MICROFACET_SEPARABLE: u32 = 2;
+
 /// Light kinds, the first float of a light's head texel.
 pub const LIGHT_AREA: u32 = 0;
 pub const LIGHT_POINT: u32 = 1;
@@ -208,6 +215,8 @@ pub fn glsl_defines() -> Vec<(&'static str, String)> {
         ("BSDF_DIFFUSE", u(BSDF_DIFFUSE)),
         ("BSDF_DELTA", u(BSDF_DELTA)),
         ("BSDF_GLOSSY", u(BSDF_GLOSSY)),
+        ("MICROFACET_BECKMANN", u(MICROFACET_BECKMANN)),
+        ("MICROFACET_SEPARABLE", u(MICROFACET_SEPARABLE)),
         ("LIGHT_AREA", u(LIGHT_AREA)),
         ("LIGHT_POINT", u(LIGHT_POINT)),
         ("LIGHT_TRIANGLES", u(LIGHT_TRIANGLES)),

@@ -17,16 +17,18 @@ struct Bsdf {
     int kind;    // MAT_*
     vec3 color;  // diffuse albedo, mirror reflectance, a conductor's tint
     float ior;   // glass: the interior's index over the exterior's
-    vec2 alpha;  // conductor: Trowbridge-Reitz (GGX) alpha along the frame's t and b; 0: smooth
+    vec2 alpha;  // conductor: microfacet alpha along the frame's t and b; 0: smooth
     vec3 eta;    // conductor: complex index eta + i k, per channel
     vec3 k;
+    int model;   // a rough lobe's microfacet model: MICROFACET_* bits
 };
 
 // Material mat's BSDF (src/scene/pack.rs lays out its texels). A conductor's
 // index is read only where the scene holds one.
 Bsdf material_bsdf(int mat) {
     vec4 head = material_texel(mat, 0);
-    Bsdf b = Bsdf(int(head.x), material_texel(mat, 1).rgb, head.y, head.zw, vec3(1.0), vec3(0.0));
+    vec4 color = material_texel(mat, 1);
+    Bsdf b = Bsdf(int(head.x), color.rgb, head.y, head.zw, vec3(1.0), vec3(0.0), int(color.w));
     if (SCENE_HAS_MATERIAL(MAT_CONDUCTOR) && b.kind == MAT_CONDUCTOR) {
         b.eta = material_texel(mat, 2).rgb;
         b.k = material_texel(mat, 3).rgb;
@@ -88,7 +90,7 @@ vec3 fresnel_conductor(float c, vec3 eta, vec3 k) {
 }
 
 // Trowbridge-Reitz (GGX) in the local frame (z the normal), as pbrt-v4's
-// TrowbridgeReitzDistribution: D, Smith's Lambda, height-correlated G.
+// TrowbridgeReitzDistribution: D, Smith's Lambda, G1.
 float ggx_d(vec2 alpha, vec3 m) {
     if (m.z <= 0.0) return 0.0;
     float e = (m.x * m.x) / (alpha.x * alpha.x) + (m.y * m.y) / (alpha.y * alpha.y) + m.z * m.z;
@@ -103,9 +105,6 @@ float ggx_lambda(vec2 alpha, vec3 w) {
 }
 
 float ggx_g1(vec2 alpha, vec3 w) { return 1.0 / (1.0 + ggx_lambda(alpha, w)); }
-float ggx_g(vec2 alpha, vec3 wo, vec3 wi) {
-    return 1.0 / (1.0 + ggx_lambda(alpha, wo) + ggx_lambda(alpha, wi));
-}
 
 // The distribution of normals visible from wo (Heitz 2018), sampled from u.
 vec3 ggx_sample_visible(vec2 alpha, vec3 wo, vec2 u) {
@@ -128,6 +127,58 @@ float ggx_pdf_visible(vec2 alpha, vec3 wo, vec3 m) {
     return ggx_g1(alpha, wo) / abs(wo.z) * ggx_d(alpha, m) * abs(dot(wo, m));
 }
 
+// Beckmann's distribution (Mitsuba's default for a rough conductor), with
+// Walter et al.'s rational approximation of its Smith G1, as Mitsuba uses
+// it, and sampled as D(m) cos(m) (Walter et al. 2007).
+float beckmann_d(vec2 alpha, vec3 m) {
+    if (m.z <= 0.0) return 0.0;
+    float z2 = m.z * m.z;
+    float e = ((m.x * m.x) / (alpha.x * alpha.x) + (m.y * m.y) / (alpha.y * alpha.y)) / z2;
+    return exp(-e) / (PI * alpha.x * alpha.y * z2 * z2);
+}
+
+float beckmann_lambda(vec2 alpha, vec3 w) {
+    float r = sqrt(w.x * w.x * alpha.x * alpha.x + w.y * w.y * alpha.y * alpha.y);
+    if (r == 0.0) return 0.0;
+    float a = abs(w.z) / r;
+    if (a >= 1.6) return 0.0;
+    if (a == 0.0) return 1e30;
+    float g1 = (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a);
+    return 1.0 / g1 - 1.0;
+}
+
+vec3 beckmann_sample(vec2 alpha, vec2 u) {
+    float phi = 2.0 * PI * u.y;
+    // The azimuth of an anisotropic lobe, stretched (and kept in phi's quadrant).
+    if (alpha.x != alpha.y) phi = atan(alpha.y * sin(phi), alpha.x * cos(phi));
+    float c = cos(phi), s = sin(phi);
+    float tan2 = -log(max(1.0 - u.x, 1e-30)) / (c * c / (alpha.x * alpha.x) + s * s / (alpha.y * alpha.y));
+    float cos_t = 1.0 / sqrt(1.0 + tan2);
+    float sin_t = sqrt(max(0.0, 1.0 - cos_t * cos_t));
+    return vec3(sin_t * c, sin_t * s, cos_t);
+}
+
+// The lobe's microfacet model: its distribution, its Smith Lambda, and the
+// masking-shadowing term, height-correlated (pbrt) or the product of the
+// two directions' G1 (Mitsuba).
+bool is_beckmann(Bsdf b) { return (b.model & MICROFACET_BECKMANN) != 0; }
+float mf_d(Bsdf b, vec3 m) { return is_beckmann(b) ? beckmann_d(b.alpha, m) : ggx_d(b.alpha, m); }
+float mf_lambda(Bsdf b, vec3 w) {
+    return is_beckmann(b) ? beckmann_lambda(b.alpha, w) : ggx_lambda(b.alpha, w);
+}
+float mf_g(Bsdf b, vec3 wo, vec3 wi) {
+    float lo = mf_lambda(b, wo), li = mf_lambda(b, wi);
+    if ((b.model & MICROFACET_SEPARABLE) != 0) return 1.0 / ((1.0 + lo) * (1.0 + li));
+    return 1.0 / (1.0 + lo + li);
+}
+
+// The density of the sampled normal m seen from wo: the visible normals for
+// GGX, D(m) cos(m) for Beckmann.
+float mf_pdf_m(Bsdf b, vec3 wo, vec3 m) {
+    if (is_beckmann(b)) return beckmann_d(b.alpha, m) * m.z;
+    return ggx_pdf_visible(b.alpha, wo, m);
+}
+
 // f(wo, wi) of the non-delta lobes, local directions.
 vec3 bsdf_eval_local(Bsdf b, vec3 wo, vec3 wi) {
     if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
@@ -137,7 +188,7 @@ vec3 bsdf_eval_local(Bsdf b, vec3 wo, vec3 wi) {
     if (dot(m, m) == 0.0) return vec3(0.0);
     m = normalize(m);
     vec3 f = fresnel_conductor(abs(dot(wo, m)), b.eta, b.k);
-    return b.color * f * (ggx_d(b.alpha, m) * ggx_g(b.alpha, wo, wi) / (4.0 * wo.z * wi.z));
+    return b.color * f * (mf_d(b, m) * mf_g(b, wo, wi) / (4.0 * wo.z * wi.z));
 }
 
 float bsdf_pdf_local(Bsdf b, vec3 wo, vec3 wi) {
@@ -147,7 +198,7 @@ float bsdf_pdf_local(Bsdf b, vec3 wo, vec3 wi) {
     vec3 m = wo + wi;
     if (dot(m, m) == 0.0) return 0.0;
     m = normalize(m);
-    return ggx_pdf_visible(b.alpha, wo, m) / (4.0 * abs(dot(wo, m)));
+    return mf_pdf_m(b, wo, m) / (4.0 * abs(dot(wo, m)));
 }
 
 vec3 bsdf_eval(Bsdf b, Frame f, vec3 wo, vec3 wi) {
@@ -179,10 +230,11 @@ BsdfSample bsdf_sample(Bsdf b, Frame f, vec3 wo, vec2 u) {
     if (bsdf_lobes(b) != BSDF_GLOSSY) return s;
     vec3 lo = to_local(f, wo);
     if (lo.z <= 0.0) return s;
-    vec3 m = ggx_sample_visible(b.alpha, lo, u);
+    vec3 m = is_beckmann(b) ? beckmann_sample(b.alpha, u) : ggx_sample_visible(b.alpha, lo, u);
+    if (dot(lo, m) <= 0.0) return s;
     vec3 li = reflect(-lo, m);
     if (li.z <= 0.0) return s;
-    s.pdf = ggx_pdf_visible(b.alpha, lo, m) / (4.0 * abs(dot(lo, m)));
+    s.pdf = mf_pdf_m(b, lo, m) / (4.0 * abs(dot(lo, m)));
     if (!(s.pdf > 0.0)) return s;
     s.wi = normalize(from_local(f, li));
     s.weight = bsdf_eval_local(b, lo, li) * li.z / s.pdf;

@@ -12,6 +12,7 @@ uniform vec2 u_alpha;
 uniform vec3 u_eta;
 uniform vec3 u_k;
 uniform vec3 u_normal;
+uniform int u_model;
 layout(location = 0) out vec4 o_eval;   // f(wo, wi), pdf(wo, wi)
 layout(location = 1) out vec4 o_sample; // wi, lobe
 layout(location = 2) out vec4 o_weight; // weight, pdf
@@ -20,7 +21,7 @@ void main() {
     vec3 wo = texelFetch(u_wo, px, 0).xyz;
     vec3 wi = texelFetch(u_wi, px, 0).xyz;
     vec2 u = texelFetch(u_u, px, 0).xy;
-    Bsdf b = Bsdf(u_kind, u_color, 1.0, u_alpha, u_eta, u_k);
+    Bsdf b = Bsdf(u_kind, u_color, 1.0, u_alpha, u_eta, u_k, u_model);
     Frame f = frame_around(u_normal);
     o_eval = vec4(bsdf_eval(b, f, wo, wi), bsdf_pdf(b, f, wo, wi));
     BsdfSample s = bsdf_sample(b, f, wo, u);

@@ -53,13 +53,14 @@ pub enum Material {
     Glass { ior: f32 },
     /// A metal, both sides: exact unpolarised Fresnel of the complex index
     /// eta + i k (per channel), times `tint`. `alpha` 0: smooth (a delta
-    /// lobe, as a mirror); above 0: rough, an isotropic Trowbridge-Reitz
-    /// (GGX) microfacet lobe of that alpha (glsl/common/bsdf.glsl).
+    /// lobe, as a mirror); above 0: rough, an isotropic microfacet lobe of
+    /// that alpha and `microfacet` model (glsl/common/bsdf.glsl).
     Conductor {
         eta: Vec3,
         k: Vec3,
         tint: Vec3,
         alpha: f32,
+        microfacet: Microfacet,
     },
     /// An area light's surface: emits `radiance` on the side of `normal`, reflects
     /// nothing. `normal` None: each primitive's front face, the side of its
@@ -69,6 +70,31 @@ pub enum Material {
         radiance: Vec3,
         normal: Option<Vec3>,
     },
+}
+
+/// A rough lobe's microfacet model: pbrt-v4's is Trowbridge-Reitz with
+/// height-correlated masking; Mitsuba 3's is GGX or Beckmann with the
+/// product of the two directions' G1.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Microfacet {
+    pub beckmann: bool,
+    pub separable: bool,
+}
+
+impl Microfacet {
+    /// Mitsuba's `roughconductor` of the given distribution.
+    pub fn mitsuba(beckmann: bool) -> Self {
+        Self {
+            beckmann,
+            separable: true,
+        }
+    }
+
+    /// The MICROFACET_* bits glsl/common/bsdf.glsl reads.
+    pub fn bits(&self) -> u32 {
+        u32::from(self.beckmann) * crate::layout::MICROFACET_BECKMANN
+            + u32::from(self.separable) * crate::layout::MICROFACET_SEPARABLE
+    }
 }
 
 impl Material {

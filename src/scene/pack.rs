@@ -206,7 +206,8 @@ impl PackedScene {
 
 /// A material's MATERIAL_TEXELS texels, as glsl/common/bsdf.glsl's
 /// `material_bsdf` and direct light read them: (kind, ior, alpha, alpha),
-/// colour (albedo, reflectance, a metal's tint or an emitter's radiance),
+/// colour (albedo, reflectance, a metal's tint or an emitter's radiance;
+/// .w a rough metal's MICROFACET_* bits),
 /// then a metal's eta and k, or an emitter's normal (.w = 1: each
 /// primitive's front face instead).
 fn pack_material(m: &Material) -> [[f32; 4]; MATERIAL_TEXELS as usize] {
@@ -220,6 +221,7 @@ fn pack_material(m: &Material) -> [[f32; 4]; MATERIAL_TEXELS as usize] {
             k,
             tint,
             alpha,
+            ..
         } => (MAT_CONDUCTOR, 1.0, alpha, tint, eta, k, 0.0),
         Material::Emitter { radiance, normal } => (
             MAT_EMITTER,
@@ -231,9 +233,13 @@ fn pack_material(m: &Material) -> [[f32; 4]; MATERIAL_TEXELS as usize] {
             f32::from(normal.is_none()),
         ),
     };
+    let model = match m {
+        Material::Conductor { microfacet, .. } => microfacet.bits() as f32,
+        _ => 0.0,
+    };
     [
         [kind as f32, ior, alpha, alpha],
-        [color.x, color.y, color.z, 0.0],
+        [color.x, color.y, color.z, model],
         [third.x, third.y, third.z, own_face],
         [fourth.x, fourth.y, fourth.z, 0.0],
     ]

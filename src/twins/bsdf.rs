@@ -1,5 +1,6 @@
 //! Twin of glsl/common/bsdf.glsl, line for line: the BSDF layer's evaluate,
-//! pdf and sample (diffuse, and the Trowbridge-Reitz conductor), and the
+//! pdf and sample (diffuse, and the microfacet conductor: Trowbridge-Reitz
+//! or Beckmann, height-correlated or separable masking), and the
 //! delta lobes' factor. Its tests hold each lobe to what a BSDF must be:
 //! reciprocal, at most energy 1 (a white furnace), and sampled as its pdf
 //! says (a chi-square test, as pbrt's and Mitsuba's BSDF tests do).
@@ -8,6 +9,7 @@ use glam::{Vec2, Vec3};
 
 use crate::layout::{
     BSDF_DELTA, BSDF_DIFFUSE, BSDF_GLOSSY, MAT_CONDUCTOR, MAT_DIFFUSE, MAT_EMITTER,
+    MICROFACET_BECKMANN, MICROFACET_SEPARABLE,
 };
 use crate::sampling::{basis_around, sample_cosine};
 
@@ -21,6 +23,7 @@ pub struct Bsdf {
     pub alpha: Vec2,
     pub eta: Vec3,
     pub k: Vec3,
+    pub model: u32,
 }
 
 impl Bsdf {
@@ -32,6 +35,7 @@ impl Bsdf {
             alpha: Vec2::ZERO,
             eta: Vec3::ONE,
             k: Vec3::ZERO,
+            model: 0,
         }
     }
 
@@ -43,7 +47,13 @@ impl Bsdf {
             alpha,
             eta,
             k,
+            model: 0,
         }
+    }
+
+    /// The same lobe with the microfacet model `model` (MICROFACET_* bits).
+    pub fn with_model(self, model: u32) -> Self {
+        Self { model, ..self }
     }
 
     pub fn lobes(&self) -> u32 {
@@ -120,10 +130,6 @@ pub fn ggx_g1(alpha: Vec2, w: Vec3) -> f32 {
     1.0 / (1.0 + ggx_lambda(alpha, w))
 }
 
-pub fn ggx_g(alpha: Vec2, wo: Vec3, wi: Vec3) -> f32 {
-    1.0 / (1.0 + ggx_lambda(alpha, wo) + ggx_lambda(alpha, wi))
-}
-
 pub fn ggx_sample_visible(alpha: Vec2, wo: Vec3, u: Vec2) -> Vec3 {
     let mut wh = Vec3::new(alpha.x * wo.x, alpha.y * wo.y, wo.z).normalize();
     if wh.z < 0.0 {
@@ -150,6 +156,79 @@ pub fn ggx_pdf_visible(alpha: Vec2, wo: Vec3, m: Vec3) -> f32 {
     ggx_g1(alpha, wo) / wo.z.abs() * ggx_d(alpha, m) * wo.dot(m).abs()
 }
 
+pub fn beckmann_d(alpha: Vec2, m: Vec3) -> f32 {
+    if m.z <= 0.0 {
+        return 0.0;
+    }
+    let z2 = m.z * m.z;
+    let e = ((m.x * m.x) / (alpha.x * alpha.x) + (m.y * m.y) / (alpha.y * alpha.y)) / z2;
+    (-e).exp() / (PI * alpha.x * alpha.y * z2 * z2)
+}
+
+pub fn beckmann_lambda(alpha: Vec2, w: Vec3) -> f32 {
+    let r = (w.x * w.x * alpha.x * alpha.x + w.y * w.y * alpha.y * alpha.y).sqrt();
+    if r == 0.0 {
+        return 0.0;
+    }
+    let a = w.z.abs() / r;
+    if a >= 1.6 {
+        return 0.0;
+    }
+    if a == 0.0 {
+        return 1e30;
+    }
+    let g1 = (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a);
+    1.0 / g1 - 1.0
+}
+
+pub fn beckmann_sample(alpha: Vec2, u: Vec2) -> Vec3 {
+    let mut phi = 2.0 * PI * u.y;
+    if alpha.x != alpha.y {
+        phi = (alpha.y * phi.sin()).atan2(alpha.x * phi.cos());
+    }
+    let (c, s) = (phi.cos(), phi.sin());
+    let tan2 =
+        -(1.0 - u.x).max(1e-30).ln() / (c * c / (alpha.x * alpha.x) + s * s / (alpha.y * alpha.y));
+    let cos_t = 1.0 / (1.0 + tan2).sqrt();
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    Vec3::new(sin_t * c, sin_t * s, cos_t)
+}
+
+fn is_beckmann(b: &Bsdf) -> bool {
+    b.model & MICROFACET_BECKMANN != 0
+}
+
+pub fn mf_d(b: &Bsdf, m: Vec3) -> f32 {
+    if is_beckmann(b) {
+        beckmann_d(b.alpha, m)
+    } else {
+        ggx_d(b.alpha, m)
+    }
+}
+
+pub fn mf_lambda(b: &Bsdf, w: Vec3) -> f32 {
+    if is_beckmann(b) {
+        beckmann_lambda(b.alpha, w)
+    } else {
+        ggx_lambda(b.alpha, w)
+    }
+}
+
+pub fn mf_g(b: &Bsdf, wo: Vec3, wi: Vec3) -> f32 {
+    let (lo, li) = (mf_lambda(b, wo), mf_lambda(b, wi));
+    if b.model & MICROFACET_SEPARABLE != 0 {
+        return 1.0 / ((1.0 + lo) * (1.0 + li));
+    }
+    1.0 / (1.0 + lo + li)
+}
+
+pub fn mf_pdf_m(b: &Bsdf, wo: Vec3, m: Vec3) -> f32 {
+    if is_beckmann(b) {
+        return beckmann_d(b.alpha, m) * m.z;
+    }
+    ggx_pdf_visible(b.alpha, wo, m)
+}
+
 /// f(wo, wi) of the non-delta lobes, local directions.
 pub fn eval_local(b: &Bsdf, wo: Vec3, wi: Vec3) -> Vec3 {
     if wo.z <= 0.0 || wi.z <= 0.0 {
@@ -167,7 +246,7 @@ pub fn eval_local(b: &Bsdf, wo: Vec3, wi: Vec3) -> Vec3 {
     }
     let m = m.normalize();
     let f = fresnel_conductor(wo.dot(m).abs(), b.eta, b.k);
-    b.color * f * (ggx_d(b.alpha, m) * ggx_g(b.alpha, wo, wi) / (4.0 * wo.z * wi.z))
+    b.color * f * (mf_d(b, m) * mf_g(b, wo, wi) / (4.0 * wo.z * wi.z))
 }
 
 pub fn pdf_local(b: &Bsdf, wo: Vec3, wi: Vec3) -> f32 {
@@ -185,7 +264,7 @@ pub fn pdf_local(b: &Bsdf, wo: Vec3, wi: Vec3) -> f32 {
         return 0.0;
     }
     let m = m.normalize();
-    ggx_pdf_visible(b.alpha, wo, m) / (4.0 * wo.dot(m).abs())
+    mf_pdf_m(b, wo, m) / (4.0 * wo.dot(m).abs())
 }
 
 pub fn eval(b: &Bsdf, f: &Frame, wo: Vec3, wi: Vec3) -> Vec3 {
@@ -231,12 +310,19 @@ pub fn sample(b: &Bsdf, f: &Frame, wo: Vec3, u: Vec2) -> BsdfSample {
     if lo.z <= 0.0 {
         return none;
     }
-    let m = ggx_sample_visible(b.alpha, lo, u);
+    let m = if is_beckmann(b) {
+        beckmann_sample(b.alpha, u)
+    } else {
+        ggx_sample_visible(b.alpha, lo, u)
+    };
+    if lo.dot(m) <= 0.0 {
+        return none;
+    }
     let li = reflect(-lo, m);
     if li.z <= 0.0 {
         return none;
     }
-    let pdf = ggx_pdf_visible(b.alpha, lo, m) / (4.0 * lo.dot(m).abs());
+    let pdf = mf_pdf_m(b, lo, m) / (4.0 * lo.dot(m).abs());
     // Not positive, or NaN.
     if pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return none;

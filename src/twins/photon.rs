@@ -199,8 +199,9 @@ pub fn bounce(
             k,
             tint,
             alpha,
+            microfacet,
         } if alpha > 0.0 => {
-            let b = Bsdf::conductor(tint, eta, k, Vec2::splat(alpha));
+            let b = Bsdf::conductor(tint, eta, k, Vec2::splat(alpha)).with_model(microfacet.bits());
             let s = bsdf_sample(&b, &Frame::around(ms), -d, Vec2::new(u1, u2));
             alive = s.lobe != 0 && s.wi.dot(nf) > 0.0;
             let next = if alive { s.wi } else { d };

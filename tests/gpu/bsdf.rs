@@ -1,12 +1,14 @@
 //! glsl/common/bsdf.glsl against its twin (src/twins/bsdf.rs) on random
 //! queries: evaluate, pdf and sample of the diffuse lobe and of smooth-ish to
-//! rough, isotropic and anisotropic conductors, about a tilted normal.
+//! rough, isotropic and anisotropic conductors (Trowbridge-Reitz and
+//! Beckmann, height-correlated and separable masking), about a tilted normal.
 
 use crate::common;
 use crate::common::Rng;
 
 use glam::{Vec2, Vec3};
 use photonmap::gpu::{DrawState, Program, Target, TexFormat, Texture};
+use photonmap::layout::{MICROFACET_BECKMANN, MICROFACET_SEPARABLE};
 use photonmap::twins::bsdf::{eval, pdf, sample, Bsdf, Frame};
 
 const WIDTH: u32 = 64;
@@ -41,6 +43,12 @@ fn the_bsdf_layer_matches_its_twin() {
             Vec3::splat(3.0),
             Vec2::splat(1.0),
         ),
+        Bsdf::conductor(Vec3::ONE, gold.0, gold.1, Vec2::splat(0.3))
+            .with_model(MICROFACET_BECKMANN | MICROFACET_SEPARABLE),
+        Bsdf::conductor(Vec3::ONE, gold.0, gold.1, Vec2::new(0.1, 0.4))
+            .with_model(MICROFACET_BECKMANN),
+        Bsdf::conductor(Vec3::ONE, gold.0, gold.1, Vec2::splat(0.3))
+            .with_model(MICROFACET_SEPARABLE),
     ];
     let mut rng = Rng(0xb5df);
     let direction = |rng: &mut Rng| -> Vec3 {
@@ -85,6 +93,7 @@ fn the_bsdf_layer_matches_its_twin() {
             .vec3("u_eta", b.eta.into())
             .vec3("u_k", b.k.into())
             .vec3("u_normal", normal.into())
+            .int("u_model", b.model as i32)
             .draw_fullscreen(&target, &DrawState::PLAIN)
             .unwrap();
         let [evals, samples, weights] = [0, 1, 2].map(|i| common::texels(&outs[i]));

@@ -26,7 +26,17 @@ pub enum Mat {
         k: [f64; 3],
         tint: [f64; 3],
         alpha: f64,
+        /// Mitsuba's microfacet model (GGX or Beckmann, separable
+        /// masking) rather than pbrt's.
+        mitsuba: Option<Distribution>,
     },
+}
+
+/// A rough lobe's microfacet distribution, as Mitsuba names it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Distribution {
+    Ggx,
+    Beckmann,
 }
 
 /// A surface, in world space; `material` indexes `Model::materials`.
@@ -434,13 +444,21 @@ pub fn to_toml(model: &Model) -> String {
                 k,
                 tint,
                 alpha,
+                mitsuba,
             } => writeln!(
                 w,
-                "{name} = {{ type = \"conductor\", eta = {}, k = {}, tint = {}, alpha = {} }}",
+                "{name} = {{ type = \"conductor\", eta = {}, k = {}, tint = {}, alpha = {}{} }}",
                 fmt_c(eta),
                 fmt_c(k),
                 fmt_c(tint),
-                fmt(alpha)
+                fmt(alpha),
+                match mitsuba.filter(|_| alpha > 0.0) {
+                    None => "",
+                    Some(Distribution::Ggx) => ", distribution = \"ggx\", masking = \"separable\"",
+                    Some(Distribution::Beckmann) => {
+                        ", distribution = \"beckmann\", masking = \"separable\""
+                    }
+                }
             ),
         };
     }

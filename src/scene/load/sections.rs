@@ -16,7 +16,7 @@ use super::super::defaults::{
 use super::super::metals;
 use super::super::rebase::Coord;
 use super::super::{
-    Camera, Geometry, Light, Material, PhotonMapParams, RenderParams, Scene, Shape,
+    Camera, Geometry, Light, Material, Microfacet, PhotonMapParams, RenderParams, Scene, Shape,
 };
 use super::context::{Cx, Span};
 use super::mesh::{self, Model};
@@ -64,7 +64,15 @@ const MATERIAL_KINDS: &Kinds<MaterialKind> = &[
     (
         "conductor",
         MaterialKind::Conductor,
-        &["metal", "eta", "k", "tint", "alpha"],
+        &[
+            "metal",
+            "eta",
+            "k",
+            "tint",
+            "alpha",
+            "distribution",
+            "masking",
+        ],
     ),
 ];
 
@@ -467,11 +475,39 @@ fn read_conductor(t: &Table) -> Result<Material, SceneError> {
         ));
     }
     let alpha = if alpha < SMOOTH_ALPHA { 0.0 } else { alpha };
+    let choice = |key: &str, names: [&str; 2], default: &str| -> Result<bool, SceneError> {
+        let at = t.or::<String>(key, default.to_string())?;
+        match names.iter().position(|n| n == at.get_ref()) {
+            Some(i) => Ok(i == 1),
+            None => Err(t.cx.err(
+                at.span(),
+                &t.field(key),
+                format!(
+                    "unknown {key} `{}`, expected `{}` or `{}`",
+                    at.get_ref(),
+                    names[0],
+                    names[1]
+                ),
+            )),
+        }
+    };
+    let mut microfacet = Microfacet {
+        beckmann: choice("distribution", ["ggx", "beckmann"], "ggx")?,
+        separable: choice(
+            "masking",
+            ["height-correlated", "separable"],
+            "height-correlated",
+        )?,
+    };
+    if alpha == 0.0 {
+        microfacet = Microfacet::default(); // a smooth metal has no microfacets
+    }
     Ok(Material::Conductor {
         eta,
         k,
         tint,
         alpha,
+        microfacet,
     })
 }
 

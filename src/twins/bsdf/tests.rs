@@ -46,6 +46,23 @@ fn lobes() -> Vec<(&'static str, Bsdf)> {
         ("perfect 0.6", perfect(Vec2::splat(0.6))),
         ("perfect 0.1 x 0.5", perfect(Vec2::new(0.1, 0.5))),
         ("perfect 1.0", perfect(Vec2::splat(1.0))),
+        (
+            "gold 0.3, separable",
+            Bsdf::conductor(Vec3::ONE, GOLD_ETA, GOLD_K, Vec2::splat(0.3))
+                .with_model(MICROFACET_SEPARABLE),
+        ),
+        (
+            "beckmann 0.15",
+            perfect(Vec2::splat(0.15)).with_model(MICROFACET_BECKMANN | MICROFACET_SEPARABLE),
+        ),
+        (
+            "beckmann 0.5",
+            perfect(Vec2::splat(0.5)).with_model(MICROFACET_BECKMANN | MICROFACET_SEPARABLE),
+        ),
+        (
+            "beckmann 0.1 x 0.4",
+            perfect(Vec2::new(0.1, 0.4)).with_model(MICROFACET_BECKMANN),
+        ),
     ]
 }
 

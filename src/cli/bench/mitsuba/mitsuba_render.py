@@ -54,7 +54,8 @@ def bsdf(m):
         metal = {"type": "conductor", "eta": rgb(m["eta"]), "k": rgb(m["k"]),
                  "specular_reflectance": rgb(m["tint"])}
         if m["alpha"] > 0.0:
-            metal.update({"type": "roughconductor", "distribution": "ggx", "alpha": m["alpha"]})
+            metal.update({"type": "roughconductor", "distribution": m["distribution"],
+                          "alpha": m["alpha"]})
         return {"type": "twosided", "bsdf": metal}
     if m["type"] == "glass":
         return {"type": "dielectric", "int_ior": m["ior"], "ext_ior": 1.0}

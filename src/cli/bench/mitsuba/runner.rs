@@ -90,14 +90,15 @@ pub fn export(scene: &Scene, width: u32, height: u32, max_depth: i32) -> serde_j
             json!({"type": "mirror", "reflectance": v(reflectance)})
         }
         Material::Glass { ior } => json!({"type": "glass", "ior": ior}),
+        // Mitsuba masks by the product of the two G1 whatever is asked.
         Material::Conductor {
             eta,
             k,
             tint,
             alpha,
-        } => {
-            json!({"type": "conductor", "eta": v(eta), "k": v(k), "tint": v(tint), "alpha": alpha})
-        }
+            microfacet,
+        } => json!({"type": "conductor", "eta": v(eta), "k": v(k), "tint": v(tint), "alpha": alpha,
+                    "distribution": if microfacet.beckmann { "beckmann" } else { "ggx" }}),
         Material::Emitter { radiance, .. } => json!({"type": "emitter", "radiance": v(radiance)}),
     };
     let (meshes, spheres, cylinders) = shapes(scene, &material);

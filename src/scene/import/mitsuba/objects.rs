@@ -9,7 +9,7 @@ use glam::{DMat4, DQuat, DVec3};
 use roxmltree::Node;
 
 use super::super::geometry::{self, Emission, Mesh, Xf};
-use super::super::model::{CameraSpec, Emitter, Mat};
+use super::super::model::{CameraSpec, Distribution, Emitter, Mat};
 use super::state::Reader;
 use super::values::{At, Props};
 use crate::error::SceneError;
@@ -272,6 +272,7 @@ fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, Sce
         }
     };
     let mut alpha = 0.0;
+    let mut model = Distribution::Ggx;
     if rough {
         let distribution = p
             .string(at, "distribution")?
@@ -280,14 +281,19 @@ fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, Sce
         let a = p.float(at, "alpha", 0.1)?;
         let (u, v) = (p.float(at, "alpha_u", a)?, p.float(at, "alpha_v", a)?);
         alpha = u.max(v);
-        if distribution != "ggx" {
-            r.cx.unsupported(
-                at.file,
-                p.line_of(at, "distribution"),
-                &format!("{} with the {distribution} distribution", p.what),
-                &format!("GGX of alpha {alpha}"),
-            )?;
-        }
+        model = match distribution.as_str() {
+            "ggx" => Distribution::Ggx,
+            "beckmann" => Distribution::Beckmann,
+            other => {
+                r.cx.unsupported(
+                    at.file,
+                    p.line_of(at, "distribution"),
+                    &format!("{} with the {other} distribution", p.what),
+                    &format!("Beckmann of alpha {alpha}"),
+                )?;
+                Distribution::Beckmann
+            }
+        };
         if (u - v).abs() > 1e-6 * alpha {
             r.cx.unsupported(
                 at.file,
@@ -313,6 +319,7 @@ fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, Sce
         k: k.map(|x| x.clamp(0.0, 100.0)),
         tint,
         alpha,
+        mitsuba: Some(model),
     })
 }
 

@@ -288,6 +288,7 @@ fn conductor(r: &mut Reader, p: &Params) -> Result<Mat, SceneError> {
         k: k.map(|x| x.clamp(0.0, 100.0)),
         tint: [1.0; 3],
         alpha,
+        mitsuba: None,
     })
 }
 

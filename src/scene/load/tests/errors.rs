@@ -323,6 +323,7 @@ fn conductors_load_by_name_or_index() {
         k,
         tint,
         alpha,
+        ..
     } = gold.materials[0]
     else {
         panic!("{:?}", gold.materials[0]);
@@ -339,6 +340,15 @@ fn conductors_load_by_name_or_index() {
     // Below 1e-3 a metal is smooth, as pbrt-v4 treats it.
     let nearly = load(&metal("metal = \"Ag\", alpha = 0.0005")).unwrap();
     assert!(!nearly.materials[0].is_glossy());
+    // pbrt's microfacet model by default; Mitsuba's when asked.
+    let model = |fields: &str| match load(&metal(fields)).unwrap().materials[0] {
+        Material::Conductor { microfacet, .. } => microfacet,
+        m => panic!("{m:?}"),
+    };
+    assert_eq!(model("metal = \"Au\"").bits(), 0);
+    let mitsuba =
+        model("metal = \"Au\", alpha = 0.3, distribution = \"beckmann\", masking = \"separable\"");
+    assert_eq!(mitsuba, crate::scene::Microfacet::mitsuba(true));
 }
 
 #[test]
@@ -384,4 +394,19 @@ fn bad_conductors_name_their_field() {
         "materials.white.tint",
     );
     assert!(e.message.contains("[0, 1]"), "{e}");
+    let e = error_at(
+        &metal("metal = \"Au\", distribution = \"phong\""),
+        10,
+        "materials.white.distribution",
+    );
+    assert!(e.message.contains("`ggx` or `beckmann`"), "{e}");
+    let e = error_at(
+        &metal("metal = \"Au\", masking = \"none\""),
+        10,
+        "materials.white.masking",
+    );
+    assert!(
+        e.message.contains("`height-correlated` or `separable`"),
+        "{e}"
+    );
 }
