@@ -82,11 +82,23 @@ void main() {
             o_throughput = vec4(throughput, float(prim));
             return;
         }
-        if (!bsdf_is_delta(b)) return;
-        float u = b.kind == MAT_GLASS ? rng_next(rng) : 0.0;
         bool shaded = has_shading_normal(prim);
         vec3 ms = nf;
         if (shaded) ms = shading_normal(prim, p, n) * (entering ? 1.0 : -1.0);
+        if (SCENE_HAS_GLOSSY && bsdf_lobes(b) == BSDF_GLOSSY) {
+            // A rough metal: on along a sample of its lobe; light that meets
+            // it straight from an emitter is the caustic map's, as through a
+            // mirror.
+            float v1 = rng_next(rng);
+            BsdfSample s = bsdf_sample(b, frame_around(ms), -d, vec2(v1, rng_next(rng)));
+            if (s.lobe == 0 || dot(s.wi, nf) <= 0.0) return;
+            throughput *= s.weight;
+            d = s.wi;
+            o = offset_origin(p, nf, d);
+            continue;
+        }
+        if (!bsdf_is_delta(b)) return;
+        float u = b.kind == MAT_GLASS ? rng_next(rng) : 0.0;
         // A gather ray carries radiance back to the pixel, as an eye path does.
         vec3 factor;
         bool used;

@@ -222,25 +222,24 @@ impl RenderOptions {
     }
 
     /// Refuses a scene with a rough metal (a glossy lobe) where this render
-    /// cannot follow one: only the fused eye paths sample and evaluate a
-    /// glossy lobe, so direct light, the paper's method and SPPM render it,
-    /// and not under `--faithful` (the paper's pass per bounce), final
-    /// gather, IGI, differentials, radiosity or VCM.
+    /// cannot follow one: only the fused eye paths (and final gather's
+    /// rays) sample and evaluate a glossy lobe, so direct light, the paper's
+    /// method with or without final gather and SPPM render it, and not
+    /// under `--faithful` (the paper's pass per bounce), IGI, differentials,
+    /// radiosity or VCM.
     pub fn check_materials(&self, scene: &Scene) -> crate::error::Result<()> {
         let Some(material) = scene.glossy_material() else {
             return Ok(());
         };
         let what = match &self.method {
             _ if self.pass_per_bounce => "--faithful (the paper's pass per bounce)",
-            Method::DirectOnly | Method::Sppm(_) => return Ok(()),
-            Method::PhotonMap(o) if o.final_gather.is_none() => return Ok(()),
-            Method::PhotonMap(_) => "final gather",
+            Method::DirectOnly | Method::Sppm(_) | Method::PhotonMap(_) => return Ok(()),
             m => m.name(),
         };
         Err(crate::error::Error::InvalidOption(format!(
             "{what} cannot render a {} (alpha {}): only the fused eye paths follow a \
-             glossy lobe; render it with --method sppm, the paper's method or \
-             --direct-only, or make the metal smooth (alpha = 0)",
+             glossy lobe; render it with --method sppm, the paper's method (with or \
+             without final gather) or --direct-only, or make the metal smooth (alpha = 0)",
             material.kind_name(),
             match material {
                 crate::scene::Material::Conductor { alpha, .. } => *alpha,

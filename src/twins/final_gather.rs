@@ -3,11 +3,11 @@
 //! traced by the CPU ray tracer, and the global map's estimate at their hits by
 //! the CPU kNN-grid.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::scene::{Material, Scene};
 
-use super::bsdf::fresnel_conductor;
+use super::bsdf::{fresnel_conductor, sample as bsdf_sample, Bsdf, Frame};
 use super::knn::{knn_grid, CpuPhotonMap};
 use super::random::{rng_init, rng_next};
 use super::ray_trace::{closest_hit, offset_scale};
@@ -82,8 +82,31 @@ pub fn gather_ray(
                 0.0
             }
             Material::Glass { ior } => ior,
-            // A rough metal ends the ray (final gather refuses such scenes).
-            Material::Conductor { alpha, .. } if alpha > 0.0 => return None,
+            Material::Conductor {
+                eta,
+                k,
+                tint,
+                alpha,
+                microfacet,
+            } if alpha > 0.0 => {
+                let ms = facing_shading_normal(&scene.shapes[shape], p, n, d);
+                let b =
+                    Bsdf::conductor(tint, eta, k, Vec2::splat(alpha)).with_model(microfacet.bits());
+                let v1 = rng_next(&mut rng);
+                let s = bsdf_sample(
+                    &b,
+                    &Frame::around(ms),
+                    -d,
+                    Vec2::new(v1, rng_next(&mut rng)),
+                );
+                if s.lobe == 0 || s.wi.dot(nf) <= 0.0 {
+                    return None;
+                }
+                throughput *= s.weight;
+                d = s.wi;
+                o = offset_origin(p, nf, d, floor);
+                continue;
+            }
             Material::Conductor { .. } => 0.0,
         };
         let u = if ior > 0.0 { rng_next(&mut rng) } else { 0.0 };

@@ -322,7 +322,6 @@ fn a_rough_metal_renders_by_the_fused_eye_paths_and_is_refused_elsewhere() {
     for refused in [
         vec!["--method", "vcm"],
         vec!["--method", "igi"],
-        vec!["--final-gather", "4"],
         vec!["--faithful"],
     ] {
         let out = d.join("refused.png");

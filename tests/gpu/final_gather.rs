@@ -78,6 +78,49 @@ fn final_gather_equals_its_cpu_twin() {
     assert!(pixels_apart * 100 <= pixels, "{pixels_apart} pixels apart");
 }
 
+/// The same through metals (`scenes/tests/metal_box.toml`): a gather ray
+/// that meets the rough gold sphere goes on along a sample of its lobe, and
+/// one that meets the smooth aluminium sphere takes its Fresnel, as the twin
+/// does with the same random numbers.
+#[test]
+fn final_gather_through_metals_equals_its_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = common::paper_scene("tests/metal_box");
+    let (w, h, rays, k, seed) = (24u32, 24u32, 8u32, 40u32, 5u32);
+    let out = render(
+        &gpu,
+        &scene,
+        &gather_options(&scene, w, h, seed, rays, k),
+        &mut (),
+    )
+    .unwrap();
+    let fg = out.gather().unwrap();
+    let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
+    let c = compare_with_twin(
+        &scene,
+        &out.state.direct,
+        fg,
+        &map,
+        (seed, rays, k),
+        (scene.render.max_specular_depth, 0.0),
+    );
+    eprintln!(
+        "final gather twin through metals: {} of {} rays apart ({} through a metal), {} of {} pixels apart",
+        c.rays_apart, c.rays_checked, c.through_specular, c.pixels_apart, c.pixels
+    );
+    assert!(c.through_specular > 50, "the scene exercises the metals");
+    assert!(
+        c.rays_apart * 200 <= c.rays_checked,
+        "{} rays apart",
+        c.rays_apart
+    );
+    assert!(
+        c.pixels_apart * 100 <= c.pixels,
+        "{} pixels apart",
+        c.pixels_apart
+    );
+}
+
 /// What `compare_with_twin` counted.
 pub struct TwinCheck {
     pub rays_checked: u32,

@@ -193,3 +193,33 @@ fn mitsuba_errors_name_their_line() {
         "--lenient: left out",
     );
 }
+
+/// Metals import as conductors: Mitsuba's `roughconductor` (Beckmann by
+/// default) in Mitsuba's own microfacet model, pbrt's rough conductor with
+/// its roughness remapped; anisotropy is refused strictly.
+#[test]
+fn rough_metals_import_in_their_renderers_models() {
+    let xml = format!(
+        "{XML_HEAD}<shape type=\"sphere\"><bsdf type=\"roughconductor\">\
+         <string name=\"material\" value=\"Au\"/><float name=\"alpha\" value=\"0.2\"/></bsdf></shape>\n</scene>\n"
+    );
+    let toml = convert_default("metal.xml", &xml).unwrap().toml;
+    assert!(toml.contains("type = \"conductor\""), "{toml}");
+    assert!(
+        toml.contains("alpha = 0.2, distribution = \"beckmann\", masking = \"separable\""),
+        "{toml}"
+    );
+    let pbrt = "Camera \"perspective\"\nWorldBegin\nLightSource \"point\"\n\
+                Material \"conductor\" \"float roughness\" 0.04\nShape \"sphere\"\n";
+    let toml = convert_default("metal.pbrt", pbrt).unwrap().toml;
+    assert!(toml.contains("type = \"conductor\""), "{toml}");
+    assert!(
+        toml.contains("alpha = 0.2 }"),
+        "sqrt(0.04) and pbrt's model: {toml}"
+    );
+    let e = xml_error(
+        "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>\
+         <float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>\n",
+    );
+    assert!(e.to_string().contains("anisotropic alpha"), "{e}");
+}
