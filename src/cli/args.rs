@@ -681,7 +681,7 @@ fn non_negative(s: &str) -> Result<f64, String> {
 /// The scene a command renders, and overrides of its fields.
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
-    /// Scene file (TOML; see README.md), or the name of an embedded scene
+    /// Scene file (TOML; see the book's scene format), or the name of an embedded scene
     /// (`photonmap scenes` lists them: glass_ball, ring, cornell_box, ...).
     pub scene: std::path::PathBuf,
     /// Override a scene field by its path, validated like the file and

@@ -152,7 +152,7 @@ impl BitonicBuild {
         Ok(Self {
             gpu: gpu.clone(),
             // Off: on llvmpipe the fused passes take as long as the faithful
-            // ones (`bench build`; README), so renders keep the paper's.
+            // ones (`bench build`; the book), so renders keep the paper's.
             fused: false,
             bitonic_pair: p("photon/bitonic_pair.frag")?,
             bitonic_local: p("photon/bitonic_local.frag")?,

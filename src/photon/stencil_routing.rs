@@ -18,7 +18,7 @@
 //! redistribution scales each kept photon by destined / kept of its own cell
 //! and keeps that factor in power .w. A cell whose bucket filled before any of
 //! its photons arrived has no slot to carry its power: that power is lost, and
-//! counted (`LostPower`; README, "The hash grid").
+//! counted (`LostPower`; the book, "The hash grid").
 
 use crate::error::Error;
 use crate::gpu::{

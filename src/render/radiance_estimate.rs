@@ -69,7 +69,7 @@ pub struct EstimateOptions {
     /// The paper's float convert1dto2d for photon addresses (`--faithful`).
     pub float_addressing: bool,
     /// Which photons in the sphere may light the query point (default:
-    /// visibility; README, "Light through walls").
+    /// visibility; the book, "Light through walls").
     pub leak: LeakTest,
     /// Skip cells beyond the search radius unopened (the same result, bit for
     /// bit); false visits every cell of every ring, as the paper's search.

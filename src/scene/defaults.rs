@@ -1,6 +1,6 @@
 //! Every default and limit of the scene format, in one place: the loader
 //! fills absent fields from here and checks ranges against these limits,
-//! `Scene::with_shapes` builds its parameters from here, and the README's
+//! `Scene::with_shapes` builds its parameters from here, and the book's
 //! scene-format section quotes these numbers (the loader's unit tests,
 //! src/scene/load/tests/defaults.rs, check that it still does).
 

@@ -522,7 +522,7 @@ fn prescan_mtl(text: &str, path: &Path) -> Result<MtlNames, String> {
 // ---- MTL materials as the renderer's --------------------------------------------
 
 /// An MTL material as one of the renderer's, by the first rule that applies
-/// (README, "OBJ meshes and MTL materials"):
+/// (the book, "OBJ meshes and MTL materials"):
 /// 1. `Ke` with a channel above 0: an emitter of radiance Ke, from each
 ///    triangle's front face (its Kd is not used: emitters reflect nothing);
 /// 2. `illum 7`, or `illum 4` or `6` with `Ni` other than 1: glass of ior Ni;

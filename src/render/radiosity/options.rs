@@ -62,7 +62,7 @@ impl Default for RadiosityOptions {
     /// split once (depth 1) where the second difference exceeds a quarter of
     /// the local radiosity: against SPPM, depth 1 beat uniform tiles on
     /// CORNELL BOX and the mesh scene, and beat depth 2 on the mesh scene,
-    /// which on CORNELL BOX took twice the solve for 0.3% less error (README).
+    /// which on CORNELL BOX took twice the solve for 0.3% less error (the book's radiosity page).
     fn default() -> Self {
         Self {
             resolution: 16,

@@ -85,7 +85,7 @@ impl SppmStart {
 }
 
 /// The first radius in pixel footprints by default. Chosen against the
-/// independent truth at equal time (README, "The truth: SPPM").
+/// independent truth at equal time (the book, "The truth: SPPM").
 pub const DEFAULT_START_PIXELS: f32 = 4.0;
 
 /// The kNN bound on the first radius by default: bright caustics start
@@ -97,5 +97,5 @@ pub const DEFAULT_START_PHOTONS: Option<u32> = Some(16);
 
 /// The gather's leak test by default: none. The leak vanishes as the radii
 /// shrink, and the visibility test's shadow ray per photon cost more error
-/// at equal time than it removed (README, "The truth: SPPM").
+/// at equal time than it removed (the book, "The truth: SPPM").
 pub const DEFAULT_SPPM_LEAK: LeakTest = LeakTest::None;

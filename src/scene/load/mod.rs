@@ -1,4 +1,4 @@
-//! TOML scene files (format in README.md) into `Scene`, with every error
+//! TOML scene files (format in docs/src/guide/scene-format.md) into `Scene`, with every error
 //! naming the file, line and field.
 //!
 //! The text is parsed with toml's span-keeping document API (`DeTable`), in

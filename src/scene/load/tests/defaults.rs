@@ -1,6 +1,6 @@
 //! The numbers the scenes and the format promise: the paper scenes' pinned
 //! parameters, and the defaults an absent field takes, which
-//! `Scene::with_shapes` uses too and README's scene format quotes.
+//! `Scene::with_shapes` uses too and the book's scene format (docs/src/guide/scene-format.md) quotes.
 
 use glam::Vec3;
 
@@ -101,18 +101,18 @@ fn absent_parameters_take_the_defaults_that_with_shapes_and_the_readme_use() {
     assert_eq!(p.max_radius, DEFAULT_MAX_RADIUS_OF_SIZE * 2.0);
     assert_eq!(p.projection_resolution, DEFAULT_PROJECTION_RESOLUTION);
 
-    // The README's scene format quotes the same numbers.
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let format = readme
-        .split("## Scene format")
+    // The book's scene format quotes the same numbers.
+    let page = std::fs::read_to_string(root().join("docs/src/guide/scene-format.md")).unwrap();
+    let format = page
+        .split("```toml")
         .nth(1)
-        .and_then(|s| s.split("\n## ").next())
-        .expect("README has a scene-format section");
+        .and_then(|s| s.split("```").next())
+        .expect("the scene-format page has a TOML example");
     let line = |key: &str| {
         format
             .lines()
             .find(|l| l.trim_start().starts_with(&format!("{key} ")))
-            .unwrap_or_else(|| panic!("README's scene format has no {key}"))
+            .unwrap_or_else(|| panic!("the book's scene format has no {key}"))
     };
     let tenth = if DEFAULT_MAX_RADIUS_OF_SIZE == 0.1 {
         "default a tenth of the scene's size".to_string()
@@ -134,7 +134,7 @@ fn absent_parameters_take_the_defaults_that_with_shapes_and_the_readme_use() {
         ("glass", format!("ior in [{}, {}]", IOR_RANGE.0, IOR_RANGE.1)),
         ("metal", format!("alpha in [{}, {}]", ALPHA_RANGE.0, ALPHA_RANGE.1)),
     ] {
-        assert!(line(key).contains(&says), "README: {:?} should say {says:?}", line(key));
+        assert!(line(key).contains(&says), "the book's scene format: {:?} should say {says:?}", line(key));
     }
 }
 

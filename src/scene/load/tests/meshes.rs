@@ -1,4 +1,4 @@
-//! OBJ meshes with MTL materials: the mapping of MTL materials (README,
+//! OBJ meshes with MTL materials: the mapping of MTL materials (the book,
 //! "OBJ meshes and MTL materials"), the overrides, emissive triangles as
 //! lights, vertex normals, and errors that name the OBJ or MTL file and
 //! line as well as the scene's `file` field.
