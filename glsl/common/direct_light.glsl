@@ -16,6 +16,23 @@ vec3 emitter_seen(int mat, vec3 n, vec3 d) {
     return dot(d, light_normal) < 0.0 ? material_texel(mat, 1).rgb : vec3(0.0);
 }
 
+// Stratified sample s of area light l (strata_x columns of strata_y rows),
+// from its own random stream per pixel, depth, light and sample: the point
+// q, the direction wi and distance to it from origin, and the light's
+// normal there. direct_light and glossy_direct_light draw the same samples.
+vec3 area_light_sample(uint seed, uvec2 px, int depth, int l, AreaLight L, int s, int strata_x,
+                       int strata_y, vec3 origin, out vec3 wi, out float dist,
+                       out vec3 light_normal) {
+    uint rng = rng_init(seed, px, 0x40000000u | (uint(depth) << 24) | (uint(l) << 12) | uint(s));
+    float su = (float(s % strata_x) + rng_next(rng)) / float(strata_x);
+    float sv = (float(s / strata_x) + rng_next(rng)) / float(strata_y);
+    vec3 q = area_light_point(l, L, su, sv, light_normal);
+    vec3 to_light = q - origin;
+    dist = length(to_light);
+    wi = to_light / dist;
+    return q;
+}
+
 // Irradiance-like sum for direct light at the diffuse hit p (geometric
 // normal n, primitive prim, material mat) seen along d; the light reflected
 // is throughput * (albedo / PI) * sum, in that order (the rounding the
@@ -55,15 +72,10 @@ vec3 direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 n, vec3 d, int pr
         vec3 light_sum = vec3(0.0);
         AreaLight L = area_light(l);
         for (int s = begin; s < end; ++s) {
-            uint rng = rng_init(seed, px,
-                                0x40000000u | (uint(depth) << 24) | (uint(l) << 12) | uint(s));
-            float su = (float(s % strata_x) + rng_next(rng)) / float(strata_x);
-            float sv = (float(s / strata_x) + rng_next(rng)) / float(strata_y);
-            vec3 light_normal;
-            vec3 q = area_light_point(l, L, su, sv, light_normal);
-            vec3 to_light = q - origin;
-            float dist = length(to_light);
-            vec3 wi = to_light / dist;
+            vec3 wi, light_normal;
+            float dist;
+            vec3 q = area_light_sample(seed, px, depth, l, L, s, strata_x, strata_y, origin, wi,
+                                       dist, light_normal);
             float cos_x = dot(nf, wi);
             float cos_l = -dot(light_normal, wi);
             if (cos_x <= 0.0 || cos_l <= 0.0) continue;
@@ -102,15 +114,10 @@ vec3 glossy_direct_light(uint seed, uvec2 px, int depth, vec3 p, vec3 nf, Bsdf b
         vec3 emitted = light_texel(l, 4).rgb;
         AreaLight L = area_light(l);
         for (int s = 0; s < shadow_rays; ++s) {
-            uint rng = rng_init(seed, px,
-                                0x40000000u | (uint(depth) << 24) | (uint(l) << 12) | uint(s));
-            float su = (float(s % strata_x) + rng_next(rng)) / float(strata_x);
-            float sv = (float(s / strata_x) + rng_next(rng)) / float(strata_y);
-            vec3 light_normal;
-            vec3 q = area_light_point(l, L, su, sv, light_normal);
-            vec3 to_light = q - origin;
-            float dist = length(to_light);
-            vec3 wi = to_light / dist;
+            vec3 wi, light_normal;
+            float dist;
+            vec3 q = area_light_sample(seed, px, depth, l, L, s, strata_x, strata_y, origin, wi,
+                                       dist, light_normal);
             float cos_l = -dot(light_normal, wi);
             if (dot(nf, wi) <= 0.0 || cos_l <= 0.0) continue;
             vec3 fr = bsdf_eval(b, f, wo, wi);

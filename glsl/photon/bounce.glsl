@@ -35,14 +35,13 @@ PhotonRecord dead_photon() {
 }
 
 // What the previous interaction multiplies the power by on the way out: a
-// diffuse lobe's albedo over the roulette's survival, a mirror's colour.
-// (A metal's Fresnel depends on the angle and is taken at the bounce.)
+// diffuse lobe's albedo over the roulette's survival. (Delta and glossy
+// lobes take their factor at the bounce.)
 vec3 leaving_factor(int mat) {
     if (mat < 0) return vec3(1.0); // emission
     Bsdf b = material_bsdf(mat);
     vec3 color = b.color;
     if (bsdf_is_diffuse(b)) return color / max(color.r, max(color.g, color.b)); // roulette kept it
-    if (b.kind == MAT_MIRROR) return color;
     return vec3(1.0);
 }
 
@@ -118,7 +117,7 @@ PhotonRecord photon_bounce(PhotonRecord last, ivec2 px, ivec2 local, int bounce)
             float den = -dot(d, nf) * abs(dot(next, ms));
             power *= den > 0.0 ? (-dot(d, ms) * abs(dot(next, nf))) / den : 0.0;
         }
-        if (b.kind == MAT_CONDUCTOR) power *= factor;
+        power *= factor;
     }
     r.position = vec4(p, float(mat));
     r.power = vec4(power, stored ? 1.0 : 0.0);

@@ -12,6 +12,7 @@ use crate::layout::{
     MICROFACET_BECKMANN, MICROFACET_SEPARABLE,
 };
 use crate::sampling::{basis_around, sample_cosine};
+use crate::scene::Material;
 
 const PI: f32 = std::f32::consts::PI;
 
@@ -67,6 +68,35 @@ impl Bsdf {
             return 0;
         }
         BSDF_DELTA
+    }
+}
+
+/// A rough metal's lobe (`material_bsdf` of a rough conductor); None for
+/// any other material.
+pub fn rough_metal(m: &Material) -> Option<Bsdf> {
+    match *m {
+        Material::Conductor {
+            eta,
+            k,
+            tint,
+            alpha,
+            microfacet,
+        } if alpha > 0.0 => {
+            Some(Bsdf::conductor(tint, eta, k, Vec2::splat(alpha)).with_model(microfacet.bits()))
+        }
+        _ => None,
+    }
+}
+
+/// What a smooth metal's delta lobe multiplies a path by, leaving about the
+/// unit normal m that d meets (`bsdf_delta_direction`): its tint times its
+/// Fresnel; 1 for every other material.
+pub fn smooth_metal_factor(material: &Material, d: Vec3, m: Vec3) -> Vec3 {
+    match *material {
+        Material::Conductor { eta, k, tint, .. } => {
+            tint * fresnel_conductor((-d.dot(m)).min(1.0), eta, k)
+        }
+        _ => Vec3::ONE,
     }
 }
 

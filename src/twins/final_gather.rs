@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 
 use crate::scene::{Material, Scene};
 
-use super::bsdf::{fresnel_conductor, sample as bsdf_sample, Bsdf, Frame};
+use super::bsdf::{rough_metal, sample as bsdf_sample, smooth_metal_factor, Frame};
 use super::knn::{knn_grid, CpuPhotonMap};
 use super::random::{rng_init, rng_next};
 use super::ray_trace::{closest_hit, offset_scale};
@@ -82,16 +82,9 @@ pub fn gather_ray(
                 0.0
             }
             Material::Glass { ior } => ior,
-            Material::Conductor {
-                eta,
-                k,
-                tint,
-                alpha,
-                microfacet,
-            } if alpha > 0.0 => {
+            m @ Material::Conductor { .. } if m.is_glossy() => {
                 let ms = facing_shading_normal(&scene.shapes[shape], p, n, d);
-                let b =
-                    Bsdf::conductor(tint, eta, k, Vec2::splat(alpha)).with_model(microfacet.bits());
+                let b = rough_metal(&m).expect("a rough metal");
                 let v1 = rng_next(&mut rng);
                 let s = bsdf_sample(
                     &b,
@@ -116,10 +109,8 @@ pub fn gather_ray(
         } else {
             (specular_about(d, nf, ior, entering, u), false)
         };
-        if let Material::Conductor { eta, k, tint, .. } = scene.materials[material] {
-            let m = if used { ms } else { nf };
-            throughput *= tint * fresnel_conductor((-d.dot(m)).min(1.0), eta, k);
-        }
+        throughput *=
+            smooth_metal_factor(&scene.materials[material], d, if used { ms } else { nf });
         throughput *= radiance_refraction_scale(next, nf, ior, entering);
         let next = next.normalize();
         d = next;

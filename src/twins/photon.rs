@@ -8,7 +8,7 @@ use crate::photon::projection::{ProjectionMaps, ProjectionTexels};
 use crate::scene::pack::PackedScene;
 use crate::scene::{Material, Scene};
 
-use super::bsdf::{fresnel_conductor, sample as bsdf_sample, Bsdf, Frame};
+use super::bsdf::{rough_metal, sample as bsdf_sample, smooth_metal_factor, Frame};
 use super::intersect::intersect_geometry;
 use super::light::sample_light_triangle;
 use super::random::{rng_init, rng_next};
@@ -48,7 +48,6 @@ fn leaving_factor(scene: &Scene, material: i32) -> Vec3 {
     }
     match scene.materials[material as usize] {
         Material::Diffuse { albedo } => albedo / albedo.max_element(),
-        Material::Mirror { reflectance } => reflectance,
         _ => Vec3::ONE,
     }
 }
@@ -194,14 +193,8 @@ pub fn bounce(
             }
             sample_cosine(nf, u1, u2)
         }
-        Material::Conductor {
-            eta,
-            k,
-            tint,
-            alpha,
-            microfacet,
-        } if alpha > 0.0 => {
-            let b = Bsdf::conductor(tint, eta, k, Vec2::splat(alpha)).with_model(microfacet.bits());
+        Material::Conductor { .. } if material.is_glossy() => {
+            let b = rough_metal(&material).expect("a rough metal");
             let s = bsdf_sample(&b, &Frame::around(ms), -d, Vec2::new(u1, u2));
             alive = s.lobe != 0 && s.wi.dot(nf) > 0.0;
             let next = if alive { s.wi } else { d };
@@ -226,10 +219,10 @@ pub fn bounce(
             } else {
                 (specular_about(d, nf, ior, entering, u0), false)
             };
-            if let Material::Conductor { eta, k, tint, .. } = material {
-                let m = if used { ms } else { nf };
-                power *= tint * fresnel_conductor((-d.dot(m)).min(1.0), eta, k);
+            if let Material::Mirror { reflectance } = material {
+                power *= reflectance;
             }
+            power *= smooth_metal_factor(&material, d, if used { ms } else { nf });
             next
         }
         Material::Emitter { .. } => unreachable!(),

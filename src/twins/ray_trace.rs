@@ -9,7 +9,7 @@ use crate::scene::{triangle_area, Geometry, Light, Material, Scene, Shape};
 
 use crate::scene::pack::PackedScene;
 
-use super::bsdf::fresnel_conductor;
+use super::bsdf::smooth_metal_factor;
 use super::intersect::intersect_geometry;
 use super::light::{area_light_point, sample_light_triangle};
 use super::random::{rng_init, rng_next};
@@ -170,14 +170,13 @@ pub fn expected_moments(
             panic!("expected_moments follows smooth surfaces only, not a rough metal")
         }
         Material::Conductor { .. } if depth_left == 0 => (Vec3::ZERO, Vec3::ZERO),
-        Material::Conductor { eta, k, tint, .. } => {
+        metal @ Material::Conductor { .. } => {
             // One branch, about the shading normal where its reflection
             // leaves above the geometric surface (specular_shaded's rule).
             let about_ms = shape.normals.is_some()
                 && d.dot(ms) < 0.0
                 && specular_about(d, ms, 0.0, true, 0.0).dot(nf) > 0.0;
-            let m = if about_ms { ms } else { nf };
-            let f = tint * fresnel_conductor((-d.dot(m)).min(1.0), eta, k);
+            let f = smooth_metal_factor(&metal, d, if about_ms { ms } else { nf });
             let (m1, m2) = specular_moments(scene, (p, n, nf, ms), shape, d, 0.0, depth_left, grid);
             (f * m1, f * f * m2)
         }

@@ -41,28 +41,7 @@ fn gather_options(scene: &Scene, w: u32, h: u32, seed: u32, rays: u32, k: u32) -
 /// may end elsewhere only where the two tracers' rounding sends it past an edge.
 #[test]
 fn final_gather_equals_its_cpu_twin() {
-    let gpu = common::gpu();
-    let scene = common::fixture("mirror_box");
-    let (w, h, rays, k, seed) = (24u32, 24u32, 8u32, 40u32, 5u32);
-    let out = render(
-        &gpu,
-        &scene,
-        &gather_options(&scene, w, h, seed, rays, k),
-        &mut (),
-    )
-    .unwrap();
-    let fg = out.gather().unwrap();
-    assert_eq!(fg.rays.batch, rays, "one batch holds every ray");
-    let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
-    let depth_and_fade = (scene.render.max_specular_depth, 0.0);
-    let c = compare_with_twin(
-        &scene,
-        &out.state.direct,
-        fg,
-        &map,
-        (seed, rays, k),
-        depth_and_fade,
-    );
+    let c = gather_against_twin(&common::fixture("mirror_box"));
     let TwinCheck {
         rays_checked,
         rays_apart,
@@ -84,26 +63,7 @@ fn final_gather_equals_its_cpu_twin() {
 /// does with the same random numbers.
 #[test]
 fn final_gather_through_metals_equals_its_cpu_twin() {
-    let gpu = common::gpu();
-    let scene = common::paper_scene("tests/metal_box");
-    let (w, h, rays, k, seed) = (24u32, 24u32, 8u32, 40u32, 5u32);
-    let out = render(
-        &gpu,
-        &scene,
-        &gather_options(&scene, w, h, seed, rays, k),
-        &mut (),
-    )
-    .unwrap();
-    let fg = out.gather().unwrap();
-    let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
-    let c = compare_with_twin(
-        &scene,
-        &out.state.direct,
-        fg,
-        &map,
-        (seed, rays, k),
-        (scene.render.max_specular_depth, 0.0),
-    );
+    let c = gather_against_twin(&common::paper_scene("tests/metal_box"));
     eprintln!(
         "final gather twin through metals: {} of {} rays apart ({} through a metal), {} of {} pixels apart",
         c.rays_apart, c.rays_checked, c.through_specular, c.pixels_apart, c.pixels
@@ -119,6 +79,32 @@ fn final_gather_through_metals_equals_its_cpu_twin() {
         "{} pixels apart",
         c.pixels_apart
     );
+}
+
+/// `scene` by final gather at 24 x 24 (8 rays a pixel in one batch, k 40,
+/// seed 5), every ray and pixel against the twin (`compare_with_twin`).
+fn gather_against_twin(scene: &Scene) -> TwinCheck {
+    let gpu = common::gpu();
+    let (w, h, rays, k, seed) = (24u32, 24u32, 8u32, 40u32, 5u32);
+    let out = render(
+        &gpu,
+        scene,
+        &gather_options(scene, w, h, seed, rays, k),
+        &mut (),
+    )
+    .unwrap();
+    let fg = out.gather().unwrap();
+    assert_eq!(fg.rays.batch, rays, "one batch holds every ray");
+    let map = CpuPhotonMap::from_gpu(out.gather_map().unwrap());
+    let depth_and_fade = (scene.render.max_specular_depth, 0.0);
+    compare_with_twin(
+        scene,
+        &out.state.direct,
+        fg,
+        &map,
+        (seed, rays, k),
+        depth_and_fade,
+    )
 }
 
 /// What `compare_with_twin` counted.

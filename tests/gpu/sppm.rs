@@ -320,20 +320,16 @@ fn the_furnace_seen_from_inside_glass_is_ior_squared_as_bright() {
     }
 }
 
-/// A block and the floor inside a glass tank (`scenes/variants/glass_tank.toml`
-/// at 32 x 32, an eighth of its size) against Mitsuba 3's path tracer: the
-/// reference is two independent 90 s runs (`reference_images/glass_tank/`,
-/// made by `bench mitsuba --mitsuba-reference`). The camera sees the block and
-/// the floor in the tank only through the glass, so radiance's (eta_i /
-/// eta_t)^2 decides them: without it they read 2.25 times as bright. Block by
-/// block (4 x 4 pixels), SPPM's mean over 8 seeds must meet the reference
-/// within the bound `block_chi2` derives from the seeds' spread, and the
-/// image's energy must lie within 1% and within 4 standard errors.
-#[test]
-fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
-    let scene = common::paper_scene("variants/glass_tank");
+/// SPPM of `scene_name` at the size of two independent Mitsuba runs
+/// (`reference_images/<dir>/reference_run{1,2}.exr`, from `bench mitsuba
+/// --mitsuba-reference`), 8 seeds of 32 iterations, against the runs: block
+/// by block (4 x 4 pixels) the seeds' mean must meet the runs' within the
+/// bound `block_chi2` derives from the seeds' spread, and the image's
+/// energy must lie within 1% and within 4 standard errors.
+fn assert_sppm_meets_mitsuba_runs(scene_name: &str, dir: &str) {
+    let scene = common::paper_scene(scene_name);
     let run = |k: u32| {
-        let path = common::root().join(format!("reference_images/glass_tank/reference_run{k}.exr"));
+        let path = common::root().join(format!("reference_images/{dir}/reference_run{k}.exr"));
         Image::read_exr(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
     };
     let runs = [run(1), run(2)];
@@ -341,8 +337,8 @@ fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
     let sppm = SppmOptions {
         iterations: 32,
         photons_per_iteration: 1 << 13,
-        // A pixel's footprint at 32 x 32 would blur the tank's edges into
-        // their neighbours' blocks; this is about its footprint at 128 x 128.
+        // A pixel's footprint at 32 x 32 would blur edges into their
+        // neighbours' blocks; this is about its footprint at 128 x 128.
         initial_radius: Some(0.03),
         ..SppmOptions::default()
     };
@@ -356,7 +352,7 @@ fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
     let ratios: Vec<f64> = images.iter().map(|i| mean_of(i) / reference).collect();
     let (energy, se) = mean_and_standard_error(&ratios);
     eprintln!(
-        "glass tank {w} x {h}: {blocks} blocks, chi^2/n = {chi2:.2} (bound {bound:.2}); energy {energy:.4} +- {se:.4} of Mitsuba's (8 x 32 SPPM iterations in {seconds:.1} s)"
+        "{dir} {w} x {h}: {blocks} blocks, chi^2/n = {chi2:.2} (bound {bound:.2}); energy {energy:.4} +- {se:.4} of Mitsuba's (8 x 32 SPPM iterations in {seconds:.1} s)"
     );
     assert!(
         chi2 < bound,
@@ -366,6 +362,20 @@ fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
         (energy - 1.0).abs() < 0.01 && (energy - 1.0).abs() < 4.0 * se.max(1e-4),
         "energy {energy} +- {se} of the reference's"
     );
+}
+
+/// A block and the floor inside a glass tank (`scenes/variants/glass_tank.toml`
+/// at 32 x 32, an eighth of its size) against Mitsuba 3's path tracer: the
+/// reference is two independent 90 s runs (`reference_images/glass_tank/`,
+/// made by `bench mitsuba --mitsuba-reference`). The camera sees the block and
+/// the floor in the tank only through the glass, so radiance's (eta_i /
+/// eta_t)^2 decides them: without it they read 2.25 times as bright. Block by
+/// block (4 x 4 pixels), SPPM's mean over 8 seeds must meet the reference
+/// within the bound `block_chi2` derives from the seeds' spread, and the
+/// image's energy must lie within 1% and within 4 standard errors.
+#[test]
+fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
+    assert_sppm_meets_mitsuba_runs("variants/glass_tank", "glass_tank");
 }
 
 /// CORNELL BOX with a rough gold sphere (Trowbridge-Reitz alpha 0.2) and a
@@ -381,39 +391,7 @@ fn a_block_in_a_glass_tank_meets_mitsubas_path_tracer() {
 /// 4 standard errors.
 #[test]
 fn rough_and_smooth_metals_meet_mitsubas_path_tracer() {
-    let scene = common::paper_scene("tests/metal_box");
-    let run = |k: u32| {
-        let path = common::root().join(format!("reference_images/metal_box/reference_run{k}.exr"));
-        Image::read_exr(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-    };
-    let runs = [run(1), run(2)];
-    let (w, h) = (runs[0].width, runs[0].height);
-    let sppm = SppmOptions {
-        iterations: 32,
-        photons_per_iteration: 1 << 13,
-        initial_radius: Some(0.03),
-        ..SppmOptions::default()
-    };
-    let t0 = std::time::Instant::now();
-    let images: Vec<Image> = (1..=8)
-        .map(|seed| sppm_image(&scene, w, h, seed, &sppm))
-        .collect();
-    let seconds = t0.elapsed().as_secs_f64();
-    let (chi2, blocks, bound) = common::block_chi2_against_runs(&images, [&runs[0], &runs[1]], 4);
-    let reference = 0.5 * (mean_of(&runs[0]) + mean_of(&runs[1]));
-    let ratios: Vec<f64> = images.iter().map(|i| mean_of(i) / reference).collect();
-    let (energy, se) = mean_and_standard_error(&ratios);
-    eprintln!(
-        "metal box {w} x {h}: {blocks} blocks, chi^2/n = {chi2:.2} (bound {bound:.2}); energy {energy:.4} +- {se:.4} of Mitsuba's (8 x 32 SPPM iterations in {seconds:.1} s)"
-    );
-    assert!(
-        chi2 < bound,
-        "chi^2/n = {chi2} over {blocks} blocks, bound {bound}"
-    );
-    assert!(
-        (energy - 1.0).abs() < 0.01 && (energy - 1.0).abs() < 4.0 * se.max(1e-4),
-        "energy {energy} +- {se} of the reference's"
-    );
+    assert_sppm_meets_mitsuba_runs("tests/metal_box", "metal_box");
 }
 
 /// Energy: inside a closed diffuse sphere (radius 1, albedo rho) with a point

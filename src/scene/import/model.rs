@@ -12,6 +12,7 @@ use glam::DVec3;
 
 use super::source::Cx;
 use crate::error::SceneError;
+use crate::scene::defaults::ALPHA_RANGE;
 
 /// A material photonmap renders.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,6 +31,60 @@ pub enum Mat {
         /// masking) rather than pbrt's.
         mitsuba: Option<Distribution>,
     },
+}
+
+/// Where an imported rough conductor's notes point: its file, its name
+/// (`what`), the line of its second roughness (`uneven_line`, for
+/// anisotropy) and of its roughness (`alpha_line`), and what the file calls
+/// roughness (`name`: "roughness", "alpha").
+pub struct RoughSource<'a> {
+    pub file: &'a Path,
+    pub what: &'a str,
+    pub name: &'a str,
+    pub uneven_line: usize,
+    pub alpha_line: usize,
+}
+
+impl Mat {
+    /// A conductor as the scene format takes it: eta and k within its
+    /// range, and alpha isotropic (the larger of `u`, `v`) within
+    /// ALPHA_RANGE, each change noted by `Cx::unsupported` (an error unless
+    /// --lenient).
+    pub fn conductor(
+        cx: &mut Cx,
+        at: &RoughSource,
+        (eta, k, tint): ([f64; 3], [f64; 3], [f64; 3]),
+        (u, v): (f64, f64),
+        mitsuba: Option<Distribution>,
+    ) -> Result<Mat, SceneError> {
+        let mut alpha = u.max(v);
+        if (u - v).abs() > 1e-6 * alpha {
+            cx.unsupported(
+                at.file,
+                at.uneven_line,
+                &format!("{} with anisotropic {}", at.what, at.name),
+                &format!("isotropic alpha {alpha}"),
+            )?;
+        }
+        let (lo, hi) = ALPHA_RANGE;
+        if !(f64::from(lo)..=f64::from(hi)).contains(&alpha) {
+            let instead = alpha.clamp(f64::from(lo), f64::from(hi));
+            cx.unsupported(
+                at.file,
+                at.alpha_line,
+                &format!("{} alpha {alpha} (outside [{lo}, {hi}])", at.what),
+                &format!("alpha {instead}"),
+            )?;
+            alpha = instead;
+        }
+        Ok(Mat::Conductor {
+            eta: eta.map(|x| x.clamp(1e-4, 100.0)),
+            k: k.map(|x| x.clamp(0.0, 100.0)),
+            tint,
+            alpha,
+            mitsuba,
+        })
+    }
 }
 
 /// A rough lobe's microfacet distribution, as Mitsuba names it.

@@ -9,11 +9,10 @@ use glam::{DMat4, DQuat, DVec3};
 use roxmltree::Node;
 
 use super::super::geometry::{self, Emission, Mesh, Xf};
-use super::super::model::{CameraSpec, Distribution, Emitter, Mat};
+use super::super::model::{CameraSpec, Distribution, Emitter, Mat, RoughSource};
 use super::state::Reader;
 use super::values::{At, Props};
 use crate::error::SceneError;
-use crate::scene::defaults::ALPHA_RANGE;
 use crate::scene::metals;
 
 fn int(p: &Props, at: &At, name: &str, default: i64, lo: i64, hi: i64) -> Result<i64, SceneError> {
@@ -271,7 +270,7 @@ fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, Sce
             )?));
         }
     };
-    let mut alpha = 0.0;
+    let (mut u, mut v) = (0.0, 0.0);
     let mut model = Distribution::Ggx;
     if rough {
         let distribution = p
@@ -279,8 +278,7 @@ fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, Sce
             .unwrap_or_else(|| "beckmann".into());
         p.ignore(&["sample_visible"]);
         let a = p.float(at, "alpha", 0.1)?;
-        let (u, v) = (p.float(at, "alpha_u", a)?, p.float(at, "alpha_v", a)?);
-        alpha = u.max(v);
+        (u, v) = (p.float(at, "alpha_u", a)?, p.float(at, "alpha_v", a)?);
         model = match distribution.as_str() {
             "ggx" => Distribution::Ggx,
             "beckmann" => Distribution::Beckmann,
@@ -289,38 +287,20 @@ fn conductor(r: &mut Reader, at: &At, p: &Props, rough: bool) -> Result<Mat, Sce
                     at.file,
                     p.line_of(at, "distribution"),
                     &format!("{} with the {other} distribution", p.what),
-                    &format!("Beckmann of alpha {alpha}"),
+                    &format!("Beckmann of alpha {}", u.max(v)),
                 )?;
                 Distribution::Beckmann
             }
         };
-        if (u - v).abs() > 1e-6 * alpha {
-            r.cx.unsupported(
-                at.file,
-                p.line_of(at, "alpha_u"),
-                &format!("{} with anisotropic alpha", p.what),
-                &format!("isotropic alpha {alpha}"),
-            )?;
-        }
-        let (lo, hi) = ALPHA_RANGE;
-        if !(f64::from(lo)..=f64::from(hi)).contains(&alpha) {
-            let instead = alpha.clamp(f64::from(lo), f64::from(hi));
-            r.cx.unsupported(
-                at.file,
-                p.line_of(at, "alpha"),
-                &format!("{} alpha {alpha} (outside [{lo}, {hi}])", p.what),
-                &format!("alpha {instead}"),
-            )?;
-            alpha = instead;
-        }
     }
-    Ok(Mat::Conductor {
-        eta: eta.map(|x| x.clamp(1e-4, 100.0)),
-        k: k.map(|x| x.clamp(0.0, 100.0)),
-        tint,
-        alpha,
-        mitsuba: Some(model),
-    })
+    let source = RoughSource {
+        file: at.file,
+        what: &p.what,
+        name: "alpha",
+        uneven_line: p.line_of(at, "alpha_u"),
+        alpha_line: p.line_of(at, "alpha"),
+    };
+    Mat::conductor(&mut r.cx, &source, (eta, k, tint), (u, v), Some(model))
 }
 
 /// What a conductor it cannot colour becomes (`what`, at `line`, unsupported).

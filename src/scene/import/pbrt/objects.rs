@@ -6,11 +6,10 @@
 use glam::{DMat4, DVec3};
 
 use super::super::geometry::{self, Emission, Mesh, Xf};
-use super::super::model::{Emitter, Mat};
+use super::super::model::{Emitter, Mat, RoughSource};
 use super::params::{blackbody_rgb, Colour, Params};
 use super::state::{AreaLight, PbrtCamera, PendingShape, Reader};
 use crate::error::SceneError;
-use crate::scene::defaults::ALPHA_RANGE;
 use crate::scene::metals;
 
 /// pbrt's LookAt: the camera-from-world transform.
@@ -262,34 +261,20 @@ fn conductor(r: &mut Reader, p: &Params) -> Result<Mat, SceneError> {
     let (u, v) = (p.float("uroughness", rough)?, p.float("vroughness", rough)?);
     let remap = p.bool("remaproughness", true)?;
     let alpha_of = |x: f64| if remap { x.max(0.0).sqrt() } else { x };
-    let (au, av) = (alpha_of(u), alpha_of(v));
-    let mut alpha = au.max(av);
-    if (au - av).abs() > 1e-6 * alpha {
-        r.cx.unsupported(
-            p.file,
-            p.line_of("uroughness"),
-            &format!("{} with anisotropic roughness", p.what),
-            &format!("isotropic alpha {alpha}"),
-        )?;
-    }
-    let (lo, hi) = ALPHA_RANGE;
-    if !(f64::from(lo)..=f64::from(hi)).contains(&alpha) {
-        let instead = alpha.clamp(f64::from(lo), f64::from(hi));
-        r.cx.unsupported(
-            p.file,
-            p.line_of("roughness"),
-            &format!("{} alpha {alpha} (outside [{lo}, {hi}])", p.what),
-            &format!("alpha {instead}"),
-        )?;
-        alpha = instead;
-    }
-    Ok(Mat::Conductor {
-        eta: eta.map(|x| x.clamp(1e-4, 100.0)),
-        k: k.map(|x| x.clamp(0.0, 100.0)),
-        tint: [1.0; 3],
-        alpha,
-        mitsuba: None,
-    })
+    let at = RoughSource {
+        file: p.file,
+        what: &p.what,
+        name: "roughness",
+        uneven_line: p.line_of("uroughness"),
+        alpha_line: p.line_of("roughness"),
+    };
+    Mat::conductor(
+        &mut r.cx,
+        &at,
+        (eta, k, [1.0; 3]),
+        (alpha_of(u), alpha_of(v)),
+        None,
+    )
 }
 
 fn roughness(p: &Params) -> Result<f64, SceneError> {
